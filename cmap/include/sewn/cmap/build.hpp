@@ -1,0 +1,316 @@
+#pragma once
+// Building a map from an indexed mesh, and gluing cells that share a facet.
+//
+//   auto mesh = sewn::hex_grid(8, 8, 10);
+//   sewn::CMap<3, NodeIndex> map;
+//   auto built = sewn::build(map, mesh);            // creates and sews every cell
+//   map.create_attributes<0>([&](sewn::Dart d) { return NodeIndex{built.vertex_of_dart[d.index()]}; });
+//
+// Every cell becomes its own closed piece of the map (volumes: polyhedra with outward faces;
+// 2D cells: polygons; segments: a β2-linked dart pair, or one dart when D = 1). Then cells of the
+// same dimension that share a facet are glued: volumes by β3 across shared faces, 2D cells by
+// β2 across shared edges, segments by β1 at vertices with exactly two segments. A facet shared
+// by three or more cells stays unsewn (its cells share mesh points only), which is how
+// non-manifold junctions of mixed meshes are represented.
+
+#include <algorithm>
+#include <array>
+#include <string>
+#include <vector>
+
+#include "sewn/cmap/cmap.hpp"
+#include "sewn/cmap/mesh.hpp"
+
+namespace sewn {
+
+struct BuildOptions {
+  bool sew = true;                ///< glue cells that share a facet
+  bool orient_surfaces = true;    ///< reverse 2D cells so that neighbours can be glued
+  bool allow_nonmanifold = true;  ///< leave facets of 3+ cells unsewn (false: throw MeshError)
+  std::string source = "mesh";    ///< name used in error messages (a file name, say)
+};
+
+struct BuildResult {
+  /// Per mesh cell, one of its darts: for polyhedra the dart from local vertex 0 to 1 (VTK
+  /// order), for polygons the dart starting at its first vertex, for segments the dart 0 -> 1.
+  std::vector<Dart> cell_dart;
+  /// Mesh point at which each dart starts, indexed by dart index (null_index for darts that
+  /// existed before the build).
+  std::vector<std::uint32_t> vertex_of_dart;
+  /// Mesh cell each dart belongs to, indexed by dart index.
+  std::vector<std::uint32_t> cell_of_dart;
+  /// Per mesh cell: true if a 2D cell was reversed to orient its surface consistently.
+  std::vector<bool> flipped;
+  std::uint32_t sewn_facets = 0;        ///< facets glued
+  std::uint32_t nonmanifold_facets = 0; ///< facets of 3+ cells left unsewn
+  std::uint32_t unorientable_edges = 0; ///< edges of 2D cells left unsewn: orientations clash
+};
+
+namespace detail {
+
+// A facet to be matched: its sorted points (up to 4) and the dart it starts from.
+struct FacetKey {
+  std::array<std::uint32_t, 4> v;
+  std::uint8_t n;
+  std::uint32_t dart;
+  std::uint32_t cell;
+  friend bool operator<(const FacetKey& a, const FacetKey& b) {
+    return a.n != b.n ? a.n < b.n : a.v < b.v;
+  }
+  [[nodiscard]] bool same_points(const FacetKey& o) const { return n == o.n && v == o.v; }
+};
+
+// Groups facets by their smallest point with a counting sort, then by key within a group:
+// O(facets + points). Calls f(first, last) for each run of facets with the same points.
+template <class F>
+void for_each_facet_group(std::vector<FacetKey>& facets, std::uint32_t num_points, F&& f) {
+  std::vector<std::uint32_t> start(num_points + 1, 0);
+  for (const auto& k : facets) ++start[k.v[0] + 1];
+  for (std::uint32_t p = 0; p < num_points; ++p) start[p + 1] += start[p];
+  std::vector<FacetKey> sorted(facets.size());
+  {
+    std::vector<std::uint32_t> pos(start.begin(), start.end() - 1);
+    for (const auto& k : facets) sorted[pos[k.v[0]]++] = k;
+  }
+  for (std::uint32_t p = 0; p < num_points; ++p) {
+    auto first = sorted.begin() + start[p], last = sorted.begin() + start[p + 1];
+    if (last - first > 1) std::sort(first, last);
+    for (auto it = first; it != last;) {
+      auto run = it + 1;
+      while (run != last && run->same_points(*it)) ++run;
+      f(it, run);
+      it = run;
+    }
+  }
+}
+
+}  // namespace detail
+
+/// Creates the cells of `mesh` in `map` (which may already hold darts) and glues them as
+/// described above. Throws MeshError naming the cell for: an index out of range, a repeated
+/// point in a cell, a cell of higher dimension than the map, two volumes whose shared face has
+/// the same orientation in both (one is inverted), or a non-manifold facet when
+/// allow_nonmanifold is false. O(darts + points).
+template <int D, class... A>
+BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOptions& opt = {}) {
+  constexpr std::uint32_t null = Dart::null_index;
+  mesh.check_indices(opt.source);
+  const std::uint32_t nc = mesh.num_cells();
+  BuildResult res;
+  res.cell_dart.resize(nc);
+  res.flipped.assign(nc, false);
+
+  // 1) sizes, dimension check
+  std::uint64_t darts = 0;
+  for (std::uint32_t c = 0; c < nc; ++c) {
+    const CellType t = mesh.types[c];
+    if (cell_dimension(t) > D)
+      throw MeshError(opt.source + ": cell " + std::to_string(c) + " is a " + to_string(t) + " but the map has dimension " +
+                      std::to_string(D));
+    if (cell_dimension(t) == 3)
+      for (auto f : cell_faces(t)) darts += f.size();
+    else if (cell_dimension(t) == 2)
+      darts += static_cast<std::uint64_t>(cell_vertex_count(t));
+    else
+      darts += D == 1 ? 1 : 2;
+  }
+  map.reserve(static_cast<std::uint32_t>(map.dart_capacity() + darts));
+  const std::uint32_t base = map.dart_capacity();
+  res.vertex_of_dart.assign(base, null);
+  res.cell_of_dart.assign(base, null);
+  auto record = [&](Dart d, std::uint32_t point, std::uint32_t cell) {
+    if (d.index() >= res.vertex_of_dart.size()) {
+      res.vertex_of_dart.resize(d.index() + 1, null);
+      res.cell_of_dart.resize(d.index() + 1, null);
+    }
+    res.vertex_of_dart[d.index()] = point;
+    res.cell_of_dart[d.index()] = cell;
+  };
+
+  // 2) orient 2D cells: breadth-first over cells sharing a manifold edge, reversing a
+  //    neighbour that runs along the shared edge in the same direction.
+  if (opt.orient_surfaces) {
+    std::vector<detail::FacetKey> edges;
+    for (std::uint32_t c = 0; c < nc; ++c) {
+      if (cell_dimension(mesh.types[c]) != 2) continue;
+      const auto v = mesh.cell(c);
+      for (std::uint32_t k = 0; k < v.size(); ++k) {
+        const std::uint32_t a = v[k], b = v[(k + 1) % v.size()];
+        edges.push_back({{std::min(a, b), std::max(a, b), 0, 0}, 2, k, c});
+      }
+    }
+    std::vector<std::vector<std::pair<std::uint32_t, bool>>> nbr(nc);  // (cell, same direction)
+    detail::for_each_facet_group(edges, mesh.num_points(), [&](auto first, auto last) {
+      if (last - first != 2) return;
+      const auto& e0 = *first;
+      const auto& e1 = *(first + 1);
+      const auto v0 = mesh.cell(e0.cell);
+      const auto v1 = mesh.cell(e1.cell);
+      const bool same = v0[e0.dart] == v1[e1.dart];  // both start at the same point
+      nbr[e0.cell].emplace_back(e1.cell, same);
+      nbr[e1.cell].emplace_back(e0.cell, same);
+    });
+    std::vector<std::uint8_t> seen(nc, 0);
+    std::vector<std::uint32_t> queue;
+    for (std::uint32_t c0 = 0; c0 < nc; ++c0) {
+      if (cell_dimension(mesh.types[c0]) != 2 || seen[c0]) continue;
+      seen[c0] = 1;
+      queue.assign(1, c0);
+      for (std::size_t h = 0; h < queue.size(); ++h) {
+        const std::uint32_t c = queue[h];
+        for (auto [o, same] : nbr[c]) {
+          const bool want_flip = res.flipped[c] ^ same;
+          if (!seen[o]) {
+            seen[o] = 1;
+            res.flipped[o] = want_flip;
+            queue.push_back(o);
+          }
+        }
+      }
+    }
+  }
+
+  // 3) create the cells, recording each dart's start point and cell
+  std::array<CellTemplate, 7> templates;
+  std::array<bool, 7> have_template{};
+  std::vector<Dart> made;
+  std::vector<detail::FacetKey> facets;      // faces of volumes, edges of 2D cells
+  std::vector<detail::FacetKey> segment_at;  // (point, dart ending there / starting there)
+  for (std::uint32_t c = 0; c < nc; ++c) {
+    const CellType t = mesh.types[c];
+    const auto v = mesh.cell(c);
+    const auto ti = static_cast<std::size_t>(t);
+    made.clear();
+    switch (cell_dimension(t)) {
+      case 3: {
+        if (!have_template[ti]) {
+          templates[ti] = CellTemplate::from_faces(cell_faces(t));
+          have_template[ti] = true;
+        }
+        const CellTemplate& tp = templates[ti];
+        res.cell_dart[c] = map.make_cell(tp, &made);
+        for (std::size_t h = 0; h < made.size(); ++h) record(made[h], v[tp.from[h]], c);
+        std::size_t h = 0;
+        for (std::uint32_t size : tp.face_size) {
+          detail::FacetKey k{{0, 0, 0, 0}, static_cast<std::uint8_t>(size), made[h].index(), c};
+          if (size > 4) throw MeshError(opt.source + ": cell " + std::to_string(c) + " has a face with more than 4 points");
+          for (std::uint32_t l = 0; l < size; ++l) k.v[l] = v[tp.from[h + l]];
+          std::sort(k.v.begin(), k.v.begin() + size);
+          for (std::uint32_t l = size; l < 4; ++l) k.v[l] = null;
+          facets.push_back(k);
+          h += size;
+        }
+        break;
+      }
+      case 2: {
+        const auto n = static_cast<std::uint32_t>(v.size());
+        const Dart first = map.make_polygon(n);
+        res.cell_dart[c] = first;
+        std::uint32_t x = first.index();
+        for (std::uint32_t k = 0; k < n; ++k, x = map.b(x, 1)) {
+          // a reversed cell walks its points backwards: dart k starts at v[(n - k) % n]
+          const std::uint32_t p = res.flipped[c] ? v[(n - k) % n] : v[k];
+          record(Dart(x), p, c);
+        }
+        if constexpr (D >= 2) {
+          x = first.index();
+          for (std::uint32_t k = 0; k < n; ++k, x = map.b(x, 1)) {
+            const std::uint32_t p = res.vertex_of_dart[x], q = res.vertex_of_dart[map.b(x, 1)];
+            facets.push_back({{std::min(p, q), std::max(p, q), null, null}, 2, x, c});
+          }
+        }
+        break;
+      }
+      default: {
+        if constexpr (D == 1) {
+          const Dart d = map.create_dart();
+          res.cell_dart[c] = d;
+          record(d, v[0], c);
+          segment_at.push_back({{v[1], 0, 0, 0}, 1, d.index(), c});  // ends at v[1]
+          segment_at.push_back({{v[0], 0, 0, 0}, 1, d.index(), c});  // starts at v[0]
+        } else {
+          const Dart fwd = map.make_polyline(1);
+          const Dart bwd = map.beta(fwd, 2);
+          res.cell_dart[c] = fwd;
+          record(fwd, v[0], c);
+          record(bwd, v[1], c);
+          segment_at.push_back({{v[1], 0, 0, 0}, 1, fwd.index(), c});
+          segment_at.push_back({{v[0], 0, 0, 0}, 1, bwd.index(), c});
+        }
+      }
+    }
+  }
+  if (!opt.sew) return res;
+
+  // 4) glue facets shared by exactly two cells of the same dimension
+  auto start_of = [&](std::uint32_t x) { return res.vertex_of_dart[x]; };
+  auto describe = [&](std::uint32_t cell) { return "cell " + std::to_string(cell) + " (" + to_string(mesh.types[cell]) + ")"; };
+  detail::for_each_facet_group(facets, mesh.num_points(), [&](auto first, auto last) {
+    const auto count = last - first;
+    if (count == 1) return;
+    const bool volume = first->n != 2;
+    if (count > 2) {
+      if (!opt.allow_nonmanifold)
+        throw MeshError(opt.source + ": " + std::to_string(count) + " cells share one " + (volume ? "face" : "edge") +
+                        ", among them " + describe(first->cell) + " and " + describe((first + 1)->cell) +
+                        " (a non-manifold " + (volume ? "face" : "edge") + " where a manifold is required)");
+      ++res.nonmanifold_facets;
+      return;
+    }
+    const std::uint32_t a = first->dart, bb = (first + 1)->dart;
+    if (!volume) {  // two 2D cells along an edge: 2-sew if they run along it in opposite directions
+      if constexpr (D >= 2) {
+        if (start_of(a) == start_of(bb)) {
+          ++res.unorientable_edges;
+          return;
+        }
+        map.template link_beta<2>(Dart(a), Dart(bb));
+        ++res.sewn_facets;
+      }
+      return;
+    }
+    if constexpr (D >= 3) {
+      // two faces: pair each dart u->v of one with the dart v->u of the other
+      std::uint32_t y = bb;
+      const std::uint32_t want = start_of(map.b(a, 1));
+      std::uint32_t guard = 0;
+      while (start_of(y) != want && guard++ < 4) y = map.b(y, 1);
+      if (start_of(map.b(y, 1)) != start_of(a)) {
+        throw MeshError(opt.source + ": " + describe(first->cell) + " and " + describe((first + 1)->cell) +
+                        " share a face with the same orientation: one of them is inverted (negative volume)");
+      }
+      std::uint32_t x = a;
+      do {
+        map.template link_beta<3>(Dart(x), Dart(y));
+        x = map.b(x, 1);
+        y = map.b(y, 0);
+      } while (x != a);
+      ++res.sewn_facets;
+    }
+  });
+  // 5) chain segments at points where exactly two of them meet
+  detail::for_each_facet_group(segment_at, mesh.num_points(), [&](auto first, auto last) {
+    if (last - first != 2) return;
+    if constexpr (D == 1) {
+      // one segment must end here and the other start here
+      const bool starts0 = start_of(first->dart) == first->v[0];
+      const bool starts1 = start_of((first + 1)->dart) == first->v[0];
+      if (starts0 == starts1) {
+        ++res.unorientable_edges;
+        return;
+      }
+      const std::uint32_t in = starts0 ? (first + 1)->dart : first->dart;
+      const std::uint32_t out = starts0 ? first->dart : (first + 1)->dart;
+      map.template link_beta<1>(Dart(in), Dart(out));
+    } else {
+      // each entry is the dart of its segment ending at this point; its β2 starts here
+      const std::uint32_t in0 = first->dart, in1 = (first + 1)->dart;
+      map.template link_beta<1>(Dart(in0), Dart(map.b(in1, 2)));
+      map.template link_beta<1>(Dart(in1), Dart(map.b(in0, 2)));
+    }
+    ++res.sewn_facets;
+  });
+  return res;
+}
+
+}  // namespace sewn

@@ -1,0 +1,540 @@
+#pragma once
+// CMap<D, A0, A1, ...>: a D-dimensional combinatorial map with optional cell attributes.
+//
+// Vocabulary (Damiand & Lienhardt, "Combinatorial Maps", 2014): a dart is an oriented piece of
+// an edge inside one face of one volume (...); β1 links a dart to the next dart of its face,
+// β0 = β1⁻¹ to the previous one; for 2 ≤ i ≤ D, βi is an involution linking a dart to the dart
+// of the i-adjacent cell with the opposite orientation. A null β means "i-free". An i-cell is
+// the orbit of its darts under every β except βi (for i = 0: the compositions βj∘βk, j≠k).
+//
+// Storage: darts are 32-bit indices; β0..βD are stored packed per dart; removed darts go on a
+// free list. For each dimension I whose attribute type A_I is not void, every dart also stores
+// the index of its I-cell's attribute (null if the cell has none), and the values live in one
+// AttributeContainer<A_I> (contiguous, iterable without darts). A void attribute costs nothing.
+//
+// Attribute hooks, set per dimension with on_split / on_merge / on_erase, fire after an
+// operation has finished changing β links, in this order: dimension 0 first, then 1, ..., D;
+// within a dimension, cells are visited starting from the operation's first dart argument.
+//   on_merge(kept, gone): two cells became one; fires before `gone`'s darts are relabelled to
+//                         `kept` and `gone` is freed. `kept` is the attribute of the cell of the
+//                         operation's first dart (for sew<i>(a, b): a's side).
+//   on_split(orig, copy): one cell became two; fires after `copy` (a copy of orig's value) has
+//                         been given to the darts of the part that does not contain the first dart.
+//   on_erase(gone):       the last dart of a cell was erased; fires before the slot is freed.
+// Hooks can be paused (set_hooks_enabled(false) or HooksPaused) for bulk edits; attributes are
+// still kept consistent while hooks are paused.
+//
+// Not thread-safe, not even for const traversals: they use the map's marks.
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <initializer_list>
+#include <span>
+#include <string>
+#include <tuple>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include <boost/container/small_vector.hpp>
+
+#include "sewn/cmap/attributes.hpp"
+#include "sewn/cmap/dart.hpp"
+#include "sewn/cmap/errors.hpp"
+#include "sewn/cmap/marks.hpp"
+#include "sewn/cmap/validation.hpp"
+
+namespace sewn {
+
+/// Darts of an orbit or cell, in breadth-first order from the dart asked for (which comes first).
+using DartList = boost::container::small_vector<Dart, 32>;
+
+namespace detail {
+
+template <int I, class... A>
+struct nth_or_void {
+  using type = void;
+};
+template <class H, class... T>
+struct nth_or_void<0, H, T...> {
+  using type = H;
+};
+template <int I, class H, class... T>
+  requires(I > 0)
+struct nth_or_void<I, H, T...> {
+  using type = typename nth_or_void<I - 1, T...>::type;
+};
+
+template <int I, class T>
+struct AttrStore {
+  std::vector<std::uint32_t> of_dart;  // attribute index of each dart's I-cell
+  AttributeContainer<T> values;
+  std::function<void(AttrId<I>, AttrId<I>)> on_split, on_merge;
+  std::function<void(AttrId<I>)> on_erase;
+};
+template <int I>
+struct AttrStore<I, void> {};
+
+template <class Seq, class... A>
+struct StoreTuple;
+template <int... I, class... A>
+struct StoreTuple<std::integer_sequence<int, I...>, A...> {
+  using type = std::tuple<AttrStore<I, typename nth_or_void<I, A...>::type>...>;
+};
+
+inline constexpr std::uint32_t null_index = Dart::null_index;
+inline constexpr std::uint32_t dead_marker = Dart::null_index - 1;  // β0 of a free-listed dart
+
+}  // namespace detail
+
+/// A face table checked once and ready to instantiate: each half-edge (a dart-to-be, in table
+/// order) with its local start and end vertex and the index of its opposite half-edge.
+struct CellTemplate {
+  std::vector<std::uint32_t> face_size;
+  std::vector<std::uint32_t> from, to, mate;  // mate: null_index for a single polygon
+  std::uint32_t first = 0;                    // the half-edge 0 -> 1 if any, else 0
+  /// Checks and converts a table (see CMap::make_cell). Throws TopologyError if malformed.
+  static CellTemplate from_faces(std::span<const std::span<const std::uint32_t>> faces);
+};
+
+template <int D, class... Attrs>
+class CMap {
+  static_assert(D >= 1 && D <= 8, "CMap dimension must be in 1..8");
+  static_assert(sizeof...(Attrs) <= D + 1, "at most D+1 attribute types (one per dimension 0..D)");
+
+ public:
+  static constexpr int dimension = D;
+  /// The attribute type of I-cells (void when disabled).
+  template <int I>
+  using attribute_type = typename detail::nth_or_void<I, Attrs...>::type;
+  template <int I>
+  static constexpr bool has_attribute = (I >= 0 && I <= D) && !std::is_void_v<attribute_type<I>>;
+
+  CMap() = default;
+  CMap(const CMap&) = default;
+  CMap(CMap&&) noexcept = default;
+  CMap& operator=(const CMap&) = default;
+  CMap& operator=(CMap&&) noexcept = default;
+
+  // ---------------------------------------------------------------- darts
+  /// Creates an isolated dart (every β null, no attributes). O(1) amortised; may reallocate
+  /// internal arrays but never invalidates Dart handles.
+  Dart create_dart();
+  /// Erases an isolated dart (every β null). Throws TopologyError if d is dead or linked.
+  /// Frees attributes whose last dart it was (on_erase fires). O(1).
+  void erase_dart(Dart d);
+  /// Number of live darts. O(1).
+  [[nodiscard]] std::uint32_t num_darts() const { return alive_; }
+  /// One past the largest dart index ever used (live or free-listed). O(1).
+  [[nodiscard]] std::uint32_t dart_capacity() const { return static_cast<std::uint32_t>(beta_.size()); }
+  /// True if d indexes a live dart of this map. O(1).
+  [[nodiscard]] bool is_alive(Dart d) const {
+    return d.index() < beta_.size() && beta_[d.index()][0] != detail::dead_marker;
+  }
+  /// Range over live darts in index order. Do not create or erase darts while iterating.
+  [[nodiscard]] auto darts() const;
+  /// Reserves storage for n darts. Invalidates nothing.
+  void reserve(std::uint32_t n);
+  /// Renumbers live darts to 0..num_darts()-1, keeping their order, and releases free slots.
+  /// Returns old index -> new dart (null for dead slots). Invalidates every Dart held by the
+  /// caller; attribute ids are unchanged. Throws TopologyError if a mark is reserved. O(n).
+  std::vector<Dart> compact();
+  /// Removes every dart and attribute (hooks do not fire). Marks must be free.
+  void clear();
+  /// Bytes of heap memory held by the map: β arrays, attribute indices and containers, marks.
+  [[nodiscard]] std::size_t memory_bytes() const;
+
+  // ---------------------------------------------------------------- β
+  /// βi(d), null if d is i-free. Throws TopologyError if d is not a live dart or i ∉ [0, D].
+  [[nodiscard]] Dart beta(Dart d, int i) const {
+    check_alive(d, "beta");
+    if (i < 0 || i > D) throw TopologyError("cmap::beta: index " + std::to_string(i) + " outside [0, D]");
+    return Dart(b(d.index(), i));
+  }
+  /// Composition applied left to right: beta(d, 1, 2) = β2(β1(d)); null propagates.
+  template <class... I>
+  [[nodiscard]] Dart beta(Dart d, int i, int j, I... rest) const {
+    Dart e = beta(d, i);
+    return e ? beta(e, j, rest...) : null_dart;
+  }
+  template <int I>
+  [[nodiscard]] Dart beta(Dart d) const {
+    static_assert(I >= 0 && I <= D);
+    check_alive(d, "beta");
+    return Dart(b(d.index(), I));
+  }
+  /// True if βi(d) is null. Same checks as beta().
+  [[nodiscard]] bool is_free(Dart d, int i) const { return beta(d, i).is_null(); }
+
+  // ---------------------------------------------------------------- marks
+  /// Reserves one of 32 marks; every live dart is unmarked for it. Throws CapacityError when
+  /// all are reserved. O(1) (O(n/64) the first time a mark number is used).
+  [[nodiscard]] Mark reserve_mark() const { return marks_.reserve(); }
+  /// Unmarks every dart for m and releases it. O(1) when no or all live darts are marked.
+  void free_mark(Mark m) const;
+  [[nodiscard]] bool is_marked(Dart d, Mark m) const { return marks_.test(d.index(), m); }
+  /// Marks d; returns false if it was already marked. O(1).
+  bool mark(Dart d, Mark m) const { return marks_.set(d.index(), m); }
+  /// Unmarks d; returns false if it was not marked. O(1).
+  bool unmark(Dart d, Mark m) const { return marks_.clear(d.index(), m); }
+  /// Unmarks every dart. O(1) if all or none of the live darts are marked, else O(n/64).
+  void unmark_all(Mark m) const { marks_.clear_all(m, alive_, dead_darts()); }
+  [[nodiscard]] std::uint32_t num_marked(Mark m) const { return marks_.count(m); }
+  [[nodiscard]] int num_reserved_marks() const { return marks_.reserved_count(); }
+  /// Marks every dart of the I-cell of d; returns how many were newly marked. O(cell).
+  template <int I>
+  std::uint32_t mark_cell(Dart d, Mark m) const;
+
+  // ---------------------------------------------------------------- attributes
+  /// The I-attribute of the I-cell of d (null if none). O(1).
+  template <int I>
+  [[nodiscard]] AttrId<I> attribute(Dart d) const {
+    static_assert(has_attribute<I>, "attributes are not enabled for this dimension");
+    check_alive(d, "attribute");
+    return AttrId<I>(store<I>().of_dart[d.index()]);
+  }
+  /// The value of attribute a. Throws TopologyError if a is null or dead.
+  template <int I>
+  attribute_type<I>& value(AttrId<I> a) {
+    check_attr(a);
+    return store<I>().values.value(a.index());
+  }
+  template <int I>
+  const attribute_type<I>& value(AttrId<I> a) const {
+    check_attr(a);
+    return store<I>().values.value(a.index());
+  }
+  /// Creates an attribute holding v and gives it to every dart of the I-cell of d; the cell's
+  /// previous attribute, if any, is freed (on_erase fires). O(cell).
+  template <int I>
+  AttrId<I> set_attribute(Dart d, attribute_type<I> v);
+  /// Gives an attribute f(dart) to every I-cell that has none. Returns how many were created. O(n).
+  template <int I, class F>
+  std::uint32_t create_attributes(F&& f);
+  /// A dart of the cell carrying a. Throws TopologyError if a is null or dead. O(1).
+  template <int I>
+  [[nodiscard]] Dart dart_of(AttrId<I> a) const {
+    check_attr(a);
+    return Dart(store<I>().values.dart(a.index()));
+  }
+  /// Number of live I-attributes. O(1).
+  template <int I>
+  [[nodiscard]] std::uint32_t num_attributes() const {
+    return store<I>().values.size();
+  }
+  /// Range over live I-attribute ids, in slot order, without touching darts.
+  template <int I>
+  [[nodiscard]] auto attributes() const;
+  /// The container of I-attribute values, for bulk access by slot index.
+  template <int I>
+  [[nodiscard]] const AttributeContainer<attribute_type<I>>& attribute_container() const {
+    return store<I>().values;
+  }
+
+  template <int I>
+  void on_split(std::function<void(AttrId<I> orig, AttrId<I> copy)> f) {
+    store<I>().on_split = std::move(f);
+  }
+  template <int I>
+  void on_merge(std::function<void(AttrId<I> kept, AttrId<I> gone)> f) {
+    store<I>().on_merge = std::move(f);
+  }
+  template <int I>
+  void on_erase(std::function<void(AttrId<I> gone)> f) {
+    store<I>().on_erase = std::move(f);
+  }
+  void set_hooks_enabled(bool on) { hooks_on_ = on; }
+  [[nodiscard]] bool hooks_enabled() const { return hooks_on_; }
+
+  // ---------------------------------------------------------------- traversal
+  /// Darts reachable from d through the listed β indices (1 also follows β0). O(orbit).
+  template <int... B>
+  [[nodiscard]] DartList orbit(Dart d) const;
+  /// Darts of the I-cell of d, d first. O(cell).
+  template <int I>
+  [[nodiscard]] DartList cell(Dart d) const;
+  /// Darts of the connected component of d. O(component).
+  [[nodiscard]] std::vector<Dart> component(Dart d) const;
+  /// Range yielding one dart per I-cell, in increasing order of the cell's smallest dart.
+  /// Holds a mark while alive (released on destruction, early break included). Do not modify
+  /// the map while iterating.
+  template <int I>
+  [[nodiscard]] auto cells() const;
+  /// One dart per J-cell incident to the I-cell of d (J < I: its faces; J > I: the cells it
+  /// lies in), each returned dart belonging to the I-cell of d. O(I-cell · J-cell).
+  template <int I, int J>
+  [[nodiscard]] DartList incident(Dart d) const;
+  /// One dart per I-cell adjacent to the I-cell of d, the cell itself excluded: for I ≥ 1 the
+  /// I-cells sharing an (I-1)-cell with it, for I = 0 the other ends of its edges.
+  template <int I>
+  [[nodiscard]] DartList adjacent(Dart d) const;
+  /// True if a and b belong to the same I-cell. O(cell).
+  template <int I>
+  [[nodiscard]] bool same_cell(Dart a, Dart b) const;
+
+  // ---------------------------------------------------------------- counting
+  /// Number of I-cells. O(n).
+  template <int I>
+  [[nodiscard]] std::uint32_t count() const;
+  /// Number of i-cells for every i in one pass. O(n·(D+1)).
+  [[nodiscard]] std::array<std::uint32_t, D + 1> count_all() const;
+  /// Σ (-1)^i · count<i>(), i = 0..D. O(n·(D+1)).
+  [[nodiscard]] std::int64_t euler_characteristic() const;
+  /// Number of connected components. O(n).
+  [[nodiscard]] std::uint32_t count_components() const;
+  /// One dart per boundary facet: a (D-1)-cell with a D-free dart. O(n).
+  [[nodiscard]] std::vector<Dart> boundary_facets() const;
+
+  // ---------------------------------------------------------------- sewing
+  /// True if sew<I>(a, b) would succeed: both live, a I-free (I = 1: a 1-free, b 0-free),
+  /// and the orbits to be sewn have the same shape. O(orbit).
+  template <int I>
+  [[nodiscard]] bool is_sewable(Dart a, Dart b) const;
+  /// I-sews a and b (βI(a) = b) and every matching pair of their orbits, then merges the
+  /// attributes of cells that became one (on_merge: a's side is kept). Throws TopologyError
+  /// if not sewable. O(orbit + merged cells).
+  template <int I>
+  void sew(Dart a, Dart b);
+  /// I-unsews the orbit of d, then splits attributes of cells that became two (on_split: the
+  /// part holding d keeps the original). Throws TopologyError if d is I-free. O(orbit + cells).
+  template <int I>
+  void unsew(Dart d);
+  /// As sew<I> but leaves attributes untouched (the caller fixes them; validate() will tell).
+  template <int I>
+  void link(Dart a, Dart b);
+  /// As unsew<I> but leaves attributes untouched.
+  template <int I>
+  void unlink(Dart d);
+  /// Low level: sets βI(a) = b and its inverse, nothing else. For builders that complete whole
+  /// orbits themselves; the map is invalid until they do. Throws TopologyError on dead darts.
+  template <int I>
+  void link_beta(Dart a, Dart b);
+  /// Low level: makes d I-free (and its partner's inverse link), nothing else.
+  template <int I>
+  void unlink_beta(Dart d);
+
+  // ---------------------------------------------------------------- construction
+  /// A closed polygon of n ≥ 1 edges (n darts in a β1 cycle). Returns its first dart. O(n).
+  Dart make_polygon(std::uint32_t n);
+  Dart make_triangle() { return make_polygon(3); }
+  Dart make_quad() { return make_polygon(4); }
+  /// An open chain of n ≥ 1 edges. D = 1: n darts chained by β1. D ≥ 2: 2n darts, each edge a
+  /// β2-linked pair, forward darts chained by β1 and backward darts in reverse. Returns the
+  /// first forward dart. O(n).
+  Dart make_polyline(std::uint32_t n);
+  /// Closed polyhedra (D ≥ 3) with outward-oriented faces. Local vertex numbers follow VTK:
+  /// the returned dart starts at local vertex 0 and goes to local vertex 1 (see mesh.hpp for
+  /// the face tables). O(1).
+  Dart make_tetrahedron();
+  Dart make_hexahedron();
+  Dart make_prism();
+  Dart make_pyramid();
+  /// Creates a closed cell from a face table (faces as local vertex lists, outward, each edge in
+  /// exactly two faces with opposite directions). D ≥ 3 for polyhedra, D ≥ 2 for one polygon.
+  /// `darts`, if given, receives the new darts in table order (face 0's darts starting at its
+  /// vertices in order, then face 1's, ...). Throws TopologyError on a malformed table, before
+  /// changing the map. O(size of table²).
+  Dart make_cell(std::span<const std::span<const std::uint32_t>> faces, std::vector<Dart>* darts = nullptr);
+  /// As above from a table validated once (see CellTemplate), for building many cells. O(darts).
+  Dart make_cell(const CellTemplate& t, std::vector<Dart>* darts = nullptr);
+
+  // ---------------------------------------------------------------- insertion
+  /// Splits the edge of d at a new vertex. Returns the new dart following d in its face (it
+  /// starts at the new vertex). The edge's attribute is copied to the second half (on_split);
+  /// the new vertex gets no 0-attribute. O(edge).
+  Dart insert_vertex_in_edge(Dart d);
+  /// True if insert_edge_in_face(a, b) may be called: a ≠ b, both live, b on a's closed β1 cycle.
+  [[nodiscard]] bool is_insertable_edge_in_face(Dart a, Dart b) const;
+  /// Splits the face of a and b by a new edge from a's start vertex to b's start vertex (D ≥ 2;
+  /// also across every βj-sewn copy of the face, j ≥ 3). Returns the new dart that starts at a's
+  /// vertex; it lies in the face of b. The face holding a keeps the attribute; the other gets a
+  /// copy (on_split). The new edge has no 1-attribute. O(face).
+  Dart insert_edge_in_face(Dart a, Dart b);
+  /// True if path is a closed chain of darts of one volume (end of each = start of the next),
+  /// with distinct edges, along which a face may be inserted (D ≥ 3; 4..D-free darts).
+  [[nodiscard]] bool is_insertable_face_in_volume(std::span<const Dart> path) const;
+  /// Inserts a face along the closed dart path inside a volume (two β3-linked polygons). Returns
+  /// the new dart β2(path[0]). If the volume falls in two, the part holding path[0] keeps its
+  /// attribute and the other gets a copy (on_split). The new face has no 2-attribute. O(path + volume).
+  Dart insert_face_in_volume(std::span<const Dart> path);
+
+  // ---------------------------------------------------------------- removal, contraction
+  /// True if the I-cell of d can be removed: I ≥ D-1, or it is incident to at most two
+  /// (I+1)-cells (β_{I+1}∘β_{I+2} is an involution on its darts). O(cell).
+  template <int I>
+  [[nodiscard]] bool is_removable(Dart d) const;
+  /// Removes the I-cell of d, merging the (I+1)-cells around it (on_merge keeps the attribute
+  /// of the first cell reached). Erases its darts. Throws TopologyError if not removable. O(cells).
+  template <int I>
+  void remove_cell(Dart d);
+  /// True if the I-cell of d can be contracted: I = 1, or (I ≥ 2) it has at most two (I-1)-cells.
+  template <int I>
+  [[nodiscard]] bool is_contractible(Dart d) const;
+  /// Contracts the I-cell of d into an (I-1)-cell (I = 1: the edge's two vertices merge).
+  /// Erases its darts. Throws TopologyError if not contractible. O(cells).
+  template <int I>
+  void contract_cell(Dart d);
+
+  // ---------------------------------------------------------------- checks
+  /// Checks every invariant and names each violation with its dart: β0∘β1 = id, βi involutions
+  /// without fixed points (i ≥ 2), βi∘βj involutions for i+2 ≤ j, links to live darts only,
+  /// attribute consistency (one attribute per cell, reference counts, no orphan, one cell per
+  /// attribute), the free list, and marks. O(n·D²).
+  [[nodiscard]] ValidationReport validate() const;
+
+  // ---------------------------------------------------------------- internals for sibling headers
+  /// Raw β without checks (builders and operations). i ∈ [0, D], x a live dart index.
+  [[nodiscard]] std::uint32_t b(std::uint32_t x, int i) const { return beta_[x][static_cast<std::size_t>(i)]; }
+
+ private:
+  using Stores = typename detail::StoreTuple<std::make_integer_sequence<int, D + 1>, Attrs...>::type;
+
+  template <int I>
+  auto& store() {
+    static_assert(has_attribute<I>, "attributes are not enabled for this dimension");
+    return std::get<I>(stores_);
+  }
+  template <int I>
+  const auto& store() const {
+    static_assert(has_attribute<I>, "attributes are not enabled for this dimension");
+    return std::get<I>(stores_);
+  }
+  template <class F>
+  static void for_each_dim(F&& f) {
+    [&]<int... I>(std::integer_sequence<int, I...>) {
+      (f(std::integral_constant<int, I>{}), ...);
+    }(std::make_integer_sequence<int, D + 1>{});
+  }
+
+  // Orbit descriptions: a bit per β index (bit 1 stands for β1 and β0), or the vertex orbit.
+  struct Orbit {
+    unsigned mask;
+    bool vertex;
+  };
+  static constexpr unsigned all_betas = ((1u << (D + 1)) - 1u) & ~1u;
+  static constexpr Orbit cell_orbit(int i) {
+    return i == 0 ? Orbit{0, true} : Orbit{all_betas & ~(1u << i), false};
+  }
+  static constexpr Orbit component_orbit() { return Orbit{all_betas, false}; }
+
+  void set_b(std::uint32_t x, int i, std::uint32_t y) { beta_[x][static_cast<std::size_t>(i)] = y; }
+  // Links x -> y for βi, with the inverse (β0/β1 pair or involution). Null y makes x i-free.
+  void raw_link(std::uint32_t x, int i, std::uint32_t y);
+  void check_alive(Dart d, const char* where) const;
+  template <int I>
+  void check_attr(AttrId<I> a) const;
+  [[nodiscard]] std::vector<std::uint32_t> dead_darts() const;
+
+  template <class F>
+  void for_each_neighbor(std::uint32_t x, Orbit o, F&& f) const;
+  // Breadth-first collection of an orbit; marks visited darts with m and appends them to out.
+  template <class Out>
+  void collect(std::uint32_t root, Orbit o, Mark m, Out& out) const;
+  template <class Out>
+  void collect_unmarked(std::uint32_t root, Orbit o, Out& out) const;
+  [[nodiscard]] std::uint32_t count_orbits(Orbit o) const;
+
+  template <int I>
+  bool sew_pairs(std::uint32_t a, std::uint32_t b, std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) const;
+  template <int I>
+  void unsew_pairs(std::uint32_t d, std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const;
+
+  std::uint32_t new_dart();
+  void erase_dart_raw(std::uint32_t x);
+  // Re-derives attributes after a topological change: `touched` holds the darts whose β links
+  // changed (first the operation's first dart); `dims` a bit per dimension to update.
+  void update_attributes(const std::vector<std::uint32_t>& touched, unsigned dims);
+  template <int I>
+  void update_attributes_of(const std::vector<std::uint32_t>& touched);
+  template <int I>
+  void process_new_cell(const std::vector<std::uint32_t>& cell, std::vector<std::uint32_t>& claimed);
+  template <int I>
+  std::uint32_t copy_attribute(std::uint32_t a);
+  template <int I>
+  void relabel(const std::vector<std::uint32_t>& cell, std::uint32_t from, std::uint32_t to);
+  void flush_erased();
+
+  // Cell removal and contraction share one relinking engine (see ops header).
+  struct Relink {
+    int i;
+    std::uint32_t w, target;
+  };
+  void apply_relinks_and_erase(const DartList& cell, const std::vector<Relink>& links);
+
+  std::vector<std::array<std::uint32_t, D + 1>> beta_;
+  std::uint32_t free_head_ = detail::null_index;  // free list threaded through β1 of dead darts
+  std::uint32_t alive_ = 0;
+  Stores stores_;
+  mutable detail::MarkPlanes marks_;
+  bool hooks_on_ = true;
+  std::vector<std::pair<int, std::uint32_t>> pending_erase_;  // (dimension, attribute) to free
+};
+
+/// Pauses a map's hooks for the lifetime of the guard (attributes stay consistent).
+template <class Map>
+class HooksPaused {
+ public:
+  explicit HooksPaused(Map& m) : map_(m), was_(m.hooks_enabled()) { map_.set_hooks_enabled(false); }
+  ~HooksPaused() { map_.set_hooks_enabled(was_); }
+  HooksPaused(const HooksPaused&) = delete;
+  HooksPaused& operator=(const HooksPaused&) = delete;
+
+ private:
+  Map& map_;
+  bool was_;
+};
+
+/// A reserved mark freed (and cleared) on destruction. Clearing is O(1) when no or all live
+/// darts are marked, O(n/64) otherwise: for marking a few darts of a big map use ScopedMarker.
+template <class Map>
+class ScopedMark {
+ public:
+  explicit ScopedMark(const Map& m) : map_(m), mark_(m.reserve_mark()) {}
+  ~ScopedMark() { map_.free_mark(mark_); }
+  ScopedMark(const ScopedMark&) = delete;
+  ScopedMark& operator=(const ScopedMark&) = delete;
+  [[nodiscard]] Mark get() const { return mark_; }
+  operator Mark() const { return mark_; }  // NOLINT(google-explicit-constructor)
+
+ private:
+  const Map& map_;
+  Mark mark_;
+};
+
+/// A reserved mark that remembers what it marked and unmarks only that on destruction: O(k).
+template <class Map>
+class ScopedMarker {
+ public:
+  explicit ScopedMarker(const Map& m) : map_(m), mark_(m.reserve_mark()) {}
+  ~ScopedMarker() {
+    for (Dart d : marked_) map_.unmark(d, mark_);
+    map_.free_mark(mark_);
+  }
+  ScopedMarker(const ScopedMarker&) = delete;
+  ScopedMarker& operator=(const ScopedMarker&) = delete;
+  /// Marks d; returns false if it was already marked.
+  bool mark(Dart d) {
+    if (!map_.mark(d, mark_)) return false;
+    marked_.push_back(d);
+    return true;
+  }
+  [[nodiscard]] bool is_marked(Dart d) const { return map_.is_marked(d, mark_); }
+  [[nodiscard]] Mark get() const { return mark_; }
+
+ private:
+  const Map& map_;
+  Mark mark_;
+  std::vector<Dart> marked_;
+};
+
+}  // namespace sewn
+
+#include "sewn/cmap/detail/cmap_core.hpp"
+#include "sewn/cmap/detail/cmap_traversal.hpp"
+#include "sewn/cmap/detail/cmap_attributes.hpp"
+#include "sewn/cmap/detail/cmap_sew.hpp"
+#include "sewn/cmap/detail/cmap_make.hpp"
+#include "sewn/cmap/detail/cmap_insert.hpp"
+#include "sewn/cmap/detail/cmap_remove.hpp"
+#include "sewn/cmap/detail/cmap_validate.hpp"

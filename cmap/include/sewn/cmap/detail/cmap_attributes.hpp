@@ -1,0 +1,188 @@
+#pragma once
+// CMap: attribute assignment and the re-derivation of attributes after topological changes
+// (where on_split / on_merge fire). Included by cmap.hpp.
+
+namespace sewn {
+
+template <int D, class... A>
+template <int I>
+AttrId<I> CMap<D, A...>::set_attribute(Dart d, attribute_type<I> v) {
+  static_assert(has_attribute<I>, "attributes are not enabled for this dimension");
+  check_alive(d, "set_attribute");
+  auto& st = store<I>();
+  const std::uint32_t a = st.values.create(std::move(v));
+  std::vector<std::uint32_t> darts;
+  collect_unmarked(d.index(), cell_orbit(I), darts);
+  for (std::uint32_t x : darts) {
+    const std::uint32_t old = st.of_dart[x];
+    if (old != detail::null_index) {
+      st.values.add_count(old, -1);
+      if (st.values.count(old) == 0) pending_erase_.emplace_back(I, old);
+    }
+    st.of_dart[x] = a;
+  }
+  st.values.add_count(a, static_cast<std::int64_t>(darts.size()));
+  st.values.set_dart(a, d.index());
+  flush_erased();
+  return AttrId<I>(a);
+}
+
+template <int D, class... A>
+template <int I, class F>
+std::uint32_t CMap<D, A...>::create_attributes(F&& f) {
+  static_assert(has_attribute<I>, "attributes are not enabled for this dimension");
+  auto& st = store<I>();
+  const Mark m = marks_.reserve();
+  std::vector<std::uint32_t> darts;
+  std::uint32_t created = 0;
+  const auto cap = static_cast<std::uint32_t>(beta_.size());
+  for (std::uint32_t x = 0; x < cap; ++x) {
+    if (beta_[x][0] == detail::dead_marker || marks_.test(x, m)) continue;
+    darts.clear();
+    collect(x, cell_orbit(I), m, darts);
+    if (st.of_dart[x] != detail::null_index) continue;  // the whole cell shares x's attribute
+    const std::uint32_t a = st.values.create(f(Dart(x)));
+    for (std::uint32_t y : darts) st.of_dart[y] = a;
+    st.values.add_count(a, static_cast<std::int64_t>(darts.size()));
+    st.values.set_dart(a, x);
+    ++created;
+  }
+  free_mark(m);
+  return created;
+}
+
+template <int D, class... A>
+template <int I>
+auto CMap<D, A...>::attributes() const {
+  const auto& c = store<I>().values;
+  struct Iter {
+    const AttributeContainer<attribute_type<I>>* c;
+    std::uint32_t a;
+    AttrId<I> operator*() const { return AttrId<I>(a); }
+    Iter& operator++() {
+      do ++a;
+      while (a < c->capacity() && !c->is_alive(a));
+      return *this;
+    }
+    bool operator==(const Iter& o) const { return a == o.a; }
+  };
+  struct Range {
+    const AttributeContainer<attribute_type<I>>* c;
+    Iter begin() const {
+      Iter it{c, 0};
+      if (c->capacity() > 0 && !c->is_alive(0)) ++it;
+      return it;
+    }
+    Iter end() const { return Iter{c, c->capacity()}; }
+  };
+  return Range{&c};
+}
+
+template <int D, class... A>
+void CMap<D, A...>::update_attributes(const std::vector<std::uint32_t>& touched, unsigned dims) {
+  for_each_dim([&](auto k) {
+    constexpr int K = k();
+    if constexpr (has_attribute<K>)
+      if ((dims >> K) & 1u) update_attributes_of<K>(touched);
+  });
+  flush_erased();
+}
+
+template <int D, class... A>
+template <int I>
+void CMap<D, A...>::update_attributes_of(const std::vector<std::uint32_t>& touched) {
+  // Every new I-cell that differs from an old one contains a dart whose links changed (for
+  // I = 0: such a dart or a β-neighbour of one, since vertex generators are two links long).
+  std::vector<std::uint32_t> candidates;
+  candidates.reserve(touched.size() * (I == 0 ? D + 2 : 1));
+  for (std::uint32_t t : touched) {
+    if (!is_alive(Dart(t))) continue;
+    candidates.push_back(t);
+    if constexpr (I == 0)
+      for (int j = 0; j <= D; ++j)
+        if (const std::uint32_t y = b(t, j); y != detail::null_index) candidates.push_back(y);
+  }
+  const Mark seen = marks_.reserve();
+  std::vector<std::uint32_t> visited, cell_darts, claimed;
+  for (std::uint32_t c : candidates) {
+    if (marks_.test(c, seen)) continue;
+    cell_darts.clear();
+    collect(c, cell_orbit(I), seen, cell_darts);
+    visited.insert(visited.end(), cell_darts.begin(), cell_darts.end());
+    process_new_cell<I>(cell_darts, claimed);
+  }
+  for (std::uint32_t x : visited) marks_.clear(x, seen);
+  marks_.release(seen);
+}
+
+template <int D, class... A>
+template <int I>
+std::uint32_t CMap<D, A...>::copy_attribute(std::uint32_t a) {
+  auto& st = store<I>();
+  attribute_type<I> v = st.values.value(a);  // copy first: create() may reallocate
+  return st.values.create(std::move(v));
+}
+
+template <int D, class... A>
+template <int I>
+void CMap<D, A...>::relabel(const std::vector<std::uint32_t>& cell_darts, std::uint32_t from, std::uint32_t to) {
+  auto& st = store<I>();
+  std::int64_t moved = 0;
+  for (std::uint32_t x : cell_darts)
+    if (st.of_dart[x] == from) {
+      st.of_dart[x] = to;
+      ++moved;
+    }
+  if (from != detail::null_index) st.values.add_count(from, -moved);
+  if (to != detail::null_index) st.values.add_count(to, moved);
+}
+
+template <int D, class... A>
+template <int I>
+void CMap<D, A...>::process_new_cell(const std::vector<std::uint32_t>& cell_darts, std::vector<std::uint32_t>& claimed) {
+  auto& st = store<I>();
+  // Distinct attributes of the cell in BFS order, with how many of its darts carry each.
+  boost::container::small_vector<std::pair<std::uint32_t, std::uint32_t>, 4> attrs;
+  for (std::uint32_t x : cell_darts) {
+    const std::uint32_t a = st.of_dart[x];
+    if (a == detail::null_index) continue;
+    auto it = std::find_if(attrs.begin(), attrs.end(), [&](const auto& p) { return p.first == a; });
+    if (it == attrs.end())
+      attrs.emplace_back(a, 1u);
+    else
+      ++it->second;
+  }
+  if (attrs.empty()) return;
+  const bool hooks = hooks_on_;
+  auto is_claimed = [&](std::uint32_t a) { return std::find(claimed.begin(), claimed.end(), a) != claimed.end(); };
+  // A piece of a cell whose identity went elsewhere (claimed by an earlier new cell, or, for
+  // all but the survivor, still holding darts outside this cell) is split off into a copy.
+  auto split_off = [&](std::uint32_t a) {
+    const std::uint32_t c = copy_attribute<I>(a);
+    relabel<I>(cell_darts, a, c);
+    for (std::uint32_t x : cell_darts)
+      if (st.of_dart[x] == c) {
+        st.values.set_dart(c, x);
+        break;
+      }
+    if (st.values.dart(a) != detail::null_index && st.of_dart[st.values.dart(a)] != a)
+      st.values.set_dart(a, detail::null_index);  // refreshed where the rest of `a` is processed
+    if (hooks && st.on_split) st.on_split(AttrId<I>(a), AttrId<I>(c));
+    return c;
+  };
+  for (auto& [a, n] : attrs)
+    if (is_claimed(a)) a = split_off(a);
+  const std::uint32_t survivor = attrs.front().first;
+  for (std::size_t k = 1; k < attrs.size(); ++k) {
+    std::uint32_t o = attrs[k].first;
+    if (st.values.count(o) > attrs[k].second) o = split_off(o);
+    if (hooks && st.on_merge) st.on_merge(AttrId<I>(survivor), AttrId<I>(o));
+    relabel<I>(cell_darts, o, survivor);
+    st.values.erase(o);
+  }
+  relabel<I>(cell_darts, detail::null_index, survivor);
+  st.values.set_dart(survivor, cell_darts.front());
+  claimed.push_back(survivor);
+}
+
+}  // namespace sewn

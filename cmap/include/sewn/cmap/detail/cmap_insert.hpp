@@ -1,0 +1,184 @@
+#pragma once
+// CMap: insertion of a vertex in an edge, an edge in a face, a face in a volume.
+// Included by cmap.hpp.
+
+namespace sewn {
+
+template <int D, class... A>
+Dart CMap<D, A...>::insert_vertex_in_edge(Dart d) {
+  check_alive(d, "insert_vertex_in_edge");
+  constexpr std::uint32_t null = detail::null_index;
+  // 1) the darts of the edge (every dart on it, in every face and volume)
+  std::vector<std::uint32_t> edge;
+  collect_unmarked(d.index(), cell_orbit(1), edge);
+  // 2) a new dart after each of them, in its face: x -> x' -> old β1(x)
+  std::vector<std::uint32_t> split(edge.size());
+  std::vector<std::uint32_t> touched;
+  touched.reserve(4 * edge.size());
+  for (std::size_t k = 0; k < edge.size(); ++k) {
+    const std::uint32_t x = edge[k], nx = new_dart(), next = b(x, 1);
+    split[k] = nx;
+    raw_link(nx, 1, next);
+    raw_link(x, 1, nx);
+    touched.push_back(x);
+    touched.push_back(nx);
+    if (next != null) touched.push_back(next);
+  }
+  // 3) βj partners cross over: if βj(x) = y then βj(x) = y' and βj(x') = y
+  auto index_of = [&](std::uint32_t y) {
+    return static_cast<std::size_t>(std::find(edge.begin(), edge.end(), y) - edge.begin());
+  };
+  for (std::size_t k = 0; k < edge.size(); ++k)
+    for (int j = 2; j <= D; ++j) {
+      const std::uint32_t y = b(edge[k], j);
+      if (y == null || b(split[k], j) != null) continue;
+      const std::size_t l = index_of(y);
+      raw_link(edge[k], j, split[l]);
+      raw_link(split[k], j, y);
+    }
+  update_attributes(touched, ~0u);
+  return Dart(split[0]);
+}
+
+template <int D, class... A>
+bool CMap<D, A...>::is_insertable_edge_in_face(Dart a, Dart b2) const {
+  if constexpr (D < 2) return false;
+  if (!is_alive(a) || !is_alive(b2) || a == b2) return false;
+  std::uint32_t x = a.index();
+  const std::uint32_t cap = dart_capacity();
+  for (std::uint32_t steps = 0; steps <= cap; ++steps) {
+    x = b(x, 1);
+    if (x == detail::null_index) return false;  // open face
+    if (x == a.index()) return false;           // b not on a's cycle
+    if (x == b2.index()) break;
+  }
+  // the cycle must close (a closed face) for every βj-copy to be well defined
+  for (std::uint32_t steps = 0; steps <= cap; ++steps) {
+    if (x == a.index()) return true;
+    x = b(x, 1);
+    if (x == detail::null_index) return false;
+  }
+  return false;
+}
+
+template <int D, class... A>
+Dart CMap<D, A...>::insert_edge_in_face(Dart a, Dart b2) {
+  static_assert(D >= 2, "inserting an edge in a face needs D >= 2");
+  if (!is_insertable_edge_in_face(a, b2))
+    throw TopologyError("cmap::insert_edge_in_face: darts " + std::to_string(a.index()) + " and " +
+                        std::to_string(b2.index()) + " are not two distinct darts of one closed face");
+  constexpr std::uint32_t null = detail::null_index;
+  // 1) every copy of the face across βj (j ≥ 3), with the darts starting at a's and b's
+  //    vertices in that copy; a copy reached by an odd number of βj is reversed.
+  struct Copy {
+    std::uint32_t a, b;      // images of a and b under the βj path (for the BFS)
+    std::uint32_t c1, c2;    // darts of this copy starting at the vertices of a and b
+    std::uint32_t n1 = null, n2 = null;
+  };
+  std::vector<Copy> copies;
+  std::vector<std::array<std::uint32_t, D + 1>> next_copy;  // copy index reached by βj
+  const Mark seen = marks_.reserve();
+  std::vector<std::uint32_t> marked;
+  auto add_copy = [&](std::uint32_t ca, std::uint32_t cb, bool flipped) {
+    marks_.set(ca, seen);
+    marked.push_back(ca);
+    copies.push_back({ca, cb, flipped ? b(ca, 1) : ca, flipped ? b(cb, 1) : cb});
+    next_copy.emplace_back();
+    next_copy.back().fill(null);
+  };
+  std::vector<bool> flip{false};
+  add_copy(a.index(), b2.index(), false);
+  for (std::size_t k = 0; k < copies.size(); ++k)
+    for (int j = 3; j <= D; ++j) {
+      const std::uint32_t ja = b(copies[k].a, j), jb = b(copies[k].b, j);
+      if (ja == null || jb == null) continue;
+      if (!marks_.test(ja, seen)) {
+        flip.push_back(!flip[k]);
+        add_copy(ja, jb, flip.back());
+      }
+      next_copy[k][static_cast<std::size_t>(j)] = static_cast<std::uint32_t>(
+          std::find_if(copies.begin(), copies.end(), [&](const Copy& c) { return c.a == ja; }) - copies.begin());
+    }
+  for (std::uint32_t x : marked) marks_.clear(x, seen);
+  marks_.release(seen);
+  // 2) in each copy, n1 (c1 -> c2 vertices) closes the face holding c2, n2 the one holding c1
+  std::vector<std::uint32_t> touched;
+  for (auto& c : copies) {
+    const std::uint32_t p1 = b(c.c1, 0), p2 = b(c.c2, 0);
+    c.n1 = new_dart();
+    c.n2 = new_dart();
+    raw_link(p1, 1, c.n1);
+    raw_link(c.n1, 1, c.c2);
+    raw_link(p2, 1, c.n2);
+    raw_link(c.n2, 1, c.c1);
+    raw_link(c.n1, 2, c.n2);
+    touched.insert(touched.end(), {c.c1, c.n1, c.n2, c.c2, p1, p2});
+  }
+  // 3) βj between copies: n1 of one copy faces n2 of the next (opposite orientation)
+  for (std::size_t k = 0; k < copies.size(); ++k)
+    for (int j = 3; j <= D; ++j) {
+      const std::uint32_t l = next_copy[k][static_cast<std::size_t>(j)];
+      if (l == null) continue;
+      raw_link(copies[k].n1, j, copies[l].n2);
+      raw_link(copies[k].n2, j, copies[l].n1);
+    }
+  update_attributes(touched, ~0u);
+  return Dart(copies[0].n1);
+}
+
+template <int D, class... A>
+bool CMap<D, A...>::is_insertable_face_in_volume(std::span<const Dart> path) const {
+  if constexpr (D < 3) return false;
+  if (path.empty()) return false;
+  for (Dart d : path) {
+    if (!is_alive(d)) return false;
+    for (int j = 4; j <= D; ++j)
+      if (b(d.index(), j) != detail::null_index) return false;
+  }
+  // one volume
+  const DartList vol = cell<3>(path[0]);
+  auto in_volume = [&](Dart d) { return std::find(vol.begin(), vol.end(), d) != vol.end(); };
+  for (Dart d : path)
+    if (!in_volume(d)) return false;
+  // closed chain: each dart ends where the next starts (within the volume), distinct edges
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    const std::uint32_t end = b(path[k].index(), 1);
+    if (end == detail::null_index) return false;
+    const Dart next = path[(k + 1) % path.size()];
+    if (!same_cell<0>(Dart(end), next)) return false;
+    for (std::size_t l = 0; l < k; ++l)
+      if (same_cell<1>(path[l], path[k])) return false;
+  }
+  return true;
+}
+
+template <int D, class... A>
+Dart CMap<D, A...>::insert_face_in_volume(std::span<const Dart> path) {
+  static_assert(D >= 3, "inserting a face in a volume needs D >= 3");
+  if (!is_insertable_face_in_volume(path))
+    throw TopologyError("cmap::insert_face_in_volume: the " + std::to_string(path.size()) +
+                        " darts are not a closed chain of distinct edges of one volume");
+  constexpr std::uint32_t null = detail::null_index;
+  const std::size_t k = path.size();
+  // Path dart d_i goes v_i -> v_{i+1}. New face: p_i (v_{i+1} -> v_i) on d's side and
+  // q_i (v_i -> v_{i+1}) on the side of e_i = old β2(d_i), with β3(p_i) = q_i.
+  std::vector<std::uint32_t> p(k), q(k), e(k), touched;
+  for (std::size_t i = 0; i < k; ++i) {
+    p[i] = new_dart();
+    q[i] = new_dart();
+    e[i] = b(path[i].index(), 2);
+  }
+  for (std::size_t i = 0; i < k; ++i) {
+    raw_link(p[i], 1, p[(i + k - 1) % k]);
+    raw_link(q[i], 1, q[(i + 1) % k]);
+    raw_link(p[i], 3, q[i]);
+    raw_link(path[i].index(), 2, p[i]);
+    if (e[i] != null) raw_link(e[i], 2, q[i]);
+    touched.insert(touched.end(), {path[i].index(), p[i], q[i]});
+    if (e[i] != null) touched.push_back(e[i]);
+  }
+  update_attributes(touched, ~0u);
+  return Dart(p[0]);
+}
+
+}  // namespace sewn

@@ -1,0 +1,148 @@
+#pragma once
+// CMap::validate(): every invariant of a combinatorial map with attributes. Included by cmap.hpp.
+
+namespace sewn {
+
+template <int D, class... A>
+ValidationReport CMap<D, A...>::validate() const {
+  using K = ValidationIssue::Kind;
+  constexpr std::uint32_t null = detail::null_index;
+  ValidationReport r;
+  const auto cap = static_cast<std::uint32_t>(beta_.size());
+  auto s = [](std::uint32_t x) { return x == null ? std::string("null") : std::to_string(x); };
+  auto live = [&](std::uint32_t x) { return x < cap && beta_[x][0] != detail::dead_marker; };
+
+  // 1) free list: only dead darts, no cycle, and it accounts for every dead dart
+  std::uint32_t dead = 0;
+  for (std::uint32_t x = free_head_; x != null; x = beta_[x][1]) {
+    if (x >= cap || beta_[x][0] != detail::dead_marker) {
+      r.add(K::free_list, x, -1, "free list reaches dart " + s(x) + ", which is not a dead dart");
+      break;
+    }
+    if (++dead > cap) {
+      r.add(K::free_list, x, -1, "free list has a cycle");
+      break;
+    }
+  }
+  if (dead + alive_ != cap)
+    r.add(K::free_list, null, -1,
+          std::to_string(alive_) + " live + " + std::to_string(dead) + " free darts != capacity " + std::to_string(cap));
+
+  // 2) links: live targets, β0 = β1⁻¹, involutions, commuting pairs
+  for (std::uint32_t x = 0; x < cap; ++x) {
+    if (!live(x)) continue;
+    bool links_ok = true;
+    for (int i = 0; i <= D; ++i) {
+      const std::uint32_t y = b(x, i);
+      if (y != null && !live(y)) {
+        r.add(K::dangling_link, x, i, "beta" + std::to_string(i) + "(" + s(x) + ") = " + s(y) + " is not a live dart");
+        links_ok = false;
+      }
+    }
+    if (!links_ok) continue;
+    if (const std::uint32_t y = b(x, 1); y != null && b(y, 0) != x)
+      r.add(K::beta0_beta1, x, 1, "beta0(beta1(" + s(x) + ")) = " + s(b(y, 0)) + ", expected " + s(x));
+    if (const std::uint32_t y = b(x, 0); y != null && b(y, 1) != x)
+      r.add(K::beta0_beta1, x, 0, "beta1(beta0(" + s(x) + ")) = " + s(b(y, 1)) + ", expected " + s(x));
+    for (int i = 2; i <= D; ++i) {
+      const std::uint32_t y = b(x, i);
+      if (y == x)
+        r.add(K::not_involution, x, i, "beta" + std::to_string(i) + "(" + s(x) + ") = " + s(x) + " (a fixed point)");
+      else if (y != null && b(y, i) != x)
+        r.add(K::not_involution, x, i,
+              "beta" + std::to_string(i) + " is not an involution at dart " + s(x) + ": beta" + std::to_string(i) +
+                  "(" + s(y) + ") = " + s(b(y, i)));
+    }
+    // β1∘βj (j ≥ 3): βj(β1(x)) = β0(βj(x)), both null or both equal
+    for (int j = 3; j <= D; ++j) {
+      const std::uint32_t xj = b(x, j);
+      if (xj == null) continue;
+      const std::uint32_t x1 = b(x, 1);
+      const std::uint32_t lhs = x1 == null ? null : b(x1, j);
+      const std::uint32_t rhs = b(xj, 0);
+      if (lhs != rhs)
+        r.add(K::composition, x, j,
+              "beta1 o beta" + std::to_string(j) + " is not an involution at dart " + s(x) + ": beta" +
+                  std::to_string(j) + "(beta1(" + s(x) + ")) = " + s(lhs) + " but beta0(beta" + std::to_string(j) +
+                  "(" + s(x) + ")) = " + s(rhs));
+    }
+    // βi∘βj for 2 ≤ i, i+2 ≤ j: they commute
+    for (int i = 2; i <= D; ++i)
+      for (int j = i + 2; j <= D; ++j) {
+        const std::uint32_t xi = b(x, i), xj = b(x, j);
+        const std::uint32_t ij = xi == null ? null : b(xi, j);
+        const std::uint32_t ji = xj == null ? null : b(xj, i);
+        if (ij != ji)
+          r.add(K::composition, x, j,
+                "beta" + std::to_string(i) + " o beta" + std::to_string(j) + " is not an involution at dart " + s(x) +
+                    ": beta" + std::to_string(j) + "(beta" + std::to_string(i) + ") = " + s(ij) + ", beta" +
+                    std::to_string(i) + "(beta" + std::to_string(j) + ") = " + s(ji));
+      }
+  }
+  if (!r.ok()) return r;  // attribute checks traverse orbits and need sound links
+
+  // 3) attributes: one per cell, counts, orphans, one cell per attribute, recorded dart
+  for_each_dim([&](auto k) {
+    constexpr int I = k();
+    if constexpr (has_attribute<I>) {
+      const auto& st = store<I>();
+      const auto& vals = st.values;
+      std::vector<std::uint32_t> counted(vals.capacity(), 0);
+      const std::string dim = std::to_string(I) + "-attribute";
+      for (std::uint32_t x = 0; x < cap; ++x) {
+        if (!live(x)) continue;
+        const std::uint32_t a = st.of_dart[x];
+        if (a != null) {
+          if (!vals.is_alive(a)) {
+            r.add(K::attribute_dead, x, I, "dart " + s(x) + " refers to " + dim + " " + s(a) + ", which is not live");
+            continue;
+          }
+          ++counted[a];
+        }
+        for_each_neighbor(x, cell_orbit(I), [&](std::uint32_t y) {
+          if (st.of_dart[y] != a)
+            r.add(K::attribute_mismatch, x, I,
+                  "darts " + s(x) + " and " + s(y) + " are in one " + std::to_string(I) + "-cell but carry " + dim +
+                      "s " + s(a) + " and " + s(st.of_dart[y]));
+        });
+      }
+      const Mark m = marks_.reserve();
+      std::vector<std::uint32_t> queue;
+      for (std::uint32_t a = 0; a < vals.capacity(); ++a) {
+        if (!vals.is_alive(a)) continue;
+        if (vals.count(a) != counted[a])
+          r.add(K::attribute_count, null, I,
+                dim + " " + s(a) + " has reference count " + std::to_string(vals.count(a)) + " but " +
+                    std::to_string(counted[a]) + " darts refer to it");
+        if (counted[a] == 0) {
+          r.add(K::attribute_orphan, null, I, dim + " " + s(a) + " is live but no dart refers to it");
+          continue;
+        }
+        const std::uint32_t rep = vals.dart(a);
+        if (!live(rep) || st.of_dart[rep] != a) {
+          r.add(K::attribute_dart, rep, I, dim + " " + s(a) + " records dart " + s(rep) + ", which is not in its cell");
+          continue;
+        }
+        queue.clear();
+        collect(rep, cell_orbit(I), m, queue);
+        if (queue.size() != counted[a])
+          r.add(K::attribute_two_cells, rep, I,
+                dim + " " + s(a) + " is carried by " + std::to_string(counted[a]) + " darts but the cell of dart " +
+                    s(rep) + " has " + std::to_string(queue.size()));
+      }
+      free_mark(m);
+    }
+  });
+
+  // 4) marks: unreserved marks have no marked dart (reserved ones are the caller's business)
+  for (int m = 0; m < detail::MarkPlanes::max_marks; ++m) {
+    const Mark mk(m);
+    if (marks_.is_reserved(mk)) continue;
+    if (marks_.count(mk) != 0)
+      r.add(K::marks, null, m, "mark " + std::to_string(m) + " is free but counts " +
+                                   std::to_string(marks_.count(mk)) + " marked darts");
+  }
+  return r;
+}
+
+}  // namespace sewn

@@ -1,0 +1,192 @@
+#include "sewn/cmap/mesh.hpp"
+
+#include <algorithm>
+
+#include "sewn/cmap/errors.hpp"
+
+namespace sewn {
+
+namespace {
+
+// Outward faces, VTK vertex order (see mesh.hpp).
+constexpr std::uint32_t tet_f[4][3] = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}};
+constexpr std::uint32_t hex_f[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                       {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+constexpr std::uint32_t prism_tri[2][3] = {{0, 1, 2}, {3, 5, 4}};
+constexpr std::uint32_t prism_quad[3][4] = {{0, 3, 4, 1}, {1, 4, 5, 2}, {2, 5, 3, 0}};
+constexpr std::uint32_t pyr_base[4] = {0, 3, 2, 1};
+constexpr std::uint32_t pyr_tri[4][3] = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+
+const std::array<std::span<const std::uint32_t>, 4> tet_faces{tet_f[0], tet_f[1], tet_f[2], tet_f[3]};
+const std::array<std::span<const std::uint32_t>, 6> hex_faces{hex_f[0], hex_f[1], hex_f[2],
+                                                              hex_f[3], hex_f[4], hex_f[5]};
+const std::array<std::span<const std::uint32_t>, 5> prism_faces{prism_tri[0], prism_tri[1], prism_quad[0],
+                                                                prism_quad[1], prism_quad[2]};
+const std::array<std::span<const std::uint32_t>, 5> pyramid_faces{pyr_base, pyr_tri[0], pyr_tri[1], pyr_tri[2],
+                                                                  pyr_tri[3]};
+
+Point3 grid_point(const GridSpec& g, std::uint32_t i, std::uint32_t j, std::uint32_t k) {
+  return {g.origin[0] + i * g.spacing[0], g.origin[1] + j * g.spacing[1], g.origin[2] + k * g.spacing[2]};
+}
+
+void check_grid(std::uint32_t nx, std::uint32_t ny, std::uint32_t nz, const GridSpec& g, const char* what) {
+  if (nx == 0 || ny == 0 || nz == 0)
+    throw MeshError(std::string(what) + ": every cell count must be at least 1");
+  for (double s : g.spacing)
+    if (!(s > 0.0)) throw MeshError(std::string(what) + ": every spacing must be positive and finite");
+}
+
+}  // namespace
+
+const char* to_string(CellType t) {
+  switch (t) {
+    case CellType::segment: return "segment";
+    case CellType::triangle: return "triangle";
+    case CellType::quad: return "quad";
+    case CellType::tetrahedron: return "tetrahedron";
+    case CellType::hexahedron: return "hexahedron";
+    case CellType::prism: return "prism";
+    case CellType::pyramid: return "pyramid";
+  }
+  return "?";
+}
+
+std::span<const std::span<const std::uint32_t>> cell_faces(CellType t) {
+  switch (t) {
+    case CellType::tetrahedron: return tet_faces;
+    case CellType::hexahedron: return hex_faces;
+    case CellType::prism: return prism_faces;
+    case CellType::pyramid: return pyramid_faces;
+    default: return {};
+  }
+}
+
+std::uint32_t IndexedMesh::add_cell(CellType t, std::span<const std::uint32_t> vertices, std::int32_t tag) {
+  if (static_cast<int>(vertices.size()) != cell_vertex_count(t))
+    throw MeshError(std::string("a ") + to_string(t) + " needs " + std::to_string(cell_vertex_count(t)) +
+                    " vertices, got " + std::to_string(vertices.size()));
+  types.push_back(t);
+  conn.insert(conn.end(), vertices.begin(), vertices.end());
+  offsets.push_back(static_cast<std::uint32_t>(conn.size()));
+  tags.push_back(tag);
+  return static_cast<std::uint32_t>(types.size() - 1);
+}
+
+std::array<std::uint32_t, 4> IndexedMesh::count_by_dimension() const {
+  std::array<std::uint32_t, 4> n{};
+  for (CellType t : types) ++n[static_cast<std::size_t>(cell_dimension(t))];
+  return n;
+}
+
+void IndexedMesh::check_indices(const std::string& source) const {
+  if (offsets.size() != types.size() + 1 || tags.size() != types.size() || offsets.back() != conn.size())
+    throw MeshError(source + ": cell arrays have inconsistent sizes");
+  for (std::uint32_t c = 0; c < num_cells(); ++c) {
+    const auto v = cell(c);
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      if (v[k] >= points.size())
+        throw MeshError(source + ": cell " + std::to_string(c) + " (" + to_string(types[c]) + ") refers to point " +
+                        std::to_string(v[k]) + " but there are only " + std::to_string(points.size()) + " points");
+      for (std::size_t l = 0; l < k; ++l)
+        if (v[l] == v[k])
+          throw MeshError(source + ": cell " + std::to_string(c) + " (" + to_string(types[c]) +
+                          ") uses point " + std::to_string(v[k]) + " twice");
+    }
+  }
+}
+
+IndexedMesh hex_grid(std::uint32_t nx, std::uint32_t ny, std::uint32_t nz, const GridSpec& g) {
+  check_grid(nx, ny, nz, g, "hex_grid");
+  IndexedMesh m;
+  const std::uint32_t px = nx + 1, py = ny + 1;
+  m.points.reserve(static_cast<std::size_t>(px) * py * (nz + 1));
+  for (std::uint32_t k = 0; k <= nz; ++k)
+    for (std::uint32_t j = 0; j <= ny; ++j)
+      for (std::uint32_t i = 0; i <= nx; ++i) m.points.push_back(grid_point(g, i, j, k));
+  auto id = [&](std::uint32_t i, std::uint32_t j, std::uint32_t k) { return i + px * (j + py * k); };
+  m.types.reserve(static_cast<std::size_t>(nx) * ny * nz);
+  m.conn.reserve(8 * static_cast<std::size_t>(nx) * ny * nz);
+  for (std::uint32_t k = 0; k < nz; ++k)
+    for (std::uint32_t j = 0; j < ny; ++j)
+      for (std::uint32_t i = 0; i < nx; ++i)
+        m.add_cell(CellType::hexahedron, {id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
+                                          id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
+                                          id(i, j + 1, k + 1)});
+  return m;
+}
+
+IndexedMesh tet_grid(std::uint32_t nx, std::uint32_t ny, std::uint32_t nz, TetSplit split, const GridSpec& g) {
+  IndexedMesh hex = hex_grid(nx, ny, nz, g);
+  IndexedMesh m;
+  m.points = hex.points;
+  // Kuhn: the six monotone paths 0 -> 6 through the cube; each (0, a, b, 6) is positive for
+  // the orders below (VTK hex numbering).
+  static constexpr std::uint32_t kuhn[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6},
+                                               {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
+  // Five tets: four corners and a central one, for the two parities of a cell.
+  static constexpr std::uint32_t five_even[5][4] = {{0, 1, 3, 4}, {1, 2, 3, 6}, {1, 4, 5, 6}, {3, 6, 7, 4},
+                                                    {1, 3, 4, 6}};
+  static constexpr std::uint32_t five_odd[5][4] = {{1, 2, 0, 5}, {2, 3, 0, 7}, {2, 5, 6, 7}, {0, 7, 4, 5},
+                                                   {0, 2, 7, 5}};
+  std::uint32_t c = 0;
+  for (std::uint32_t k = 0; k < nz; ++k)
+    for (std::uint32_t j = 0; j < ny; ++j)
+      for (std::uint32_t i = 0; i < nx; ++i, ++c) {
+        const auto h = hex.cell(c);
+        auto emit = [&](const std::uint32_t (&t)[4]) {
+          std::array<std::uint32_t, 4> v{h[t[0]], h[t[1]], h[t[2]], h[t[3]]};
+          const auto& p0 = m.points[v[0]];
+          const auto& p1 = m.points[v[1]];
+          const auto& p2 = m.points[v[2]];
+          const auto& p3 = m.points[v[3]];
+          const double ax = p1[0] - p0[0], ay = p1[1] - p0[1], az = p1[2] - p0[2];
+          const double bx = p2[0] - p0[0], by = p2[1] - p0[1], bz = p2[2] - p0[2];
+          const double cx = p3[0] - p0[0], cy = p3[1] - p0[1], cz = p3[2] - p0[2];
+          const double vol = ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx);
+          if (vol < 0) std::swap(v[1], v[2]);  // keep every tetrahedron positively oriented
+          m.add_cell(CellType::tetrahedron, v);
+        };
+        if (split == TetSplit::kuhn6) {
+          for (const auto& t : kuhn) emit(t);
+        } else if ((i + j + k) % 2 == 0) {
+          for (const auto& t : five_even) emit(t);
+        } else {
+          for (const auto& t : five_odd) emit(t);
+        }
+      }
+  return m;
+}
+
+IndexedMesh quad_grid(std::uint32_t nx, std::uint32_t ny, const GridSpec& g) {
+  check_grid(nx, ny, 1, g, "quad_grid");
+  IndexedMesh m;
+  for (std::uint32_t j = 0; j <= ny; ++j)
+    for (std::uint32_t i = 0; i <= nx; ++i) m.points.push_back(grid_point(g, i, j, 0));
+  auto id = [&](std::uint32_t i, std::uint32_t j) { return i + (nx + 1) * j; };
+  for (std::uint32_t j = 0; j < ny; ++j)
+    for (std::uint32_t i = 0; i < nx; ++i)
+      m.add_cell(CellType::quad, {id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+  return m;
+}
+
+IndexedMesh tri_grid(std::uint32_t nx, std::uint32_t ny, const GridSpec& g) {
+  IndexedMesh q = quad_grid(nx, ny, g);
+  IndexedMesh m;
+  m.points = q.points;
+  for (std::uint32_t c = 0; c < q.num_cells(); ++c) {
+    const auto v = q.cell(c);
+    m.add_cell(CellType::triangle, {v[0], v[1], v[2]});
+    m.add_cell(CellType::triangle, {v[0], v[2], v[3]});
+  }
+  return m;
+}
+
+IndexedMesh polyline_x(std::uint32_t n, double spacing) {
+  if (n == 0 || !(spacing > 0)) throw MeshError("polyline_x: needs n >= 1 segments and a positive spacing");
+  IndexedMesh m;
+  for (std::uint32_t i = 0; i <= n; ++i) m.points.push_back({i * spacing, 0.0, 0.0});
+  for (std::uint32_t i = 0; i < n; ++i) m.add_cell(CellType::segment, {i, i + 1});
+  return m;
+}
+
+}  // namespace sewn
