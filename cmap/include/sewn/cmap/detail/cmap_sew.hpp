@@ -68,8 +68,10 @@ void CMap<D, A...>::unsew_pairs(std::uint32_t d, std::vector<std::pair<std::uint
   pairs.clear();
   const Mark m = marks_.reserve();
   std::vector<std::uint32_t> marked;
+  // A partial map may hold an I-sewn dart whose β1-neighbour is I-free (its partner's face is
+  // open there); only sewn darts belong to the orbit being unsewn.
   auto visit = [&](std::uint32_t x) {
-    if (x == null || !marks_.set(x, m)) return;
+    if (x == null || b(x, I) == null || !marks_.set(x, m)) return;
     marked.push_back(x);
     const std::uint32_t y = b(x, I);
     if constexpr (I >= 2) {

@@ -1,0 +1,98 @@
+#pragma once
+// Test helpers: an independent cell recount and the per-step validity check.
+
+#include <doctest/doctest.h>
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <vector>
+
+#include "sewn/cmap/cmap.hpp"
+
+namespace sewn::test {
+
+// Neighbours of dart x in the orbit of its i-cell, written out by hand from the definition of
+// cells in a combinatorial map (not shared with the library): for i ≥ 1 every βj (j ≠ i, β0
+// with β1), for i = 0 the compositions β1∘βj, βj∘β0 and βk∘βj (j ≠ k ≥ 2).
+template <class Map>
+std::vector<Dart> orbit_neighbours(const Map& m, Dart x, int i) {
+  constexpr int D = Map::dimension;
+  std::vector<Dart> out;
+  auto push = [&](Dart y) {
+    if (y) out.push_back(y);
+  };
+  if (i == 0) {
+    for (int j = 2; j <= D; ++j) {
+      if (Dart y = m.beta(x, j)) {
+        push(m.beta(y, 1));
+        for (int k = 2; k <= D; ++k)
+          if (k != j) push(m.beta(y, k));
+      }
+      if (Dart y = m.beta(x, 0)) push(m.beta(y, j));
+    }
+  } else {
+    for (int j = 0; j <= D; ++j) {
+      if (j == i || (i == 1 && j == 0)) continue;
+      push(m.beta(x, j));
+    }
+  }
+  return out;
+}
+
+// Number of i-cells for i = 0..D by breadth-first search with a plain visited array.
+template <class Map>
+std::array<std::uint32_t, Map::dimension + 1> recount(const Map& m) {
+  constexpr int D = Map::dimension;
+  std::array<std::uint32_t, D + 1> n{};
+  const std::uint32_t cap = m.dart_capacity();
+  for (int i = 0; i <= D; ++i) {
+    std::vector<char> seen(cap, 0);
+    for (std::uint32_t s = 0; s < cap; ++s) {
+      if (!m.is_alive(Dart(s)) || seen[s]) continue;
+      ++n[static_cast<std::size_t>(i)];
+      std::deque<Dart> queue{Dart(s)};
+      seen[s] = 1;
+      while (!queue.empty()) {
+        const Dart x = queue.front();
+        queue.pop_front();
+        for (Dart y : orbit_neighbours(m, x, i))
+          if (!seen[y.index()]) {
+            seen[y.index()] = 1;
+            queue.push_back(y);
+          }
+      }
+    }
+  }
+  return n;
+}
+
+// validate() is clean, the map's own counts agree with the independent recount, and no mark is
+// left reserved. Returns the counts.
+template <class Map>
+std::array<std::uint32_t, Map::dimension + 1> check_map(const Map& m) {
+  const auto report = m.validate();
+  INFO(report.str());
+  CHECK(report.ok());
+  const auto own = m.count_all();
+  const auto ref = recount(m);
+  for (int i = 0; i <= Map::dimension; ++i) {
+    INFO("dimension " << i);
+    CHECK(own[static_cast<std::size_t>(i)] == ref[static_cast<std::size_t>(i)]);
+  }
+  CHECK(m.num_reserved_marks() == 0);
+  return own;
+}
+
+template <std::size_t N>
+std::array<std::uint32_t, N> counts(std::initializer_list<std::uint32_t> v) {
+  std::array<std::uint32_t, N> a{};
+  std::size_t k = 0;
+  for (auto x : v) {
+    REQUIRE(k < N);
+    a[k++] = x;
+  }
+  return a;
+}
+
+}  // namespace sewn::test
