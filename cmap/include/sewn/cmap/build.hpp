@@ -118,8 +118,8 @@ BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOption
   }
   map.reserve(static_cast<std::uint32_t>(map.dart_capacity() + darts));
   const std::uint32_t base = map.dart_capacity();
-  res.vertex_of_dart.assign(base, null);
-  res.cell_of_dart.assign(base, null);
+  res.vertex_of_dart.assign(base + darts, null);  // new darts reuse free slots or extend the range
+  res.cell_of_dart.assign(base + darts, null);
   auto record = [&](Dart d, std::uint32_t point, std::uint32_t cell) {
     if (d.index() >= res.vertex_of_dart.size()) {
       res.vertex_of_dart.resize(d.index() + 1, null);

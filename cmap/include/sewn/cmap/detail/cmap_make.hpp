@@ -94,27 +94,27 @@ Dart CMap<D, A...>::make_polyline(std::uint32_t n) {
 template <int D, class... A>
 Dart CMap<D, A...>::make_cell(const CellTemplate& t, std::vector<Dart>* darts) {
   if (t.face_size.size() > 1 && D < 3) throw TopologyError("cmap::make_cell: a polyhedron needs D >= 3");
-  const std::size_t n = t.from.size();
-  std::vector<std::uint32_t> made;
-  made.reserve(n);
+  // The new darts go straight into the caller's list (or a local one): builders call this once
+  // per mesh cell, so no allocation per cell.
+  std::vector<Dart> local;
+  std::vector<Dart>& out = darts ? *darts : local;
+  const std::size_t base = out.size();
   for (std::uint32_t size : t.face_size) {
     const std::uint32_t first = new_dart();
-    made.push_back(first);
+    out.push_back(Dart(first));
     std::uint32_t prev = first;
     for (std::uint32_t k = 1; k < size; ++k) {
       const std::uint32_t x = new_dart();
-      made.push_back(x);
+      out.push_back(Dart(x));
       raw_link(prev, 1, x);
       prev = x;
     }
     raw_link(prev, 1, first);
   }
   if (t.face_size.size() > 1)
-    for (std::size_t k = 0; k < n; ++k)
-      if (k < t.mate[k]) raw_link(made[k], 2, made[t.mate[k]]);
-  if (darts)
-    for (std::uint32_t x : made) darts->push_back(Dart(x));
-  return Dart(made[t.first]);
+    for (std::size_t k = 0; k < t.from.size(); ++k)
+      if (k < t.mate[k]) raw_link(out[base + k].index(), 2, out[base + t.mate[k]].index());
+  return out[base + t.first];
 }
 
 template <int D, class... A>

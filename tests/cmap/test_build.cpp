@@ -1,0 +1,246 @@
+// Builders from indexed meshes: every cell type, grids, mixed meshes, orientation, bad input.
+#include <doctest/doctest.h>
+
+#include <string>
+
+#include "check.hpp"
+#include "sewn/cmap/build.hpp"
+#include "sewn/cmap/cmap.hpp"
+
+using namespace sewn;
+using sewn::test::check_map;
+using sewn::test::counts;
+
+using Map1 = CMap<1, std::uint32_t>;
+using Map2 = CMap<2, std::uint32_t>;
+using Map3 = CMap<3, std::uint32_t>;
+using Map4 = CMap<4, std::uint32_t>;
+
+namespace {
+
+template <class M>
+BuildResult build_with_points(M& m, const IndexedMesh& mesh, BuildOptions opt = {}) {
+  auto r = build(m, mesh, opt);
+  m.template create_attributes<0>([&](Dart d) { return r.vertex_of_dart[d.index()]; });
+  return r;
+}
+
+std::uint32_t hex_grid_edges(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+  return x * (y + 1) * (z + 1) + (x + 1) * y * (z + 1) + (x + 1) * (y + 1) * z;
+}
+std::uint32_t hex_grid_faces(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+  return x * y * (z + 1) + x * (y + 1) * z + (x + 1) * y * z;
+}
+
+}  // namespace
+
+TEST_CASE("hexahedral grids of any size and spacing") {
+  for (auto [x, y, z] : {std::array<std::uint32_t, 3>{1, 1, 1}, {3, 2, 4}, {8, 8, 10}, {1, 5, 1}}) {
+    CAPTURE(x);
+    CAPTURE(y);
+    CAPTURE(z);
+    Map3 m;
+    const auto mesh = hex_grid(x, y, z, GridSpec{{0.5, 2.0, 0.1}, {1, 2, 3}});
+    CHECK(mesh.points[mesh.num_points() - 1] == Point3{1 + 0.5 * x, 2 + 2.0 * y, 3 + 0.1 * z});
+    const auto r = build_with_points(m, mesh);
+    const auto n = check_map(m);
+    CHECK(n == counts<4>({(x + 1) * (y + 1) * (z + 1), hex_grid_edges(x, y, z), hex_grid_faces(x, y, z), x * y * z}));
+    CHECK(m.euler_characteristic() == 1);
+    CHECK(r.sewn_facets == hex_grid_faces(x, y, z) - 2 * (x * y + y * z + x * z));
+    CHECK(m.boundary_facets().size() == 2 * (x * y + y * z + x * z));
+    CHECK(m.count_components() == 1);
+    // every dart's 0-attribute names the mesh point it starts at; cell_dart runs 0 -> 1
+    const Dart d0 = r.cell_dart[0];
+    CHECK(m.value(m.attribute<0>(d0)) == mesh.cell(0)[0]);
+    CHECK(m.value(m.attribute<0>(m.beta(d0, 1))) == mesh.cell(0)[1]);
+  }
+  CHECK_THROWS_AS(hex_grid(0, 1, 1), MeshError);
+  CHECK_THROWS_AS(hex_grid(1, 1, 1, GridSpec{{1, -1, 1}, {}}), MeshError);
+}
+
+TEST_CASE("the paper's tetrahedral beam: 5x7x9 cells, 6 tetrahedra each") {
+  Map3 m;
+  const auto mesh = tet_grid(5, 7, 9, TetSplit::kuhn6);
+  CHECK(mesh.num_cells() == 1890);
+  build_with_points(m, mesh);
+  const auto n = check_map(m);
+  CHECK(n[0] == 480);
+  CHECK(n[1] == 2655);  // the 2013 paper's spring count: every edge a spring
+  CHECK(n[3] == 1890);
+  CHECK(m.euler_characteristic() == 1);
+}
+
+TEST_CASE("a cube as five tetrahedra, and a conforming grid of them") {
+  Map3 m;
+  build_with_points(m, tet_grid(1, 1, 1, TetSplit::five));
+  CHECK(check_map(m) == counts<4>({8, 18, 16, 5}));  // 12 edges + 6 face diagonals: 18 springs
+  Map3 g;
+  const auto r = build_with_points(g, tet_grid(3, 2, 2, TetSplit::five));
+  check_map(g);
+  CHECK(g.euler_characteristic() == 1);
+  CHECK(r.nonmanifold_facets == 0);
+  CHECK(g.boundary_facets().size() == 2 * 2 * (3 * 2 + 2 * 2 + 3 * 2));  // two triangles per boundary square
+}
+
+TEST_CASE("quad and triangle grids in a 2-map and as surfaces in a 3-map") {
+  Map2 q2;
+  build_with_points(q2, quad_grid(4, 3));
+  CHECK(check_map(q2) == counts<3>({20, 31, 12}));
+  Map2 t2;
+  build_with_points(t2, tri_grid(4, 3));
+  CHECK(check_map(t2) == counts<3>({20, 43, 24}));
+  Map3 q3;
+  build_with_points(q3, quad_grid(4, 3));
+  CHECK(check_map(q3) == counts<4>({20, 31, 12, 1}));  // one surface: a single 3-cell (open)
+}
+
+TEST_CASE("polylines in 1-, 2- and 3-maps") {
+  Map1 m1;
+  build_with_points(m1, polyline_x(5));
+  auto n1 = check_map(m1);
+  CHECK(n1[1] == 5);
+  CHECK(m1.count_components() == 1);
+  Map2 m2;
+  build_with_points(m2, polyline_x(5));
+  CHECK(check_map(m2) == counts<3>({6, 5, 2}));  // the forward and backward chains are two open 2-cells
+  Map3 m3;
+  build_with_points(m3, polyline_x(5));
+  CHECK(check_map(m3) == counts<4>({6, 5, 2, 1}));
+}
+
+TEST_CASE("mixed cell types in one solid: hexahedron, prism, pyramid, tetrahedron") {
+  IndexedMesh mesh;
+  // a unit cube 0..7, a prism on its +x face, a pyramid on its top, a tetrahedron on the
+  // pyramid's +y triangle
+  for (Point3 p : {Point3{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}})
+    mesh.points.push_back(p);
+  mesh.points.push_back({2, 0, 0});      // 8
+  mesh.points.push_back({2, 0, 1});      // 9
+  mesh.points.push_back({0.5, 0.5, 2});  // 10: apex
+  mesh.points.push_back({0.5, 1.5, 1.5});  // 11
+  mesh.add_cell(CellType::hexahedron, {0, 1, 2, 3, 4, 5, 6, 7});
+  // prism with triangles (1,8,2) and (5,9,6): the quad (1,2,6,5) is shared with the cube
+  mesh.add_cell(CellType::prism, {1, 2, 8, 5, 6, 9});
+  mesh.add_cell(CellType::pyramid, {4, 5, 6, 7, 10});
+  mesh.add_cell(CellType::tetrahedron, {6, 7, 10, 11});
+  Map3 m;
+  const auto r = build_with_points(m, mesh);
+  CHECK(r.sewn_facets == 3);
+  const auto n = check_map(m);
+  CHECK(n[3] == 4);
+  CHECK(n[0] == 12);
+  CHECK(m.euler_characteristic() == 1);
+  CHECK(m.count_components() == 1);
+}
+
+TEST_CASE("mixed dimensions: a solid, a shell on it and a rod share points but not darts") {
+  IndexedMesh mesh = hex_grid(1, 1, 1);
+  mesh.add_cell(CellType::quad, {4, 5, 6, 7});  // a shell covering the top face
+  mesh.points.push_back({0.5, 0.5, 2});
+  mesh.add_cell(CellType::segment, {6, 8});  // a rod standing on a corner
+  mesh.points.push_back({0.5, 0.5, 3});
+  mesh.add_cell(CellType::segment, {8, 9});
+  Map3 m;
+  const auto r = build_with_points(m, mesh);
+  check_map(m);
+  CHECK(m.count_components() == 3);
+  CHECK(r.sewn_facets == 1);  // only the two rod segments are chained
+  CHECK(m.num_darts() == 24 + 4 + 4);
+}
+
+TEST_CASE("surface cells with inconsistent orientation are reversed and glued") {
+  IndexedMesh mesh = tri_grid(3, 3);
+  // reverse every other triangle
+  for (std::uint32_t c = 0; c < mesh.num_cells(); c += 2) std::swap(mesh.conn[mesh.offsets[c] + 1], mesh.conn[mesh.offsets[c] + 2]);
+  Map2 m;
+  const auto r = build_with_points(m, mesh);
+  CHECK(check_map(m) == counts<3>({16, 33, 18}));
+  std::uint32_t flipped = 0;
+  for (bool f : r.flipped) flipped += f ? 1u : 0u;
+  CHECK(flipped == 9);  // half of the 18 triangles disagree with the first one
+  CHECK(r.unorientable_edges == 0);
+  BuildOptions no_orient;
+  no_orient.orient_surfaces = false;
+  Map2 raw;
+  const auto r2 = build_with_points(raw, mesh, no_orient);
+  check_map(raw);
+  CHECK(r2.unorientable_edges > 0);  // left unsewn, reported
+}
+
+TEST_CASE("a map of dimension 4 holds hexahedra glued by faces") {
+  Map4 m;
+  build_with_points(m, hex_grid(2, 1, 1));
+  const auto n = check_map(m);
+  CHECK(n[0] == 12);
+  CHECK(n[3] == 2);
+  CHECK(n[4] == 1);
+}
+
+TEST_CASE("building into a map that already has darts") {
+  Map3 m;
+  m.make_hexahedron();
+  const auto r = build(m, hex_grid(2, 1, 1));
+  CHECK(r.vertex_of_dart[0] == Dart::null_index);
+  CHECK(r.vertex_of_dart[r.cell_dart[0].index()] == 0);
+  m.create_attributes<0>([](Dart) { return 0u; });
+  CHECK(check_map(m)[3] == 3);
+}
+
+TEST_CASE("bad meshes are refused with the cell named") {
+  auto message_of = [](auto&& f) {
+    try {
+      f();
+    } catch (const MeshError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  IndexedMesh mesh = hex_grid(2, 1, 1);
+  SUBCASE("index out of range") {
+    mesh.conn[9] = 99;
+    Map3 m;
+    const auto msg = message_of([&] { build(m, mesh); });
+    CHECK(msg.find("cell 1") != std::string::npos);
+    CHECK(msg.find("99") != std::string::npos);
+    CHECK(m.num_darts() == 0);
+  }
+  SUBCASE("repeated point") {
+    mesh.conn[1] = mesh.conn[0];
+    Map3 m;
+    CHECK(message_of([&] { build(m, mesh); }).find("twice") != std::string::npos);
+  }
+  SUBCASE("a volume in a 2-map") {
+    Map2 m;
+    CHECK(message_of([&] { build(m, mesh); }).find("dimension 2") != std::string::npos);
+  }
+  SUBCASE("an inverted hexahedron next to a correct one") {
+    // mirror cell 1 (swap its bottom and top): its shared face now runs the same way as cell 0's
+    auto c1 = std::vector<std::uint32_t>(mesh.cell(1).begin(), mesh.cell(1).end());
+    for (int k = 0; k < 4; ++k) mesh.conn[mesh.offsets[1] + k] = c1[static_cast<std::size_t>(k + 4)],
+                                mesh.conn[mesh.offsets[1] + k + 4] = c1[static_cast<std::size_t>(k)];
+    Map3 m;
+    const auto msg = message_of([&] { build(m, mesh); });
+    CHECK(msg.find("inverted") != std::string::npos);
+    CHECK(msg.find("cell 0") != std::string::npos);
+    CHECK(msg.find("cell 1") != std::string::npos);
+  }
+  SUBCASE("a face shared by three volumes") {
+    IndexedMesh t;
+    t.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0, 0, -1}, {0.3, 0.3, 0.5}};
+    t.add_cell(CellType::tetrahedron, {0, 1, 2, 3});
+    t.add_cell(CellType::tetrahedron, {0, 2, 1, 4});
+    t.add_cell(CellType::tetrahedron, {0, 1, 2, 5});
+    Map3 m;
+    BuildOptions strict;
+    strict.allow_nonmanifold = false;
+    strict.source = "three.msh";
+    const auto msg = message_of([&] { build(m, t, strict); });
+    CHECK(msg.find("three.msh") != std::string::npos);
+    CHECK(msg.find("non-manifold") != std::string::npos);
+    Map3 lax;
+    const auto r = build_with_points(lax, t);
+    CHECK(r.nonmanifold_facets == 1);
+    CHECK(r.sewn_facets == 0);
+    check_map(lax);
+  }
+}
