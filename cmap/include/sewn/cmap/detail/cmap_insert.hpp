@@ -37,7 +37,7 @@ Dart CMap<D, A...>::insert_vertex_in_edge(Dart d) {
       raw_link(edge[k], j, split[l]);
       raw_link(split[k], j, y);
     }
-  update_attributes(touched, ~0u);
+  update_attributes(touched, 1u << 1);  // only the edge splits; the rest was inherited
   return Dart(split[0]);
 }
 
@@ -126,7 +126,7 @@ Dart CMap<D, A...>::insert_edge_in_face(Dart a, Dart b2) {
       raw_link(copies[k].n1, j, copies[l].n2);
       raw_link(copies[k].n2, j, copies[l].n1);
     }
-  update_attributes(touched, ~0u);
+  update_attributes(touched, 1u << 2);  // only the face splits; the rest was inherited
   return Dart(copies[0].n1);
 }
 
@@ -187,7 +187,7 @@ Dart CMap<D, A...>::insert_face_in_volume(std::span<const Dart> path) {
     touched.insert(touched.end(), {path[i].index(), p[i], q[i]});
     if (e[i] != null) touched.push_back(e[i]);
   }
-  update_attributes(touched, ~0u);
+  update_attributes(touched, 1u << 3);  // only the volume may split; the rest was inherited
   return Dart(p[0]);
 }
 
