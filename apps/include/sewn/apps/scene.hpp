@@ -1,0 +1,101 @@
+#pragma once
+// Scene files: what to simulate, read from JSON and validated against one schema
+// (scene_schema()), which also generates docs/scenes.md.
+
+#include <array>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "sewn/apps/schema.hpp"
+
+namespace sewn::app {
+
+using Vec3 = std::array<double, 3>;
+
+/// Where a rule applies: points (or cells, by their centroid) inside a region, or a mesh tag.
+struct Selector {
+  enum class Type { all, box, sphere, tag, points } type = Type::all;
+  Vec3 min{}, max{};       // box
+  Vec3 center{};           // sphere
+  double radius = 0;       // sphere
+  int tag = 0;             // tag
+  std::vector<std::uint32_t> points;  // points: mesh point indices
+  [[nodiscard]] bool contains(const Vec3& p) const;
+};
+
+struct MaterialSpec {
+  double young = 0, poisson = 0, density = 0;
+  double thickness = 1;  // 2D cells: membrane thickness (m)
+  double area = 0;       // 1D cells: cross-section (m²)
+  bool clamp_elongated = false;  // Baudet edge stiffness < 0: clamp instead of refusing
+};
+
+struct MeshSpec {
+  std::string type;  // hex_grid, tet_grid, quad_grid, tri_grid, disc, cylinder, polyline, file
+  std::string name;
+  std::string material;
+  std::vector<std::pair<Selector, std::string>> regions;  // later rules win
+  std::array<std::uint32_t, 3> cells{1, 1, 1};
+  Vec3 size{1, 1, 1}, origin{0, 0, 0};
+  std::string split = "kuhn6";  // tet_grid
+  std::string plane = "xy";     // quad_grid, tri_grid, disc
+  double radius = 0, height = 0;
+  std::uint32_t rings = 0, sectors = 0, layers = 0;
+  std::vector<Vec3> points;  // polyline
+  std::string path;          // file (resolved against the scene's folder)
+  double scale = 1;
+  Vec3 translate{0, 0, 0};
+};
+
+struct FixSpec {
+  Selector where;
+  std::array<bool, 3> axes{true, true, true};
+};
+
+struct CutSpec {
+  std::string type;  // plane, faces, particles, pierce
+  double time = 0;
+  Vec3 point{}, normal{};                        // plane
+  std::optional<Selector> within;                // plane: restrict to a region
+  std::vector<std::vector<std::uint32_t>> faces; // faces: point indices of each face
+  std::vector<std::uint32_t> particles;          // particles
+  Selector where;                                // pierce: volumes whose centroid is inside
+  bool remove = true;                            // pierce: remove the freed volumes
+};
+
+struct Scene {
+  std::string file;  // where it was read from ("(default)" for the embedded scene)
+  std::string name, description;
+  std::map<std::string, MaterialSpec> materials;
+  std::vector<MeshSpec> meshes;
+  std::vector<FixSpec> fixed;
+  Vec3 gravity{0, 0, -9.81};
+  std::string damping = "viscous";
+  double rayleigh_alpha = 0, rayleigh_beta = 0, environment_damping = 0;
+  std::string integrator = "implicit";
+  double step = 1e-3, duration = 1;
+  double tolerance = 1e-6;
+  std::uint32_t max_iterations = 2000;
+  bool allow_unstable = false;
+  std::vector<CutSpec> cuts;
+  std::uint32_t frames = 50;
+  bool write_vtu = true, write_csv = true, write_picture = true;
+  std::string color_by = "displacement", style = "shaded";
+  std::uint32_t width = 1280, height = 800;
+};
+
+/// The schema of scene files (see docs/scenes.md, generated from it).
+const Field& scene_schema();
+/// Validates and reads a scene; throws SceneError naming file, key path and reason.
+Scene parse_scene(const nlohmann::json& j, const std::string& file);
+/// Reads a scene file (JSON); throws SceneError for unreadable files and JSON syntax errors too.
+Scene load_scene(const std::string& path);
+/// The embedded default scene: a cantilever beam sagging under gravity, cut part-way through.
+const char* default_scene_json();
+Scene default_scene();
+
+}  // namespace sewn::app

@@ -1,0 +1,409 @@
+#include "sewn/apps/scene.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace sewn::app {
+
+namespace {
+
+Field selector_schema(std::string key, std::string doc) {
+  Field s = field(std::move(key), Kind::object);
+  s.doc(std::move(doc)).select_by("type");
+  s.members({field("type", Kind::string).required().doc("Kind of region.")});
+  s.variant("all", "Everything.", {});
+  s.variant("box", "An axis-aligned box (bounds included).",
+            {field("min", Kind::vec3).unit("m").required().doc("Lower corner."),
+             field("max", Kind::vec3).unit("m").required().doc("Upper corner.")});
+  s.variant("sphere", "A ball.",
+            {field("center", Kind::vec3).unit("m").required().doc("Centre."),
+             field("radius", Kind::number).unit("m").required().above(0).doc("Radius.")});
+  s.variant("tag", "Cells carrying a mesh tag (Gmsh physical group, MEDIT reference); for points: points of such cells.",
+            {field("tag", Kind::integer).required().doc("The tag.")});
+  s.variant("points", "Mesh points by index (cells: all of whose points are listed).",
+            {field("indices", Kind::number_list).required().at_least(0).items(1, 1u << 30).doc("Point indices.")});
+  return s;
+}
+
+Field build_schema() {
+  Field material = field("material", Kind::object);
+  material.doc("A linear elastic material. The mass-spring stiffnesses follow Baudet et al. (hexahedra, quads) and van Gelder (tetrahedra, triangles), see PHYSICS_NOTES §1.");
+  material.members({
+      field("young", Kind::number).unit("Pa").required().above(0).doc("Young's modulus E."),
+      field("poisson", Kind::number).fallback(0.3).above(-1).below(0.5).doc("Poisson's ratio ν."),
+      field("density", Kind::number).unit("kg/m³").required().above(0).doc("Mass density ρ (per unit area for 2D cells of unit thickness)."),
+      field("thickness", Kind::number).unit("m").fallback(1.0).above(0).doc("Thickness of 2D cells (membranes): scales their mass and stiffness."),
+      field("area", Kind::number).unit("m²").fallback(1e-4).above(0).doc("Cross-section of 1D cells (polylines): axial spring k = E·area/length."),
+      field("elongated", Kind::string).one_of({"refuse", "clamp"}).fallback("refuse")
+          .doc("Baudet's edge stiffness turns negative for boxes longer than ~1.5× their width: refuse such an element (naming it), or clamp the edge stiffness to a small positive fraction of the diagonal's (documented in PHYSICS_NOTES §1.2 handling)."),
+  });
+
+  Field mesh = field("mesh", Kind::object);
+  mesh.doc("One body. Procedural meshes are generated; `file` meshes are read from Gmsh .msh (2.2, 4.1 ASCII), MEDIT .mesh or legacy VTK .vtk files.")
+      .select_by("type");
+  Field region = field("region", Kind::object);
+  region.doc("A material assignment for the cells whose centroid lies in `where` (later entries win).")
+      .members({selector_schema("where", "Cells to assign.").required(),
+                field("material", Kind::string).required().doc("Name of a material in `materials`.")});
+  mesh.members({
+      field("type", Kind::string).required().doc("Kind of mesh."),
+      field("name", Kind::string).fallback("").doc("A name for messages and output."),
+      field("material", Kind::string).required().doc("Name of the material of every cell (see `regions` for exceptions)."),
+      field("regions", Kind::array).of(region).fallback(nlohmann::json::array()).doc("Per-region materials."),
+  });
+  auto cells3 = field("cells", Kind::number_list).items(3, 3).at_least(1).at_most(4096).required().doc("Cells along x, y, z (whole numbers).");
+  auto size3 = field("size", Kind::vec3).unit("m").above(0).required().doc("Extent along x, y, z.");
+  auto origin = field("origin", Kind::vec3).unit("m").fallback({0.0, 0.0, 0.0}).doc("Position of the minimum corner (or centre, for discs and cylinders).");
+  auto cells2 = field("cells", Kind::number_list).items(2, 2).at_least(1).at_most(65536).required().doc("Cells along the two in-plane axes.");
+  auto size2 = field("size", Kind::number_list).items(2, 2).unit("m").above(0).required().doc("Extent along the two in-plane axes.");
+  auto plane = field("plane", Kind::string).one_of({"xy", "xz", "yz"}).fallback("xy").doc("The plane the membrane lies in.");
+  mesh.variant("hex_grid", "A box of hexahedra.", {cells3, size3, origin});
+  mesh.variant("tet_grid", "A box of hexahedral cells, each cut into tetrahedra.",
+               {cells3, size3, origin,
+                field("split", Kind::string).one_of({"kuhn6", "five"}).fallback("kuhn6")
+                    .doc("6 tetrahedra per cell around one diagonal, or 5 with alternating parity.")});
+  mesh.variant("quad_grid", "A rectangle of quadrilaterals (a membrane).", {cells2, size2, origin, plane});
+  mesh.variant("tri_grid", "A rectangle of quadrilaterals cut into triangles (a membrane).", {cells2, size2, origin, plane});
+  mesh.variant("disc", "A triangulated disc: a centre point and rings of sectors·k points (ring k).",
+               {field("radius", Kind::number).unit("m").required().above(0).doc("Radius."),
+                field("rings", Kind::integer).required().at_least(1).at_most(10000).doc("Number of rings."),
+                field("sectors", Kind::integer).fallback(6).at_least(3).at_most(10000).doc("Points on the first ring."),
+                origin, plane});
+  mesh.variant("cylinder", "A tetrahedralised cylinder along z: disc layers joined by prisms, each cut into 3 tetrahedra.",
+               {field("radius", Kind::number).unit("m").required().above(0).doc("Radius."),
+                field("height", Kind::number).unit("m").required().above(0).doc("Height."),
+                field("rings", Kind::integer).required().at_least(1).at_most(1000).doc("Rings of the cross-section."),
+                field("sectors", Kind::integer).fallback(6).at_least(3).at_most(1000).doc("Points on the first ring."),
+                field("layers", Kind::integer).required().at_least(1).at_most(10000).doc("Layers along z."),
+                origin});
+  mesh.variant("polyline", "A chain of segments (a rope of axial springs).",
+               {field("points", Kind::array).of(field("point", Kind::vec3).unit("m")).items(2, 1u << 24).required()
+                    .doc("The points, in order.")});
+  mesh.variant("file", "A mesh file.",
+               {field("path", Kind::string).required().doc("Path of the file, relative to the scene file."),
+                field("scale", Kind::number).fallback(1.0).above(0).doc("Factor applied to coordinates."),
+                field("translate", Kind::vec3).unit("m").fallback({0.0, 0.0, 0.0}).doc("Offset added after scaling.")});
+
+  Field fix = field("fix", Kind::object);
+  fix.doc("Particles held in place along some axes.")
+      .members({selector_schema("where", "Particles to fix.").required(),
+                field("axes", Kind::string).one_of({"xyz", "x", "y", "z", "xy", "xz", "yz"}).fallback("xyz").doc("Axes held.")});
+
+  Field cut = field("cut", Kind::object);
+  cut.doc("A topological cut applied between two steps (3-unsew of faces between volumes; 2-unsew of edges between 2D cells).")
+      .select_by("type");
+  cut.members({field("type", Kind::string).required().doc("Kind of cut."),
+               field("time", Kind::number).unit("s").required().at_least(0).doc("When to cut (the first step starting at or after it).")});
+  cut.variant("plane", "Every inner face (edge, in 2D) whose two cells have their centroids strictly on opposite sides of a plane: the mesh faces nearest the plane, which then separate the body along it.",
+              {field("point", Kind::vec3).unit("m").required().doc("A point of the plane."),
+               field("normal", Kind::vec3).required().doc("Its normal (any length but zero)."),
+               selector_schema("within", "Only faces whose centroid lies in this region.")});
+  cut.variant("faces", "Explicit faces, each given by its mesh point indices.",
+              {field("faces", Kind::array).of(field("face", Kind::number_list).items(2, 4).at_least(0)).items(1, 1u << 24).required()
+                   .doc("Each face as 3 or 4 point indices (2 for an edge of a 2D mesh).")});
+  cut.variant("particles", "Every inner face (edge) all of whose points are among the listed particles: a cut along a path.",
+              {field("particles", Kind::number_list).at_least(0).items(2, 1u << 30).required().doc("Mesh point indices.")});
+  cut.variant("pierce", "Unsew every face of the volumes whose centroid lies in a region.",
+              {selector_schema("where", "Volumes to free.").required(),
+               field("remove", Kind::boolean).fallback(true).doc("Remove the freed volumes (true) or keep them as loose pieces.")});
+
+  Field picture = field("picture", Kind::object);
+  picture.doc("A PNG of the last frame.")
+      .members({field("enabled", Kind::boolean).fallback(true).doc("Write it."),
+                field("color_by", Kind::string).one_of({"displacement", "speed", "force", "fixed", "material"})
+                    .fallback("displacement").doc("Per-point quantity shown by colour."),
+                field("style", Kind::string).one_of({"shaded", "wireframe"}).fallback("shaded").doc("Drawing style."),
+                field("width", Kind::integer).fallback(1280).at_least(64).at_most(8192).unit("px").doc("Width."),
+                field("height", Kind::integer).fallback(800).at_least(64).at_most(8192).unit("px").doc("Height.")});
+  Field output = field("output", Kind::object);
+  output.doc("What is written to the output folder (`--out`, default `out/<name>/`).")
+      .fallback(nlohmann::json::object())
+      .members({field("frames", Kind::integer).fallback(50).at_least(1).at_most(100000).doc("Output frames over the run (a ParaView .vtu each, plus frame 0)."),
+                field("vtu", Kind::boolean).fallback(true).doc("Write the ParaView series (.vtu per frame + .pvd)."),
+                field("csv", Kind::boolean).fallback(true).doc("Write frames.csv (energies, counts, timings per frame)."),
+                picture});
+
+  Field damping = field("damping", Kind::object);
+  damping.doc("How motion is damped; the same model is used in the forces and in their Jacobians.")
+      .fallback(nlohmann::json::object())
+      .members({field("model", Kind::string).one_of({"viscous", "rayleigh", "none"}).fallback("viscous")
+                    .doc("`viscous`: the 2013 paper's per-spring γ = 2√(k(mᵢ+mⱼ)/2); `rayleigh`: C = αM + βK."),
+                field("alpha", Kind::number).unit("1/s").fallback(0.0).at_least(0).doc("Rayleigh mass coefficient α."),
+                field("beta", Kind::number).unit("s").fallback(0.0).at_least(0).doc("Rayleigh stiffness coefficient β."),
+                field("environment", Kind::number).unit("1/s").fallback(0.0).at_least(0).doc("Drag −c·m·v on every particle.")});
+
+  Field integrator = field("integrator", Kind::object);
+  integrator.doc("Time integration.")
+      .fallback(nlohmann::json::object())
+      .members({field("type", Kind::string).one_of({"implicit", "semi-implicit"}).fallback("implicit")
+                    .doc("Linearly implicit Euler (Baraff–Witkin, CG) or semi-implicit (symplectic) Euler."),
+                field("step", Kind::number).unit("s").fallback(1e-3).above(0).at_most(10).doc("Time step h."),
+                field("tolerance", Kind::number).fallback(1e-6).above(0).below(1).doc("CG relative residual (implicit)."),
+                field("max_iterations", Kind::integer).fallback(2000).at_least(1).at_most(1000000).doc("CG iteration limit (implicit); reaching it is an error."),
+                field("allow_unstable", Kind::boolean).fallback(false)
+                    .doc("Run a semi-implicit step larger than the estimated stable bound (otherwise refused with the bound).")});
+
+  Field root = field("scene", Kind::object);
+  root.doc("A scene file is one JSON object. Lengths in metres, times in seconds, SI units throughout.");
+  root.members({
+      field("name", Kind::string).fallback("").doc("Name of the scene (default: the file name without extension); the output goes to `out/<name>/`."),
+      field("description", Kind::string).fallback("").doc("Free text."),
+      field("materials", Kind::map).of(material).items(1, 1u << 20).required().doc("Named materials."),
+      field("meshes", Kind::array).of(mesh).items(1, 1u << 16).required().doc("The bodies."),
+      field("fixed", Kind::array).of(fix).fallback(nlohmann::json::array()).doc("Fixed particles."),
+      field("gravity", Kind::vec3).unit("m/s²").fallback({0.0, 0.0, -9.81}).doc("Gravity."),
+      damping,
+      integrator,
+      field("duration", Kind::number).unit("s").fallback(1.0).above(0).at_most(1e6).doc("Simulated time."),
+      field("cuts", Kind::array).of(cut).fallback(nlohmann::json::array()).doc("Scheduled cuts."),
+      output,
+  });
+  return root;
+}
+
+Selector read_selector(const nlohmann::json& j, const Field& schema) {
+  const std::string type = j.at("type").get<std::string>();
+  Reader r(j, schema, type);
+  Selector s;
+  if (type == "all") s.type = Selector::Type::all;
+  if (type == "box") {
+    s.type = Selector::Type::box;
+    s.min = r.vec3("min");
+    s.max = r.vec3("max");
+  } else if (type == "sphere") {
+    s.type = Selector::Type::sphere;
+    s.center = r.vec3("center");
+    s.radius = r.number("radius");
+  } else if (type == "tag") {
+    s.type = Selector::Type::tag;
+    s.tag = static_cast<int>(r.integer("tag"));
+  } else if (type == "points") {
+    s.type = Selector::Type::points;
+    for (const auto& x : r["indices"]) s.points.push_back(x.get<std::uint32_t>());
+  }
+  return s;
+}
+
+std::array<bool, 3> read_axes(const std::string& a) {
+  return {a.find('x') != std::string::npos, a.find('y') != std::string::npos, a.find('z') != std::string::npos};
+}
+
+void check_whole(const nlohmann::json& list, const std::string& file, const std::string& path) {
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const double x = list[i].get<double>();
+    if (x != static_cast<double>(static_cast<long long>(x)))
+      throw SceneError(file, path + "[" + std::to_string(i) + "]", "must be a whole number (got " + list[i].dump() + ")");
+  }
+}
+
+}  // namespace
+
+bool Selector::contains(const Vec3& p) const {
+  switch (type) {
+    case Type::all: return true;
+    case Type::box:
+      return p[0] >= min[0] && p[0] <= max[0] && p[1] >= min[1] && p[1] <= max[1] && p[2] >= min[2] && p[2] <= max[2];
+    case Type::sphere: {
+      const double dx = p[0] - center[0], dy = p[1] - center[1], dz = p[2] - center[2];
+      return dx * dx + dy * dy + dz * dz <= radius * radius;
+    }
+    default: return false;  // tags and point lists are not geometric
+  }
+}
+
+const Field& scene_schema() {
+  static const Field schema = build_schema();
+  return schema;
+}
+
+Scene parse_scene(const nlohmann::json& j, const std::string& file) {
+  const Field& schema = scene_schema();
+  validate(j, schema, file);
+  Reader r(j, schema);
+  Scene s;
+  s.file = file;
+  s.name = r.string("name");
+  if (s.name.empty()) s.name = file == "(default)" ? "default" : std::filesystem::path(file).stem().string();
+  s.description = r.string("description");
+
+  const Field& material_schema = *schema.member("materials")->element_;
+  for (auto it = r["materials"].begin(); it != r["materials"].end(); ++it) {
+    Reader m(it.value(), material_schema);
+    MaterialSpec ms;
+    ms.young = m.number("young");
+    ms.poisson = m.number("poisson");
+    ms.density = m.number("density");
+    ms.thickness = m.number("thickness");
+    ms.area = m.number("area");
+    ms.clamp_elongated = m.string("elongated") == "clamp";
+    s.materials[it.key()] = ms;
+  }
+  auto check_material = [&](const std::string& name, const std::string& path) {
+    if (!s.materials.count(name)) {
+      std::vector<std::string> names;
+      for (const auto& [n, _] : s.materials) names.push_back(n);
+      const std::string near = closest_key(name, names);
+      throw SceneError(file, path, "no material named \"" + name + "\"" + (near.empty() ? "" : " (did you mean \"" + near + "\"?)"));
+    }
+  };
+
+  const Field& mesh_schema = *schema.member("meshes")->element_;
+  const auto base = std::filesystem::path(file).parent_path();
+  for (std::size_t i = 0; i < r["meshes"].size(); ++i) {
+    const auto& mj = r["meshes"][i];
+    const std::string path = "meshes[" + std::to_string(i) + "]";
+    MeshSpec m;
+    m.type = mj.at("type").get<std::string>();
+    Reader mr(mj, mesh_schema, m.type);
+    m.name = mr.string("name");
+    if (m.name.empty()) m.name = m.type + std::to_string(i);
+    m.material = mr.string("material");
+    check_material(m.material, path + ".material");
+    const Field& region_schema = *mesh_schema.member("regions")->element_;
+    for (std::size_t k = 0; k < mr["regions"].size(); ++k) {
+      const auto& rj = mr["regions"][k];
+      Reader rr(rj, region_schema);
+      check_material(rr.string("material"), path + ".regions[" + std::to_string(k) + "].material");
+      m.regions.emplace_back(read_selector(rj.at("where"), *region_schema.member("where")), rr.string("material"));
+    }
+    if (mr.has("cells") || m.type == "hex_grid" || m.type == "tet_grid" || m.type == "quad_grid" || m.type == "tri_grid") {
+      check_whole(mr["cells"], file, path + ".cells");
+      const auto& c = mr["cells"];
+      for (std::size_t k = 0; k < c.size(); ++k) m.cells[k] = static_cast<std::uint32_t>(c[k].get<double>());
+      const auto& sz = mr["size"];
+      for (std::size_t k = 0; k < sz.size(); ++k) m.size[k] = sz[k].get<double>();
+    }
+    if (mesh_schema.member("origin", m.type)) m.origin = mr.vec3("origin");
+    if (m.type == "tet_grid") m.split = mr.string("split");
+    if (mesh_schema.member("plane", m.type)) m.plane = mr.string("plane");
+    if (m.type == "disc" || m.type == "cylinder") {
+      m.radius = mr.number("radius");
+      m.rings = static_cast<std::uint32_t>(mr.integer("rings"));
+      m.sectors = static_cast<std::uint32_t>(mr.integer("sectors"));
+    }
+    if (m.type == "cylinder") {
+      m.height = mr.number("height");
+      m.layers = static_cast<std::uint32_t>(mr.integer("layers"));
+    }
+    if (m.type == "polyline")
+      for (const auto& p : mr["points"]) m.points.push_back({p[0].get<double>(), p[1].get<double>(), p[2].get<double>()});
+    if (m.type == "file") {
+      const auto p = std::filesystem::path(mr.string("path"));
+      m.path = (p.is_absolute() || file == "(default)") ? p.string() : (base / p).string();
+      m.scale = mr.number("scale");
+      m.translate = mr.vec3("translate");
+    }
+    s.meshes.push_back(std::move(m));
+  }
+
+  const Field& fix_schema = *schema.member("fixed")->element_;
+  for (const auto& fj : r["fixed"]) {
+    Reader fr(fj, fix_schema);
+    s.fixed.push_back({read_selector(fj.at("where"), *fix_schema.member("where")), read_axes(fr.string("axes"))});
+  }
+  s.gravity = r.vec3("gravity");
+  {
+    Reader d(r["damping"], *schema.member("damping"));
+    s.damping = d.string("model");
+    s.rayleigh_alpha = d.number("alpha");
+    s.rayleigh_beta = d.number("beta");
+    s.environment_damping = d.number("environment");
+  }
+  {
+    Reader in(r["integrator"], *schema.member("integrator"));
+    s.integrator = in.string("type");
+    s.step = in.number("step");
+    s.tolerance = in.number("tolerance");
+    s.max_iterations = static_cast<std::uint32_t>(in.integer("max_iterations"));
+    s.allow_unstable = in.boolean("allow_unstable");
+  }
+  s.duration = r.number("duration");
+  if (s.step > s.duration) throw SceneError(file, "integrator.step", "is longer than the whole run (duration " + std::to_string(s.duration) + " s)");
+
+  const Field& cut_schema = *schema.member("cuts")->element_;
+  for (std::size_t i = 0; i < r["cuts"].size(); ++i) {
+    const auto& cj = r["cuts"][i];
+    const std::string path = "cuts[" + std::to_string(i) + "]";
+    CutSpec c;
+    c.type = cj.at("type").get<std::string>();
+    Reader cr(cj, cut_schema, c.type);
+    c.time = cr.number("time");
+    if (c.time > s.duration) throw SceneError(file, path + ".time", "is after the end of the run (duration " + std::to_string(s.duration) + " s)");
+    if (c.type == "plane") {
+      c.point = cr.vec3("point");
+      c.normal = cr.vec3("normal");
+      if (c.normal[0] == 0 && c.normal[1] == 0 && c.normal[2] == 0) throw SceneError(file, path + ".normal", "must not be zero");
+      if (cr.has("within")) c.within = read_selector(cj.at("within"), *cut_schema.member("within", "plane"));
+    } else if (c.type == "faces") {
+      for (std::size_t k = 0; k < cr["faces"].size(); ++k) {
+        check_whole(cr["faces"][k], file, path + ".faces[" + std::to_string(k) + "]");
+        std::vector<std::uint32_t> f;
+        for (const auto& x : cr["faces"][k]) f.push_back(static_cast<std::uint32_t>(x.get<double>()));
+        c.faces.push_back(std::move(f));
+      }
+    } else if (c.type == "particles") {
+      check_whole(cr["particles"], file, path + ".particles");
+      for (const auto& x : cr["particles"]) c.particles.push_back(static_cast<std::uint32_t>(x.get<double>()));
+    } else if (c.type == "pierce") {
+      c.where = read_selector(cj.at("where"), *cut_schema.member("where", "pierce"));
+      c.remove = cr.boolean("remove");
+    }
+    s.cuts.push_back(std::move(c));
+  }
+
+  {
+    Reader o(r["output"], *schema.member("output"));
+    s.frames = static_cast<std::uint32_t>(o.integer("frames"));
+    s.write_vtu = o.boolean("vtu");
+    s.write_csv = o.boolean("csv");
+    const Field& pic_schema = *schema.member("output")->member("picture");
+    const nlohmann::json picture = o["picture"].is_null() ? nlohmann::json::object() : o["picture"];
+    Reader p(picture, pic_schema);
+    s.write_picture = p.boolean("enabled");
+    s.color_by = p.string("color_by");
+    s.style = p.string("style");
+    s.width = static_cast<std::uint32_t>(p.integer("width"));
+    s.height = static_cast<std::uint32_t>(p.integer("height"));
+  }
+  return s;
+}
+
+Scene load_scene(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw SceneError(path, "", std::filesystem::exists(path) ? "cannot be read" : "no such file");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in, nullptr, true, /*ignore_comments=*/true);
+  } catch (const nlohmann::json::parse_error& e) {
+    // e.byte is the offset of the error; turn it into a line for the message
+    std::ifstream again(path);
+    std::string text((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>());
+    std::size_t line = 1;
+    for (std::size_t k = 0; k < std::min<std::size_t>(e.byte, text.size()); ++k) line += text[k] == '\n';
+    throw SceneError(path, "line " + std::to_string(line), std::string("not valid JSON: ") + e.what());
+  }
+  return parse_scene(j, path);
+}
+
+const char* default_scene_json() {
+  return R"json({
+  "name": "default",
+  "description": "A 1 m cantilever beam of 20x4x4 hexahedra, clamped at x = 0, sagging under gravity; at t = 0.6 s it is cut through its upper half at mid-span while it still swings.",
+  "materials": { "rubbery": { "young": 2e7, "poisson": 0.3, "density": 1000 } },
+  "meshes": [ { "type": "hex_grid", "name": "beam", "material": "rubbery",
+                "cells": [20, 4, 4], "size": [1.0, 0.1, 0.1], "origin": [0, -0.05, -0.05] } ],
+  "fixed": [ { "where": { "type": "box", "min": [-1, -1, -1], "max": [0.001, 1, 1] } } ],
+  "gravity": [0, 0, -9.81],
+  "damping": { "model": "viscous" },
+  "integrator": { "type": "implicit", "step": 0.001 },
+  "duration": 1.5,
+  "cuts": [ { "type": "plane", "time": 0.6, "point": [0.5, 0, 0], "normal": [1, 0, 0],
+              "within": { "type": "box", "min": [0.4, -1, 0.0], "max": [0.6, 1, 1] } } ],
+  "output": { "frames": 60, "picture": { "color_by": "displacement" } }
+})json";
+}
+
+Scene default_scene() { return parse_scene(nlohmann::json::parse(default_scene_json()), "(default)"); }
+
+}  // namespace sewn::app
