@@ -1,6 +1,8 @@
 #include "sewn/cmap/mesh.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 
 #include "sewn/cmap/errors.hpp"
 
@@ -187,6 +189,116 @@ IndexedMesh polyline_x(std::uint32_t n, double spacing) {
   for (std::uint32_t i = 0; i <= n; ++i) m.points.push_back({i * spacing, 0.0, 0.0});
   for (std::uint32_t i = 0; i < n; ++i) m.add_cell(CellType::segment, {i, i + 1});
   return m;
+}
+
+IndexedMesh polyline(std::span<const Point3> points) {
+  if (points.size() < 2) throw MeshError("polyline: needs at least 2 points");
+  IndexedMesh m;
+  m.points.assign(points.begin(), points.end());
+  for (std::uint32_t i = 0; i + 1 < points.size(); ++i) {
+    if (points[i] == points[i + 1]) throw MeshError("polyline: points " + std::to_string(i) + " and " + std::to_string(i + 1) + " coincide");
+    m.add_cell(CellType::segment, {i, i + 1});
+  }
+  return m;
+}
+
+IndexedMesh disc(double radius, std::uint32_t rings, std::uint32_t sectors) {
+  if (!(radius > 0) || rings == 0 || sectors < 3) throw MeshError("disc: needs radius > 0, rings >= 1 and sectors >= 3");
+  IndexedMesh m;
+  m.points.push_back({0, 0, 0});
+  std::vector<std::uint32_t> ring_start{0, 1};  // ring k starts at ring_start[k]
+  for (std::uint32_t k = 1; k <= rings; ++k) {
+    const std::uint32_t n = sectors * k;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const double a = 2 * std::numbers::pi * i / n, r = radius * k / rings;
+      m.points.push_back({r * std::cos(a), r * std::sin(a), 0});
+    }
+    ring_start.push_back(ring_start.back() + n);
+  }
+  // Between ring k-1 (sectors·(k-1) points) and ring k (sectors·k): in each sector, walk both
+  // rings by angle, always advancing the one whose next point comes first (ties: outer ring).
+  for (std::uint32_t k = 1; k <= rings; ++k) {
+    const std::uint32_t inner_n = std::max<std::uint32_t>(sectors * (k - 1), 1), outer_n = sectors * k;
+    auto inner = [&](std::uint32_t i) { return k == 1 ? 0u : ring_start[k - 1] + i % inner_n; };
+    auto outer = [&](std::uint32_t i) { return ring_start[k] + i % outer_n; };
+    std::uint32_t i = 0, o = 0;
+    while (i < (k == 1 ? 0u : inner_n) || o < outer_n) {
+      // angles of the next candidate points, as fractions of a turn
+      const double next_inner = k == 1 ? 2.0 : double(i + 1) / inner_n;
+      const double next_outer = double(o + 1) / outer_n;
+      if (next_outer <= next_inner + 1e-12) {
+        m.add_cell(CellType::triangle, {inner(i), outer(o), outer(o + 1)});
+        ++o;
+      } else {
+        m.add_cell(CellType::triangle, {inner(i), outer(o), inner(i + 1)});
+        ++i;
+      }
+    }
+  }
+  return m;
+}
+
+IndexedMesh cylinder(double radius, double height, std::uint32_t rings, std::uint32_t sectors, std::uint32_t layers) {
+  if (!(height > 0) || layers == 0) throw MeshError("cylinder: needs height > 0 and layers >= 1");
+  const IndexedMesh base = disc(radius, rings, sectors);
+  const std::uint32_t np = base.num_points();
+  IndexedMesh m;
+  for (std::uint32_t l = 0; l <= layers; ++l)
+    for (const auto& p : base.points) m.points.push_back({p[0], p[1], height * l / layers});
+  for (std::uint32_t l = 0; l < layers; ++l)
+    for (std::uint32_t c = 0; c < base.num_cells(); ++c) {
+      const auto t = base.cell(c);
+      std::array<std::uint32_t, 6> v{t[0] + l * np, t[1] + l * np, t[2] + l * np,
+                                     t[0] + (l + 1) * np, t[1] + (l + 1) * np, t[2] + (l + 1) * np};
+      // Put the smallest point index first by a rotation of the triangles and/or swapping the
+      // two layers; then every quad face is cut along the diagonal from its smallest index, which
+      // neighbouring prisms see the same way, so the tetrahedra conform (Dompierre et al. 1999).
+      const auto min_at = static_cast<std::size_t>(std::min_element(v.begin(), v.end()) - v.begin());
+      if (min_at >= 3) std::swap_ranges(v.begin(), v.begin() + 3, v.begin() + 3);
+      std::rotate(v.begin(), v.begin() + static_cast<long>(min_at % 3), v.begin() + 3);
+      std::rotate(v.begin() + 3, v.begin() + 3 + static_cast<long>(min_at % 3), v.end());
+      const auto [a, b, c2, d, e, f] = v;  // a-b-c2 one triangle, d-e-f the other (d over a)
+      std::array<std::array<std::uint32_t, 4>, 3> tets;
+      if (std::min(b, f) < std::min(c2, e))
+        tets = {{{a, b, c2, f}, {a, b, f, e}, {a, e, f, d}}};
+      else
+        tets = {{{a, b, c2, e}, {a, c2, f, e}, {a, e, f, d}}};
+      for (auto tv : tets) {
+        const auto& p0 = m.points[tv[0]];
+        auto sub = [&](std::uint32_t q) {
+          const auto& p = m.points[q];
+          return std::array<double, 3>{p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]};
+        };
+        const auto x = sub(tv[1]), y = sub(tv[2]), z = sub(tv[3]);
+        const double vol = x[0] * (y[1] * z[2] - y[2] * z[1]) - x[1] * (y[0] * z[2] - y[2] * z[0]) + x[2] * (y[0] * z[1] - y[1] * z[0]);
+        if (vol < 0) std::swap(tv[1], tv[2]);
+        m.add_cell(CellType::tetrahedron, tv);
+      }
+    }
+  return m;
+}
+
+void place_in_plane(IndexedMesh& mesh, const std::string& plane) {
+  if (plane == "xy") return;
+  if (plane != "xz" && plane != "yz") throw MeshError("place_in_plane: unknown plane \"" + plane + "\" (xy, xz or yz)");
+  for (auto& p : mesh.points) p = plane == "xz" ? Point3{p[0], 0.0, p[1]} : Point3{0.0, p[0], p[1]};
+}
+
+void transform(IndexedMesh& mesh, double scale, const Point3& offset) {
+  for (auto& p : mesh.points)
+    for (int k = 0; k < 3; ++k) p[static_cast<std::size_t>(k)] = scale * p[static_cast<std::size_t>(k)] + offset[static_cast<std::size_t>(k)];
+}
+
+std::uint32_t append(IndexedMesh& mesh, const IndexedMesh& other) {
+  const std::uint32_t base = mesh.num_points();
+  mesh.points.insert(mesh.points.end(), other.points.begin(), other.points.end());
+  for (std::uint32_t c = 0; c < other.num_cells(); ++c) {
+    std::array<std::uint32_t, 8> v{};
+    const auto cv = other.cell(c);
+    for (std::size_t k = 0; k < cv.size(); ++k) v[k] = cv[k] + base;
+    mesh.add_cell(other.types[c], std::span<const std::uint32_t>(v.data(), cv.size()), other.tags[c]);
+  }
+  return base;
 }
 
 }  // namespace sewn

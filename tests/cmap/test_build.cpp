@@ -244,3 +244,31 @@ TEST_CASE("bad meshes are refused with the cell named") {
     check_map(lax);
   }
 }
+
+TEST_CASE("discs, cylinders and polylines through points") {
+  const IndexedMesh frisbee = disc(0.15, 8, 8);
+  CHECK(frisbee.num_points() == 289);  // the 2019 paper's nylon frisbee
+  CHECK(frisbee.num_cells() == 512);
+  Map2 d;
+  build_with_points(d, frisbee);
+  const auto n = check_map(d);
+  CHECK(n == counts<3>({289, 289 + 512 - 1, 512}));  // a disc: V - E + F = 1
+  CHECK(d.boundary_facets().size() == 64);          // the rim: 64 rod edges in the paper
+  for (std::uint32_t c = 0; c < frisbee.num_cells(); ++c) {  // every triangle counter-clockwise
+    const auto v = frisbee.cell(c);
+    const auto &a = frisbee.points[v[0]], &b = frisbee.points[v[1]], &e = frisbee.points[v[2]];
+    CHECK((b[0] - a[0]) * (e[1] - a[1]) - (b[1] - a[1]) * (e[0] - a[0]) > 0);
+  }
+  const IndexedMesh cyl = cylinder(0.1, 0.5, 3, 6, 4);
+  Map3 c;
+  const auto r = build_with_points(c, cyl);
+  check_map(c);
+  CHECK(cyl.num_cells() == 3 * 4 * disc(0.1, 3, 6).num_cells());
+  CHECK(r.nonmanifold_facets == 0);
+  CHECK(c.euler_characteristic() == 1);  // conforming: one solid ball-like body
+  CHECK(c.count_components() == 1);
+  const Point3 pts[] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}};
+  CHECK(polyline(pts).num_cells() == 2);
+  const Point3 dup[] = {{0, 0, 0}, {0, 0, 0}};
+  CHECK_THROWS_AS(polyline(dup), MeshError);
+}

@@ -4,6 +4,7 @@
 // outward orientation (right-hand rule) for a positively oriented cell.
 
 #include <array>
+#include <initializer_list>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -86,5 +87,20 @@ IndexedMesh quad_grid(std::uint32_t nx, std::uint32_t ny, const GridSpec& g = {}
 IndexedMesh tri_grid(std::uint32_t nx, std::uint32_t ny, const GridSpec& g = {});
 /// A straight polyline of n segments along x.
 IndexedMesh polyline_x(std::uint32_t n, double spacing = 1.0);
+/// A polyline through the given points (at least 2), in order.
+IndexedMesh polyline(std::span<const Point3> points);
+/// A triangulated disc in the z = 0 plane centred at the origin: a centre point and rings
+/// k = 1..rings of sectors·k points; ring annulus k holds sectors·(2k-1) triangles. With
+/// rings = 8, sectors = 8: 289 points and 512 triangles (the 2019 paper's frisbee).
+IndexedMesh disc(double radius, std::uint32_t rings, std::uint32_t sectors);
+/// A cylinder along z (base centred at the origin): layers of the disc above joined by prisms,
+/// each cut into 3 positively oriented tetrahedra, conforming across shared faces.
+IndexedMesh cylinder(double radius, double height, std::uint32_t rings, std::uint32_t sectors, std::uint32_t layers);
+/// Maps (x, y, z) to the plane named "xy" (unchanged), "xz" ((x, 0, y)) or "yz" ((0, x, y)).
+void place_in_plane(IndexedMesh& mesh, const std::string& plane);
+/// x <- scale·x + offset for every point.
+void transform(IndexedMesh& mesh, double scale, const Point3& offset);
+/// Appends `other`'s points and cells (indices shifted); returns the index of its first point.
+std::uint32_t append(IndexedMesh& mesh, const IndexedMesh& other);
 
 }  // namespace sewn
