@@ -104,5 +104,5 @@ for s in "${suites[@]}"; do
   else
     "${report[@]}" --out-dir "$out"
   fi
-  [[ $mode == full ]] && echo "::: wrote $out/$s.md and $out/$s.json"
+  if [[ $mode == full ]]; then echo "::: wrote $out/$s.md and $out/$s.json"; fi
 done
