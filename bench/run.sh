@@ -80,8 +80,7 @@ for s in "${suites[@]}"; do
   raw="$tmp/$s.raw.json"
   run=(env SEWN_BENCH_SCALE=$mode "build/release/bench/$s/bench_$s"
        --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true
-       --benchmark_min_time="$min_time" --benchmark_display_aggregates_only=true
-       --benchmark_out="$raw" --benchmark_out_format=json)
+       --benchmark_min_time="$min_time" --benchmark_out="$raw" --benchmark_out_format=json)
   if [[ $mode == small ]]; then
     # the table is what a person wants here; the per-benchmark log only when something fails
     "${run[@]}" >"$tmp/$s.log" 2>&1 || { cat "$tmp/$s.log"; exit 1; }
