@@ -6,7 +6,7 @@ namespace sewn::bench::cmap {
 
 std::vector<std::uint32_t> hex_sizes(Scale s) {
   switch (s) {
-    case Scale::smoke: return {2};
+    case Scale::smoke: return {3};
     case Scale::small: return {8};
     case Scale::full: return {16, 32};
   }
@@ -15,7 +15,7 @@ std::vector<std::uint32_t> hex_sizes(Scale s) {
 
 std::vector<std::uint32_t> quad_sizes(Scale s) {
   switch (s) {
-    case Scale::smoke: return {4};
+    case Scale::smoke: return {3};
     case Scale::small: return {128};
     case Scale::full: return {512};
   }
