@@ -8,8 +8,9 @@
 //   build        CGAL's Linear_cell_complex_incremental_builder_3 (one vertex attribute per
 //                mesh point, faces added per volume, 2- and 3-sewing found by the builder). It is
 //                CGAL's fastest path we know: make_hexahedron from points + sew3_same_facets()
-//                was about 1.5x slower here and leaves 8 vertex attributes per hexahedron
-//                allocated (7 freed by the merges), and CGAL 5.5 has no sew2_same_edges for 2D.
+//                was slower when we tried it (it matches faces through std::maps keyed by
+//                points) and leaves 8 vertex attributes per hexahedron allocated, 7 of them
+//                freed by the merges; CGAL 5.5 has no sew2_same_edges for 2D.
 //   iterate      one_dart_per_cell<i>(), using each dart's address as ours uses its index.
 //   count_all    count_all_cells().
 //   split edges  insert_barycenter_in_cell<1>, which computes the midpoint and gives the new

@@ -1,6 +1,6 @@
 // The cmap suite, our side: sewn::CMap<D, std::uint32_t> whose 0-attribute is a node index into
 // a separate positions array, the layout physics uses (DESIGN §2). The CGAL side, in
-// cgal_lcc.cpp, registers the same cases; see there for how each operation is matched.
+// cgal_lcc.hpp, registers the same cases; see there for how each operation is matched.
 
 #include <map>
 #include <memory>
