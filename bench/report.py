@@ -53,10 +53,6 @@ def split_name(name, suite):
     return "/".join(parts[1:-1]), parts[-1]
 
 
-def higher_is_better(metric):
-    return "higher is better" in metric
-
-
 def cpu_model():
     try:
         with open("/proc/cpuinfo", encoding="utf-8") as f:
