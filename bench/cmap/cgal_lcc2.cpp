@@ -1,0 +1,14 @@
+// CGAL's side of the quad-grid cases (see cgal_lcc.hpp).
+#include "cgal_lcc.hpp"
+
+namespace sewn::bench::cmap::cgal {
+namespace {
+
+void register_all() {
+  for (std::uint32_t n : quad_sizes(scale())) register_grid<2>(n);
+}
+
+const Registration registration(&register_all);
+
+}  // namespace
+}  // namespace sewn::bench::cmap::cgal
