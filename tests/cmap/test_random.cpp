@@ -173,7 +173,9 @@ TEST_CASE("randomized operation sequences on a 2-map") {
        }},
       {"contract_edge",
        [&] {
-         m.contract_cell<1>(f.random_dart());
+         const Dart d = f.random_dart_where([&](Dart x) { return m.is_contractible<1>(x); });
+         if (!d) return false;
+         m.contract_cell<1>(d);
          return true;
        }},
       {"contract_face",
@@ -276,7 +278,9 @@ TEST_CASE("randomized operation sequences on a 3-map") {
        }},
       {"remove_face",
        [&] {
-         m.remove_cell<2>(f.random_dart());
+         const Dart d = f.random_dart_where([&](Dart x) { return m.is_removable<2>(x); });
+         if (!d) return false;
+         m.remove_cell<2>(d);
          return true;
        }},
       {"remove_volume",
@@ -287,7 +291,9 @@ TEST_CASE("randomized operation sequences on a 3-map") {
        }},
       {"contract_edge",
        [&] {
-         m.contract_cell<1>(f.random_dart());
+         const Dart d = f.random_dart_where([&](Dart x) { return m.is_contractible<1>(x); });
+         if (!d) return false;
+         m.contract_cell<1>(d);
          return true;
        }},
       {"contract_face",

@@ -365,14 +365,16 @@ class CMap {
 
   // ---------------------------------------------------------------- removal, contraction
   /// True if the I-cell of d can be removed: I ≥ D-1, or it is incident to at most two
-  /// (I+1)-cells (β_{I+1}∘β_{I+2} is an involution on its darts). O(cell).
+  /// (I+1)-cells (β_{I+1}∘β_{I+2} is an involution on its darts); and removing it does not fold
+  /// a cell onto itself (a dart would become its own βi partner). O(cell).
   template <int I>
   [[nodiscard]] bool is_removable(Dart d) const;
   /// Removes the I-cell of d, merging the (I+1)-cells around it (on_merge keeps the attribute
   /// of the first cell reached). Erases its darts. Throws TopologyError if not removable. O(cells).
   template <int I>
   void remove_cell(Dart d);
-  /// True if the I-cell of d can be contracted: I = 1, or (I ≥ 2) it has at most two (I-1)-cells.
+  /// True if the I-cell of d can be contracted: I = 1, or (I ≥ 2) it has at most two (I-1)-cells;
+  /// and contracting it does not fold a cell onto itself. O(cell).
   template <int I>
   [[nodiscard]] bool is_contractible(Dart d) const;
   /// Contracts the I-cell of d into an (I-1)-cell (I = 1: the edge's two vertices merge).
@@ -435,6 +437,20 @@ class CMap {
   // Breadth-first collection of an orbit; marks visited darts with m and appends them to out.
   template <class Out>
   void collect(std::uint32_t root, Orbit o, Mark m, Out& out) const;
+  // Continues a breadth-first collection: expands out[head..] (already marked) until closed.
+  template <class Out>
+  void expand(std::size_t head, Orbit o, Mark m, Out& out) const;
+  // As collect() for the I-cell of root, with walks specialised per dimension (β1 chains for
+  // faces and volumes, alternating involutions for edges, forward generators around interior
+  // vertices) that fall back to the generic search where the map is open.
+  template <int I, class Out>
+  void collect_cell(std::uint32_t root, Mark m, Out& out) const;
+  template <class Out>
+  void collect_chain(std::uint32_t x, Mark m, Out& out) const;
+  template <int I>
+  [[nodiscard]] std::uint32_t count_cells() const;
+  template <int I, class Out>
+  void collect_cell_unmarked(std::uint32_t root, Out& out) const;
   template <class Out>
   void collect_unmarked(std::uint32_t root, Orbit o, Out& out) const;
   [[nodiscard]] std::uint32_t count_orbits(Orbit o) const;
@@ -471,6 +487,13 @@ class CMap {
   // `merge_dim`: the dimension of the cells that fuse; a cell of that dimension whose darts are
   // all erased merges into the cell of the relink's w (into_w) or target, with on_merge.
   void apply_relinks_and_erase(const DartList& cell, const std::vector<Relink>& links, int merge_dim, bool into_w);
+  // The links that removing (contracting) the I-cell `c` creates, computed on the current map.
+  // False if the cell lies in more than two neighbours, or if a link would make a dart its own
+  // βi partner (a cell folded onto itself, which has no valid result).
+  template <int I>
+  bool plan_removal(const DartList& c, std::vector<Relink>& links) const;
+  template <int I>
+  bool plan_contraction(const DartList& c, std::vector<Relink>& links) const;
 
   std::vector<std::array<std::uint32_t, D + 1>> beta_;
   std::uint32_t free_head_ = detail::null_index;  // free list threaded through β1 of dead darts

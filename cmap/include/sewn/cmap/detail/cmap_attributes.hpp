@@ -12,7 +12,7 @@ AttrId<I> CMap<D, A...>::set_attribute(Dart d, attribute_type<I> v) {
   auto& st = store<I>();
   const std::uint32_t a = st.values.create(std::move(v));
   std::vector<std::uint32_t> darts;
-  collect_unmarked(d.index(), cell_orbit(I), darts);
+  collect_cell_unmarked<I>(d.index(), darts);
   for (std::uint32_t x : darts) {
     const std::uint32_t old = st.of_dart[x];
     if (old != detail::null_index) {
@@ -39,7 +39,7 @@ std::uint32_t CMap<D, A...>::create_attributes(F&& f) {
   for (std::uint32_t x = 0; x < cap; ++x) {
     if (beta_[x][0] == detail::dead_marker || marks_.test(x, m)) continue;
     darts.clear();
-    collect(x, cell_orbit(I), m, darts);
+    collect_cell<I>(x, m, darts);
     if (st.of_dart[x] != detail::null_index) continue;  // the whole cell shares x's attribute
     const std::uint32_t a = st.values.create(f(Dart(x)));
     for (std::uint32_t y : darts) st.of_dart[y] = a;
@@ -122,7 +122,7 @@ void CMap<D, A...>::update_attributes_of(const std::vector<std::uint32_t>& touch
   for (std::uint32_t c : candidates) {
     if (marks_.test(c, seen)) continue;
     cell_darts.clear();
-    collect(c, cell_orbit(I), seen, cell_darts);
+    collect_cell<I>(c, seen, cell_darts);
     visited.insert(visited.end(), cell_darts.begin(), cell_darts.end());
     process_new_cell<I>(cell_darts, claimed);
   }

@@ -20,7 +20,9 @@ inline CellTemplate CellTemplate::from_faces(std::span<const std::span<const std
   const std::size_t n = t.from.size();
   t.mate.assign(n, null);
   auto edge_name = [&](std::size_t k) {
-    return "(" + std::to_string(t.from[k]) + ", " + std::to_string(t.to[k]) + ")";
+    std::string name("(");  // appended piecewise: GCC 12 -O3 misreports "(" + string as overlapping (-Wrestrict)
+    name.append(std::to_string(t.from[k])).append(", ").append(std::to_string(t.to[k])).append(")");
+    return name;
   };
   if (faces.size() > 1) {
     for (std::size_t k = 0; k < n; ++k) {

@@ -49,10 +49,9 @@ void CMap<D, A...>::apply_relinks_and_erase(const DartList& cell_darts, const st
       touched.push_back(y);
     }
   }
-  // 2) the new links (computed on the old map by the caller). When the fused cell's other side
-  //    is w itself (a folded degenerate cell), w becomes i-free: involutions have no fixed point.
+  // 2) the new links (computed on the old map by the caller)
   for (const Relink& l : links) {
-    raw_link(l.w, l.i, l.i >= 2 && l.target == l.w ? null : l.target);
+    raw_link(l.w, l.i, l.target);
     touched.push_back(l.w);
     if (l.target != null) touched.push_back(l.target);
   }
@@ -68,40 +67,23 @@ void CMap<D, A...>::apply_relinks_and_erase(const DartList& cell_darts, const st
 
 template <int D, class... A>
 template <int I>
-bool CMap<D, A...>::is_removable(Dart d) const {
-  static_assert(I >= 0 && I <= D);
-  if (!is_alive(d)) return false;
-  if constexpr (I >= D - 1) {
-    return true;
-  } else {
+bool CMap<D, A...>::plan_removal(const DartList& c, std::vector<Relink>& links) const {
+  constexpr std::uint32_t null = detail::null_index;
+  links.clear();
+  if constexpr (I < D - 1) {
     // β_{I+1}∘β_{I+2} must be an involution on the cell (at most two (I+1)-cells around it).
-    constexpr std::uint32_t null = detail::null_index;
     auto y_of = [&](std::uint32_t x) {
       const std::uint32_t t = b(x, I + 2);
       return t == null ? null : b(t, I + 1);
     };
-    for (Dart x : cell<I>(d)) {
+    for (Dart x : c) {
       const std::uint32_t y = y_of(x.index());
       if (y != null && y_of(y) != x.index()) return false;
     }
-    return true;
   }
-}
-
-template <int D, class... A>
-template <int I>
-void CMap<D, A...>::remove_cell(Dart d) {
-  static_assert(I >= 0 && I <= D);
-  check_alive(d, "remove_cell");
-  if (!is_removable<I>(d))
-    throw TopologyError("cmap::remove_cell<" + std::to_string(I) + ">: the cell of dart " + std::to_string(d.index()) +
-                        " lies in more than two " + std::to_string(I + 1) + "-cells");
-  constexpr std::uint32_t null = detail::null_index;
-  const DartList c = cell<I>(d);
   const Mark in_cell = marks_.reserve();
   for (Dart x : c) marks_.set(x.index(), in_cell);
   auto inside = [&](std::uint32_t y) { return y != null && marks_.test(y, in_cell); };
-  std::vector<Relink> links;
   const std::size_t guard = c.size() + 1;
   for (Dart xd : c) {
     const std::uint32_t x = xd.index();
@@ -126,21 +108,41 @@ void CMap<D, A...>::remove_cell(Dart d) {
   }
   for (Dart x : c) marks_.clear(x.index(), in_cell);
   marks_.release(in_cell);
+  for (const Relink& l : links)
+    if (l.i >= 2 && l.target == l.w) return false;
+  return true;
+}
+
+template <int D, class... A>
+template <int I>
+bool CMap<D, A...>::is_removable(Dart d) const {
+  static_assert(I >= 0 && I <= D);
+  if (!is_alive(d)) return false;
+  std::vector<Relink> links;
+  return plan_removal<I>(cell<I>(d), links);
+}
+
+template <int D, class... A>
+template <int I>
+void CMap<D, A...>::remove_cell(Dart d) {
+  static_assert(I >= 0 && I <= D);
+  check_alive(d, "remove_cell");
+  const DartList c = cell<I>(d);
+  std::vector<Relink> links;
+  if (!plan_removal<I>(c, links))
+    throw TopologyError("cmap::remove_cell<" + std::to_string(I) + ">: the cell of dart " + std::to_string(d.index()) +
+                        " lies in more than two " + std::to_string(I + 1) +
+                        "-cells, or removing it would fold a cell onto itself (see is_removable)");
   apply_relinks_and_erase(c, links, I + 1, I == 0);
 }
 
 template <int D, class... A>
 template <int I>
-bool CMap<D, A...>::is_contractible(Dart d) const {
-  static_assert(I >= 0 && I <= D);
-  if (!is_alive(d)) return false;
-  if constexpr (I == 0) {
-    return false;
-  } else if constexpr (I == 1) {
-    return true;
-  } else {
+bool CMap<D, A...>::plan_contraction(const DartList& c, std::vector<Relink>& links) const {
+  constexpr std::uint32_t null = detail::null_index;
+  links.clear();
+  if constexpr (I >= 2) {
     // I = 2: β1 an involution (a face of at most two edges); I = 3: β2∘β0; I ≥ 4: β_{I-1}∘β_{I-2}.
-    constexpr std::uint32_t null = detail::null_index;
     auto y_of = [&](std::uint32_t x) -> std::uint32_t {
       if constexpr (I == 2) {
         return b(x, 1);
@@ -149,28 +151,14 @@ bool CMap<D, A...>::is_contractible(Dart d) const {
         return t == null ? null : b(t, I - 1);
       }
     };
-    for (Dart x : cell<I>(d)) {
+    for (Dart x : c) {
       const std::uint32_t y = y_of(x.index());
       if (y != null && y_of(y) != x.index()) return false;
     }
-    return true;
   }
-}
-
-template <int D, class... A>
-template <int I>
-void CMap<D, A...>::contract_cell(Dart d) {
-  static_assert(I >= 1 && I <= D, "only i-cells with i >= 1 can be contracted");
-  check_alive(d, "contract_cell");
-  if (!is_contractible<I>(d))
-    throw TopologyError("cmap::contract_cell<" + std::to_string(I) + ">: the cell of dart " +
-                        std::to_string(d.index()) + " has more than two " + std::to_string(I - 1) + "-cells");
-  constexpr std::uint32_t null = detail::null_index;
-  const DartList c = cell<I>(d);
   const Mark in_cell = marks_.reserve();
   for (Dart x : c) marks_.set(x.index(), in_cell);
   auto inside = [&](std::uint32_t y) { return y != null && marks_.test(y, in_cell); };
-  std::vector<Relink> links;
   const std::size_t guard = c.size() + 1;
   for (Dart xd : c) {
     const std::uint32_t x = xd.index();
@@ -191,6 +179,35 @@ void CMap<D, A...>::contract_cell(Dart d) {
   }
   for (Dart x : c) marks_.clear(x.index(), in_cell);
   marks_.release(in_cell);
+  for (const Relink& l : links)
+    if (l.i >= 2 && l.target == l.w) return false;
+  return true;
+}
+
+template <int D, class... A>
+template <int I>
+bool CMap<D, A...>::is_contractible(Dart d) const {
+  static_assert(I >= 0 && I <= D);
+  if (!is_alive(d)) return false;
+  if constexpr (I == 0) {
+    return false;
+  } else {
+    std::vector<Relink> links;
+    return plan_contraction<I>(cell<I>(d), links);
+  }
+}
+
+template <int D, class... A>
+template <int I>
+void CMap<D, A...>::contract_cell(Dart d) {
+  static_assert(I >= 1 && I <= D, "only i-cells with i >= 1 can be contracted");
+  check_alive(d, "contract_cell");
+  const DartList c = cell<I>(d);
+  std::vector<Relink> links;
+  if (!plan_contraction<I>(c, links))
+    throw TopologyError("cmap::contract_cell<" + std::to_string(I) + ">: the cell of dart " + std::to_string(d.index()) +
+                        " has more than two " + std::to_string(I - 1) +
+                        "-cells, or contracting it would fold a cell onto itself (see is_contractible)");
   apply_relinks_and_erase(c, links, I - 1, false);
 }
 

@@ -41,16 +41,104 @@ void CMap<D, A...>::for_each_neighbor(std::uint32_t x, Orbit o, F&& f) const {
 
 template <int D, class... A>
 template <class Out>
-void CMap<D, A...>::collect(std::uint32_t root, Orbit o, Mark m, Out& out) const {
+void CMap<D, A...>::expand(std::size_t head, Orbit o, Mark m, Out& out) const {
   // `out` doubles as the BFS queue: darts are appended once, when first marked.
-  std::size_t head = out.size();
-  if (!marks_.set(root, m)) return;
-  out.push_back(typename Out::value_type(root));
   while (head < out.size()) {
     const std::uint32_t x = detail::raw(out[head++]);
     for_each_neighbor(x, o, [&](std::uint32_t y) {
       if (marks_.set(y, m)) out.push_back(typename Out::value_type(y));
     });
+  }
+}
+
+template <int D, class... A>
+template <class Out>
+void CMap<D, A...>::collect(std::uint32_t root, Orbit o, Mark m, Out& out) const {
+  const std::size_t head = out.size();
+  if (!marks_.set(root, m)) return;
+  out.push_back(typename Out::value_type(root));
+  expand(head, o, m, out);
+}
+
+template <int D, class... A>
+template <class Out>
+void CMap<D, A...>::collect_chain(std::uint32_t x, Mark m, Out& out) const {
+  // x's β1 cycle, or both directions of its β1 path when the face is open
+  if (!marks_.set(x, m)) return;
+  out.push_back(typename Out::value_type(x));
+  std::uint32_t y = b(x, 1);
+  for (; y != detail::null_index && marks_.set(y, m); y = b(y, 1)) out.push_back(typename Out::value_type(y));
+  if (y != detail::null_index) return;  // closed (back at a marked dart)
+  for (y = b(x, 0); y != detail::null_index && marks_.set(y, m); y = b(y, 0)) out.push_back(typename Out::value_type(y));
+}
+
+template <int D, class... A>
+template <int I, class Out>
+void CMap<D, A...>::collect_cell(std::uint32_t root, Mark m, Out& out) const {
+  constexpr std::uint32_t null = detail::null_index;
+  const std::size_t first = out.size();
+  if constexpr (I == 1 && D <= 3) {
+    // ⟨β2, β3⟩: an alternating path or cycle through the edge
+    if (!marks_.set(root, m)) return;
+    out.push_back(typename Out::value_type(root));
+    if constexpr (D >= 2) {
+      int j = 2;
+      std::uint32_t x = root;
+      bool closed = false;
+      for (std::uint32_t y = b(x, j); y != null; y = b(x, j)) {
+        if (!marks_.set(y, m)) {
+          closed = true;
+          break;
+        }
+        out.push_back(typename Out::value_type(y));
+        x = y;
+        if constexpr (D == 3) j = 5 - j;
+      }
+      if constexpr (D == 3)
+        if (!closed)
+          for (std::uint32_t y = b(root, 3), jj = 2; y != null && marks_.set(y, m); y = b(y, static_cast<int>(jj)), jj = 5 - jj)
+            out.push_back(typename Out::value_type(y));
+    }
+  } else if constexpr (I == D && D <= 3) {
+    // D-cell: β1 chains joined by β_j, j < D
+    collect_chain(root, m, out);
+    for (std::size_t h = first; h < out.size(); ++h)
+      for (int j = 2; j < D; ++j)
+        if (const std::uint32_t y = b(detail::raw(out[h]), j); y != null && !marks_.test(y, m)) collect_chain(y, m, out);
+  } else if constexpr (I == 2 && D == 3) {
+    // a face: its β1 chain and the chain of its β3 partner
+    collect_chain(root, m, out);
+    for (std::size_t h = first; h < out.size(); ++h)
+      if (const std::uint32_t y = b(detail::raw(out[h]), 3); y != null && !marks_.test(y, m)) collect_chain(y, m, out);
+  } else if constexpr (I == 0 && D == 2) {
+    // ⟨β1∘β2⟩: around the vertex forward, then backward by β2∘β0 if the vertex is open
+    if (!marks_.set(root, m)) return;
+    out.push_back(typename Out::value_type(root));
+    auto fwd = [&](std::uint32_t x) { const std::uint32_t t = b(x, 2); return t == null ? null : b(t, 1); };
+    auto bwd = [&](std::uint32_t x) { const std::uint32_t t = b(x, 0); return t == null ? null : b(t, 2); };
+    std::uint32_t y = fwd(root);
+    for (; y != null && marks_.set(y, m); y = fwd(y)) out.push_back(typename Out::value_type(y));
+    if (y == null)
+      for (y = bwd(root); y != null && marks_.set(y, m); y = bwd(y)) out.push_back(typename Out::value_type(y));
+  } else if constexpr (I == 0 && D == 3) {
+    // Around an interior vertex every dart has β1∘β2 and β1∘β3 defined; the darts reached by
+    // these two forward maps then form the whole orbit (an injective self-map of a finite set
+    // is onto, so the inverses stay inside too). Anything undefined: the generic search.
+    if (!marks_.set(root, m)) return;
+    out.push_back(typename Out::value_type(root));
+    for (std::size_t h = first; h < out.size(); ++h) {
+      const std::uint32_t x = detail::raw(out[h]);
+      const std::uint32_t a = b(x, 2), c = b(x, 3);
+      const std::uint32_t y = a == null ? null : b(a, 1), z = c == null ? null : b(c, 1);
+      if (y == null || z == null) {
+        expand(first, cell_orbit(0), m, out);
+        return;
+      }
+      if (marks_.set(y, m)) out.push_back(typename Out::value_type(y));
+      if (marks_.set(z, m)) out.push_back(typename Out::value_type(z));
+    }
+  } else {
+    collect(root, cell_orbit(I), m, out);
   }
 }
 
@@ -73,6 +161,16 @@ void CMap<D, A...>::collect_unmarked(std::uint32_t root, Orbit o, Out& out) cons
 }
 
 template <int D, class... A>
+template <int I, class Out>
+void CMap<D, A...>::collect_cell_unmarked(std::uint32_t root, Out& out) const {
+  const std::size_t first = out.size();
+  const Mark m = marks_.reserve();
+  collect_cell<I>(root, m, out);
+  for (std::size_t i = first; i < out.size(); ++i) marks_.clear(detail::raw(out[i]), m);
+  marks_.release(m);
+}
+
+template <int D, class... A>
 template <int... B>
 DartList CMap<D, A...>::orbit(Dart d) const {
   static_assert(((B >= 0 && B <= D) && ...), "beta index outside [0, D]");
@@ -90,7 +188,7 @@ DartList CMap<D, A...>::cell(Dart d) const {
   static_assert(I >= 0 && I <= D);
   check_alive(d, "cell");
   DartList out;
-  collect_unmarked(d.index(), cell_orbit(I), out);
+  collect_cell_unmarked<I>(d.index(), out);
   return out;
 }
 
@@ -155,7 +253,7 @@ auto CMap<D, A...>::cells() const {
       while (x < n && (map_->beta_[x][0] == detail::dead_marker || map_->marks_.test(x, mark_))) ++x;
       if (x < n) {
         queue_.clear();
-        map_->collect(x, cell_orbit(I), mark_, queue_);
+        map_->template collect_cell<I>(x, mark_, queue_);
       }
       return x;
     }
@@ -178,7 +276,7 @@ DartList CMap<D, A...>::incident(Dart d) const {
   for (Dart x : darts_of_cell) {
     if (marks_.test(x.index(), seen)) continue;
     out.push_back(x);
-    collect(x.index(), cell_orbit(J), seen, marked);
+    collect_cell<J>(x.index(), seen, marked);
   }
   for (std::uint32_t x : marked) marks_.clear(x, seen);
   marks_.release(seen);
@@ -194,12 +292,12 @@ DartList CMap<D, A...>::adjacent(Dart d) const {
   DartList out;
   std::vector<std::uint32_t> marked;
   const Mark seen = marks_.reserve();
-  collect(d.index(), cell_orbit(I), seen, marked);  // the cell itself is excluded
+  collect_cell<I>(d.index(), seen, marked);  // the cell itself is excluded
   const std::size_t own = marked.size();
   auto consider = [&](std::uint32_t y) {
     if (y == null || marks_.test(y, seen)) return;
     out.push_back(Dart(y));
-    collect(y, cell_orbit(I), seen, marked);
+    collect_cell<I>(y, seen, marked);
   };
   for (std::size_t k = 0; k < own; ++k) {
     const std::uint32_t x = marked[k];
@@ -235,15 +333,32 @@ std::uint32_t CMap<D, A...>::count_orbits(Orbit o) const {
 
 template <int D, class... A>
 template <int I>
+std::uint32_t CMap<D, A...>::count_cells() const {
+  const Mark m = marks_.reserve();
+  std::vector<std::uint32_t> queue;
+  std::uint32_t n = 0;
+  const auto cap = static_cast<std::uint32_t>(beta_.size());
+  for (std::uint32_t x = 0; x < cap; ++x) {
+    if (beta_[x][0] == detail::dead_marker || marks_.test(x, m)) continue;
+    ++n;
+    queue.clear();
+    collect_cell<I>(x, m, queue);
+  }
+  free_mark(m);
+  return n;
+}
+
+template <int D, class... A>
+template <int I>
 std::uint32_t CMap<D, A...>::count() const {
   static_assert(I >= 0 && I <= D);
-  return count_orbits(cell_orbit(I));
+  return count_cells<I>();
 }
 
 template <int D, class... A>
 std::array<std::uint32_t, D + 1> CMap<D, A...>::count_all() const {
   std::array<std::uint32_t, D + 1> n{};
-  for (int i = 0; i <= D; ++i) n[static_cast<std::size_t>(i)] = count_orbits(cell_orbit(i));
+  for_each_dim([&](auto k) { n[k()] = count_cells<k()>(); });
   return n;
 }
 
@@ -270,7 +385,7 @@ std::vector<Dart> CMap<D, A...>::boundary_facets() const {
     if (beta_[x][0] == detail::dead_marker || marks_.test(x, m) || b(x, D) != detail::null_index) continue;
     out.push_back(Dart(x));
     queue.clear();
-    collect(x, cell_orbit(D - 1), m, queue);
+    collect_cell<D - 1>(x, m, queue);
   }
   free_mark(m);
   return out;

@@ -124,7 +124,7 @@ ValidationReport CMap<D, A...>::validate() const {
           continue;
         }
         queue.clear();
-        collect(rep, cell_orbit(I), m, queue);
+        collect_cell<I>(rep, m, queue);
         if (queue.size() != counted[a])
           r.add(K::attribute_two_cells, rep, I,
                 dim + " " + s(a) + " is carried by " + std::to_string(counted[a]) + " darts but the cell of dart " +
