@@ -121,6 +121,32 @@ double min_scaled_jacobian(const IndexedMesh& mesh, std::uint32_t cell) {
   return v.empty() ? 0.0 : *std::min_element(v.begin(), v.end());
 }
 
+double cell_measure(const IndexedMesh& mesh, std::uint32_t cell) {
+  const auto v = mesh.cell(cell);
+  const auto& P = mesh.points;
+  switch (cell_dimension(mesh.types[cell])) {
+    case 1: return norm(sub(P[v[1]], P[v[0]]));
+    case 2: {
+      V3 n{0, 0, 0};
+      for (std::size_t k = 1; k + 1 < v.size(); ++k) {
+        const V3 c = cross(sub(P[v[k]], P[v[0]]), sub(P[v[k + 1]], P[v[0]]));
+        for (std::size_t i = 0; i < 3; ++i) n[i] += c[i];
+      }
+      return 0.5 * norm(n);
+    }
+    default: {
+      // divergence theorem relative to vertex 0: sum of the tetrahedra (p0, face fan triangle)
+      double vol = 0;
+      for (auto f : cell_faces(mesh.types[cell])) {
+        const Point3& a = P[v[f[0]]];
+        for (std::size_t k = 1; k + 1 < f.size(); ++k)
+          vol += dot(cross(sub(P[v[f[k]]], a), sub(P[v[f[k + 1]]], a)), sub(a, P[v[0]]));
+      }
+      return vol / 6.0;
+    }
+  }
+}
+
 std::vector<GeometryIssue> find_geometry_issues(const IndexedMesh& mesh, const std::string& source,
                                                 const GeometryOptions& opt) {
   mesh.check_indices(source);

@@ -74,6 +74,10 @@ struct GeometryIssue {
 /// corner area of a 2D cell; 0 for a corner with a zero-length edge. Requires valid indices.
 double min_scaled_jacobian(const IndexedMesh& mesh, std::uint32_t cell);
 
+/// Signed measure of a cell: volume for 3D cells (from their outward faces, so negative when
+/// inverted; faces are fanned from their first vertex), area for 2D cells, length for segments.
+double cell_measure(const IndexedMesh& mesh, std::uint32_t cell);
+
 /// Every geometric problem (up to max_issues), in cell order after the non-finite points.
 /// Throws MeshError if an index is out of range (mesh.check_indices).
 std::vector<GeometryIssue> find_geometry_issues(const IndexedMesh& mesh, const std::string& source = "mesh",
