@@ -166,3 +166,38 @@ TEST_CASE("indices out of range are a MeshError before any geometry is looked at
   m.conn[3] = 9;
   CHECK_THROWS_AS(check_mesh_geometry(m, "bad"), MeshError);
 }
+
+#include "sewn/io/cleanup.hpp"
+#include "sewn/io/read.hpp"
+
+TEST_CASE("drop_embedded_cells removes boundary copies, keeps cells that are not faces or edges") {
+  IndexedMesh m = hex_grid(2, 1, 1);
+  m.add_cell(CellType::quad, {0, 1, 4, 3}, 7);     // a face of hexahedron 0 (bottom)
+  m.add_cell(CellType::quad, {0, 1, 10, 9}, 8);    // a diagonal plane of hexahedron 0: not a face
+  m.add_cell(CellType::segment, {0, 1}, 9);        // an edge of hexahedron 0
+  m.add_cell(CellType::segment, {0, 4}, 9);        // a face diagonal: not an edge
+  m.add_cell(CellType::triangle, {0, 1, 10}, 5);   // cuts through hexahedron 0: not a face
+  CHECK(drop_embedded_cells(m) == 2);
+  REQUIRE(m.num_cells() == 5);
+  CHECK(m.types == std::vector<CellType>{CellType::hexahedron, CellType::hexahedron, CellType::quad,
+                                         CellType::segment, CellType::triangle});
+  CHECK(m.tags == std::vector<std::int32_t>{0, 0, 8, 9, 5});
+  CHECK_NOTHROW(m.check_indices());
+  // segments on the edge of a 2D cell go too
+  IndexedMesh s = tri_grid(1, 1);
+  s.add_cell(CellType::segment, {0, 1});
+  CHECK(drop_embedded_cells(s) == 1);
+  CHECK(s.num_cells() == 2);
+}
+
+TEST_CASE("drop_unused_points renumbers the cells") {
+  MeshFile f = read_gmsh(test::data("mixed41.msh"));  // node tags 140 and 150 belong to no element
+  const IndexedMesh before = f.mesh;
+  const auto map = drop_unused_points(f.mesh);
+  CHECK(f.mesh.num_points() == 13);
+  CHECK(map[13] == 0xffffffffu);
+  CHECK(map[14] == 0xffffffffu);
+  for (std::uint32_t c = 0; c < before.num_cells(); ++c)
+    for (std::size_t k = 0; k < before.cell(c).size(); ++k)
+      CHECK(f.mesh.points[f.mesh.cell(c)[k]] == before.points[before.cell(c)[k]]);
+}

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "io_test_util.hpp"
+#include "sewn/io/cleanup.hpp"
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/read.hpp"
 
@@ -145,6 +146,10 @@ TEST_CASE("unstructured tetrahedra: formats agree with each other and with gmsh'
     CHECK_NOTHROW(check_mesh_geometry(f->mesh, "box_tet"));
   }
   CHECK(count(m22.mesh, CellType::tetrahedron) > 100);
+  // every triangle Gmsh saved is a boundary face of a tetrahedron, every line an edge
+  IndexedMesh solid = m41.mesh;
+  CHECK(drop_embedded_cells(solid) == count(m41.mesh, CellType::triangle) + count(m41.mesh, CellType::segment));
+  CHECK(solid.num_cells() == count(m41.mesh, CellType::tetrahedron));
   CHECK(canonical(m22.mesh) == canonical(m41.mesh));
   const auto vtk = load("box_tet", "vtk");
   CHECK(vtk.file_elements == elements);
