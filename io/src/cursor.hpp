@@ -29,9 +29,6 @@ class Cursor {
   [[nodiscard]] const std::string& source() const { return source_; }
   /// Line of the last token returned (1-based).
   [[nodiscard]] std::size_t line() const { return token_line_; }
-  /// Line the cursor is on now (where the next token would start its search).
-  [[nodiscard]] std::size_t current_line() const { return line_; }
-  [[nodiscard]] std::size_t offset() const { return pos_; }
   [[nodiscard]] std::size_t remaining() const { return text_.size() - pos_; }
 
   /// True when only whitespace (and comments) is left.

@@ -68,6 +68,16 @@ TEST_CASE("gmsh: unknown sections are skipped; without physical groups the tag i
   CHECK(f.mesh.tags[0] == 0);
 }
 
+TEST_CASE("gmsh 4.1: parametric node blocks carry extra coordinates, which are skipped") {
+  const std::string text = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n"
+                           "$Nodes\n2 3 1 3\n1 4 1 2\n1\n2\n0 0 0 0.0\n1 0 0 1.0\n2 1 1 1\n3\n0 1 0 0.5 0.5\n$EndNodes\n"
+                           "$Elements\n1 1 1 1\n2 1 2 1\n1 1 2 3\n$EndElements\n";
+  const MeshFile f = parse(text);
+  REQUIRE(f.mesh.num_points() == 3);
+  CHECK(f.mesh.points[2] == Point3{0, 1, 0});
+  CHECK(f.mesh.types[0] == CellType::triangle);
+}
+
 TEST_CASE("gmsh bad input: each problem throws its own exception naming file and line") {
   SUBCASE("empty file") {
     const auto m = message_of<ParseError>([] { parse(""); });

@@ -36,6 +36,7 @@ struct CellsView {
   std::span<const std::uint32_t> conn;
   /// The cells of an IndexedMesh (which must outlive the view).
   static CellsView of(const IndexedMesh& m) { return {m.types, m.offsets, m.conn}; }
+  /// Number of cells.
   [[nodiscard]] std::size_t size() const { return types.size(); }
 };
 
@@ -52,9 +53,13 @@ struct DataArray {
   Values values;
   int components = 1;
 
+  /// One double per point or cell (written as Float64).
   static DataArray scalars(std::string n, std::span<const double> v) { return {std::move(n), v, 1}; }
+  /// One 3-vector per point or cell (Float64, 3 components): velocity, force, displacement.
   static DataArray vectors(std::string n, std::span<const Point3> v) { return {std::move(n), v, 3}; }
+  /// One 32-bit integer per point or cell (Int32): material id, refinement level, cell type.
   static DataArray ints(std::string n, std::span<const std::int32_t> v) { return {std::move(n), v, 1}; }
+  /// One byte per point or cell (UInt8): fixed flags, masks.
   static DataArray flags(std::string n, std::span<const std::uint8_t> v) { return {std::move(n), v, 1}; }
   /// Number of tuples (values / components).
   [[nodiscard]] std::size_t tuples() const;
@@ -87,7 +92,9 @@ class PvdWriter {
   explicit PvdWriter(std::filesystem::path path);
   /// Records `vtu` (stored relative to the .pvd's folder) at time `time`. Throws FileError.
   void add(double time, const std::filesystem::path& vtu);
+  /// The .pvd file.
   [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+  /// Frames recorded so far.
   [[nodiscard]] std::size_t size() const { return entries_.size(); }
 
  private:
@@ -104,7 +111,9 @@ class CsvWriter {
   CsvWriter(const std::filesystem::path& path, std::vector<std::string> columns);
   /// Appends a row; std::invalid_argument unless it has one value per column; FileError on I/O.
   void row(std::span<const double> values);
+  /// row() for a braced list of values.
   void row(std::initializer_list<double> values) { row(std::span<const double>(values.begin(), values.size())); }
+  /// Number of columns (values each row must have).
   [[nodiscard]] std::size_t columns() const { return columns_.size(); }
 
  private:
