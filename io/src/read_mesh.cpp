@@ -1,0 +1,70 @@
+#include <algorithm>
+#include <cctype>
+
+#include "cursor.hpp"
+#include "sewn/io/read.hpp"
+
+namespace sewn::io {
+
+const char* to_string(MeshFormat f) {
+  switch (f) {
+    case MeshFormat::gmsh: return "Gmsh MSH";
+    case MeshFormat::medit: return "MEDIT";
+    case MeshFormat::vtk_legacy: return "legacy VTK";
+  }
+  return "?";
+}
+
+namespace {
+
+std::string lower(std::string_view s) {
+  std::string r(s);
+  std::transform(r.begin(), r.end(), r.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return r;
+}
+
+// The first word of the file, skipping blank space and MEDIT '#' comment lines.
+std::string first_word(std::string_view bytes) {
+  std::size_t p = 0;
+  while (p < bytes.size()) {
+    const char c = bytes[p];
+    if (c == '#') {
+      // "# vtk DataFile" is a header, not a comment
+      if (lower(bytes.substr(p, 6)) == "# vtk ") return "# vtk";
+      while (p < bytes.size() && bytes[p] != '\n') ++p;
+    } else if (std::isspace(static_cast<unsigned char>(c)) != 0) {
+      ++p;
+    } else {
+      break;
+    }
+  }
+  std::size_t e = p;
+  while (e < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[e])) == 0) ++e;
+  return lower(bytes.substr(p, std::min<std::size_t>(e - p, 64)));
+}
+
+}  // namespace
+
+MeshFile read_mesh_file(const std::filesystem::path& path, const ReadOptions& opt) {
+  const std::string bytes = detail::slurp(path);
+  const std::string name = path.string();
+  if (bytes.find_first_not_of(" \t\r\n") == std::string::npos) throw ParseError(name, 1, "a mesh", "");
+  const std::string w = first_word(bytes);
+  if (w == "$meshformat" || w == "$nod") return parse_gmsh(bytes, name);
+  if (w == "# vtk") return parse_vtk(bytes, name, opt);
+  if (w == "meshversionformatted") return parse_medit(bytes, name);
+  const std::string ext = lower(path.extension().string());
+  if (ext == ".msh") return parse_gmsh(bytes, name);
+  if (ext == ".vtk") return parse_vtk(bytes, name, opt);
+  if (ext == ".mesh") return parse_medit(bytes, name);
+  if (ext == ".meshb") throw UnsupportedError(name, 0, "binary MEDIT (.meshb) files are not supported");
+  throw UnsupportedError(name, 0,
+                         "not a recognised mesh file: expected a Gmsh .msh, MEDIT .mesh or legacy VTK .vtk file, found '" +
+                             detail::printable(w) + "' at its start");
+}
+
+IndexedMesh read_mesh(const std::filesystem::path& path, const ReadOptions& opt) {
+  return read_mesh_file(path, opt).mesh;
+}
+
+}  // namespace sewn::io
