@@ -8,9 +8,17 @@ namespace sewn::physics {
 
 namespace {
 
+// Eight independent partial sums: a single running sum is bound by the add latency, and
+// the compiler may not reorder it itself (no -ffast-math). Fixed order: deterministic.
 double dot(std::span<const double> a, std::span<const double> b) {
-  double s = 0;
-  for (std::size_t k = 0; k < a.size(); ++k) s += a[k] * b[k];
+  double part[8] = {};
+  const std::size_t n = a.size(), n8 = n - n % 8;
+  const double* __restrict x = a.data();
+  const double* __restrict y = b.data();
+  for (std::size_t k = 0; k < n8; k += 8)
+    for (std::size_t q = 0; q < 8; ++q) part[q] += x[k + q] * y[k + q];
+  double s = ((part[0] + part[1]) + (part[2] + part[3])) + ((part[4] + part[5]) + (part[6] + part[7]));
+  for (std::size_t k = n8; k < n; ++k) s += x[k] * y[k];
   return s;
 }
 

@@ -104,3 +104,30 @@ TEST_CASE("block pattern: symmetric pairs, merged duplicates, diagonal always pr
   m.build_pattern(3, std::vector<NodePair>{{0, 1}});
   CHECK(m.pattern_version() > version);
 }
+
+TEST_CASE("gravity and mass damping: per-node forces, energy and Jacobian") {
+  System sys;
+  for (int i = 0; i < 7; ++i)  // 7: the four-node vector blocks plus a tail
+    sys.nodes().add({0.1 * i, -0.2 * i, 0.3}, {1.0 + i, -2.0, 0.5 * i}, 1.0 + 0.25 * i);
+  const Vector3d g(0.5, -1.0, -9.81);
+  sys.add<Gravity>(g);
+  sys.add<MassDamping>(0.7);
+  sys.compute_forces();
+  for (Index i = 0; i < 7; ++i) {
+    const double m = sys.nodes().mass(i);
+    const Vector3d expect = m * g - 0.7 * m * sys.nodes().velocity(i);
+    CHECK((sys.nodes().force(i) - expect).norm() <= 1e-15 * expect.norm());
+  }
+  double v = 0;
+  for (Index i = 0; i < 7; ++i) v -= sys.nodes().mass(i) * g.dot(sys.nodes().position(i));
+  CHECK(sys.potential_energy() == doctest::Approx(v).epsilon(1e-15));
+  CHECK(sys.potential_energy(EnergyKind::external) == doctest::Approx(v).epsilon(1e-15));
+  CHECK(sys.potential_energy(EnergyKind::internal) == 0.0);
+  sys.refresh();
+  sys.matrix().set_zero();
+  JacobianRequest r;
+  r.matrix = &sys.matrix();
+  r.cv = 2.0;
+  sys.add_jacobians(r);
+  CHECK(sys.matrix().block(sys.matrix().diagonal(3)).isApprox(-2.0 * 0.7 * sys.nodes().mass(3) * Eigen::Matrix3d::Identity()));
+}
