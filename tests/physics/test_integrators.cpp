@@ -273,6 +273,24 @@ TEST_CASE("fixed axes stay exactly fixed under implicit and semi-implicit steps"
   check_fixed();
 }
 
+TEST_CASE("a fixed axis with a prescribed velocity is kinematic in both integrators") {
+  System sys;
+  const BoxLattice L = cube_lattice(sys, 2, 0.1, 1e5, 0.3, 1000, SpringDamping::viscous);
+  const Index driver = L.node(2, 2, 2);
+  sys.nodes().fix(driver);
+  sys.nodes().set_velocity(driver, {0.0, 0.0, 0.2});
+  const Vector3d p0 = sys.nodes().position(driver);
+  SymplecticEuler se;
+  LinearlyImplicitEuler ie;
+  const double h_se = 0.5 * sys.stable_step().h_max, h_ie = 1e-3;
+  for (int n = 0; n < 40; ++n) (void)se.step(sys, h_se);
+  for (int n = 0; n < 40; ++n) (void)ie.step(sys, h_ie);
+  CHECK(sys.nodes().velocity(driver) == Vector3d(0.0, 0.0, 0.2));
+  CHECK(sys.nodes().position(driver).z() == Approx(p0.z() + 0.2 * 40 * (h_se + h_ie)).epsilon(1e-12));
+  CHECK(sys.nodes().position(driver).x() == p0.x());
+  CHECK(sys.nodes().velocity(L.node(1, 1, 1)).norm() > 0);  // it drags the others
+}
+
 TEST_CASE("mass damping: exact discrete decay in both integrators (Rayleigh α term, correct sign)") {
   const double alpha = 3.0, h = 0.01;
   for (int scheme = 0; scheme < 2; ++scheme) {
