@@ -431,7 +431,22 @@ void Springs::add_forces(const StateView& st, std::span<double> f) const {
   }
   const double* __restrict a = acc_.data();
   double* __restrict out = f.data();
-  for (std::size_t p = 0; p < n; ++p) {
+  std::size_t p = 0;
+#ifdef SEWN_SPRINGS_AVX512
+  // Four nodes: 16 padded accumulator values -> 12 consecutive forces, by two permutes.
+  const __m512i first8 = _mm512_setr_epi64(0, 1, 2, 4, 5, 6, 8, 9);
+  const __m512i last4 = _mm512_setr_epi64(10, 12, 13, 14, 10, 12, 13, 14);  // upper half unused
+  for (; p + 4 <= n; p += 4) {
+    const __m512d lo = _mm512_load_pd(a + 4 * p), hi = _mm512_load_pd(a + 4 * p + 8);
+    double* o = out + 3 * p;
+    _mm512_storeu_pd(o, _mm512_add_pd(_mm512_loadu_pd(o), _mm512_permutex2var_pd(lo, first8, hi)));
+    // Through memory rather than a 512->256 cast, which GCC 12 flags as uninitialised.
+    alignas(64) double tail[8];
+    _mm512_store_pd(tail, _mm512_permutex2var_pd(lo, last4, hi));
+    _mm256_storeu_pd(o + 8, _mm256_add_pd(_mm256_loadu_pd(o + 8), _mm256_load_pd(tail)));
+  }
+#endif
+  for (; p < n; ++p) {
     out[3 * p] += a[4 * p];
     out[3 * p + 1] += a[4 * p + 1];
     out[3 * p + 2] += a[4 * p + 2];
