@@ -1,0 +1,59 @@
+#pragma once
+// Exceptions of sewn::physics. Every message names what is wrong and where (function, node,
+// spring, value).
+
+#include <stdexcept>
+#include <string>
+
+#include "sewn/physics/types.hpp"
+
+namespace sewn::physics {
+
+/// Bad input: negative or NaN mass, index out of range, ν ∉ (-1, 0.5), E ≤ 0, h ≤ 0, ...
+/// Thrown before anything is changed.
+class InputError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+/// A semi-implicit step larger than the stable-step bound was asked for. The state is unchanged.
+class StabilityError : public std::runtime_error {
+ public:
+  StabilityError(const std::string& what, double h, double bound)
+      : std::runtime_error(what), h_(h), bound_(bound) {}
+  [[nodiscard]] double step() const { return h_; }
+  [[nodiscard]] double bound() const { return bound_; }
+
+ private:
+  double h_, bound_;
+};
+
+/// The state became non-finite or the energy grew beyond its budget. `node()` names the node
+/// (invalid_index if none applies), `quantity()` the offending quantity ("position", ...).
+class BlowupError : public std::runtime_error {
+ public:
+  BlowupError(const std::string& what, Index node, std::string quantity)
+      : std::runtime_error(what), node_(node), quantity_(std::move(quantity)) {}
+  [[nodiscard]] Index node() const { return node_; }
+  [[nodiscard]] const std::string& quantity() const { return quantity_; }
+
+ private:
+  Index node_;
+  std::string quantity_;
+};
+
+/// A linear solve did not reach its tolerance (or broke down on a matrix that is not positive
+/// definite). The state is unchanged.
+class SolverError : public std::runtime_error {
+ public:
+  SolverError(const std::string& what, int iterations, double residual)
+      : std::runtime_error(what), iterations_(iterations), residual_(residual) {}
+  [[nodiscard]] int iterations() const { return iterations_; }
+  [[nodiscard]] double residual() const { return residual_; }
+
+ private:
+  int iterations_;
+  double residual_;
+};
+
+}  // namespace sewn::physics

@@ -1,0 +1,132 @@
+#pragma once
+// ForceTerm: the interface every force model implements (springs now; rods, shells, StVK
+// tets, connections, contacts later), so that all of them share one node table, one
+// sparsity pattern and one set of integrators. A term is a compact array of elements that
+// refer to node indices; it
+//   - adds its forces (its own damping included) at a given state,
+//   - reports its potential energy,
+//   - names the node pairs it couples (the sparsity pattern) and, once the pattern is built,
+//     caches where its blocks live,
+//   - adds a·∂F/∂x + b·∂F/∂v into that pattern, and optionally (∂F/∂x)·p,
+//   - adds Gershgorin row sums of its stiffness and damping for the stable-step bound.
+// A term that a scene does not instantiate costs nothing. Terms are not thread-safe: forces
+// may use scratch buffers owned by the term.
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "sewn/physics/block_matrix.hpp"
+#include "sewn/physics/types.hpp"
+
+namespace sewn::physics {
+
+class NodeTable;
+
+/// How the Jacobian put into the solver matrix may differ from the exact one (PHYSICS_NOTES
+/// §1.4). Forces are always exact.
+struct JacobianOptions {
+  /// Leave out position derivatives of velocity-dependent forces (for springs: ∂F^v/∂P, which
+  /// is non-symmetric). Required by CG when a term uses per-spring viscosity.
+  bool drop_viscous_position_terms = true;
+  /// Replace (1 - l/d) by max(0, 1 - l/d) so that -∂F/∂x stays positive semidefinite.
+  bool clamp_compression = true;
+};
+
+/// One assembly pass: matrix += cx·∂F/∂x + cv·∂F/∂v (if matrix is set) and
+/// product_out += (∂F/∂x)·product_in (if product_in is not empty), both with the same,
+/// possibly simplified, ∂F/∂x.
+struct JacobianRequest {
+  BlockMatrix* matrix = nullptr;
+  double cx = 0.0;
+  double cv = 0.0;
+  std::span<const double> product_in;
+  std::span<double> product_out;
+  JacobianOptions options;
+};
+
+/// Accumulates Gershgorin row sums of M^{-1/2} K M^{-1/2} and M^{-1/2} C M^{-1/2}, where K and
+/// C are the positive-semidefinite stiffness and damping matrices (K = -∂F/∂x with compression
+/// clamped, C = -∂F/∂v). Rows and columns of fixed axes are left out: the bound is for the
+/// free system. Terms call add_diagonal / add_offdiagonal with their 3×3 blocks.
+class StabilityRows {
+ public:
+  enum Which { stiffness = 0, damping = 1 };
+  struct Bound {
+    double value = 0.0;          ///< upper bound on λmax(M^{-1}K) (or M^{-1}C), 1/s² (or 1/s)
+    Index node = invalid_index;  ///< node whose row gives the bound
+  };
+  StabilityRows(std::span<const double> mass, std::span<const AxisMask> fixed);
+  /// Block (i,i) of K or C receives +B.
+  void add_diagonal(Which w, Index i, const Eigen::Matrix3d& B);
+  /// Blocks (i,j) = B and (j,i) = Bᵀ (sign irrelevant: absolute values are summed).
+  void add_offdiagonal(Which w, Index i, Index j, const Eigen::Matrix3d& B);
+  /// max over free axes of the scalar Gershgorin row sum. O(n).
+  [[nodiscard]] Bound bound(Which w) const;
+
+ private:
+  std::span<const double> mass_;
+  std::span<const AxisMask> fixed_;
+  std::vector<double> diag_[2];  // 9 per node, column-major
+  std::vector<double> off_[2];   // 3 per node, already scaled by 1/sqrt(mi mj)
+};
+
+/// Whether a term's potential is internal (elastic) or due to an external field (gravity):
+/// the energy watchdog counts work done by external fields as an energy income.
+enum class EnergyKind { internal, external };
+
+class ForceTerm {
+ public:
+  ForceTerm() = default;
+  ForceTerm(const ForceTerm&) = default;
+  ForceTerm& operator=(const ForceTerm&) = default;
+  virtual ~ForceTerm() = default;
+
+  /// Short name used in error messages ("springs", "gravity", ...).
+  [[nodiscard]] virtual std::string_view name() const = 0;
+  /// Adds this term's forces at state s into f (3n). Cost: one pass over the elements.
+  virtual void add_forces(const StateView& s, std::span<double> f) const = 0;
+  /// Potential energy at state s. Cost: one pass over the elements.
+  [[nodiscard]] virtual double potential_energy(const StateView& s) const = 0;
+  [[nodiscard]] virtual EnergyKind energy_kind() const { return EnergyKind::internal; }
+  /// A characteristic energy (springs: Σ ½ k l²) that sets the watchdog's noise floor.
+  [[nodiscard]] virtual double energy_scale() const { return 0.0; }
+
+  /// Appends the node pairs whose blocks this term writes (diagonal blocks always exist).
+  virtual void collect_pairs(std::vector<NodePair>& /*out*/) const {}
+  /// Called after the pattern is (re)built: cache block slots. Cost: O(elements · log).
+  virtual void bind_pattern(const BlockMatrix& /*pattern*/) {}
+  /// Performs the request (see JacobianRequest). The matrix must carry the bound pattern.
+  virtual void add_jacobians(const StateView& /*s*/, const JacobianRequest& /*req*/) const {}
+  /// False if, with these options, the matrix contribution is not symmetric.
+  [[nodiscard]] virtual bool jacobian_symmetric(const JacobianOptions& /*opt*/) const { return true; }
+  /// Adds this term's stiffness and damping blocks for the stable-step bound.
+  virtual void add_stability_rows(const StateView& /*s*/, StabilityRows& /*rows*/) const {}
+
+  /// Throws InputError naming the element if one refers to a node out of range or removed.
+  virtual void check_nodes(const NodeTable& /*nodes*/) const {}
+  /// Renumbers nodes after compaction (old -> new, invalid_index for removed). check_nodes()
+  /// has run before, so no element refers to a removed node.
+  virtual void remap_nodes(std::span<const Index> /*old_to_new*/) {}
+
+  /// Changes when elements are added, removed or re-attached (the pattern must be rebuilt).
+  [[nodiscard]] std::uint64_t topology_version() const { return topology_version_; }
+  /// Changes when a stiffness, rest length, damping coefficient or model changes.
+  [[nodiscard]] std::uint64_t parameter_version() const { return parameter_version_; }
+
+ protected:
+  void touch_topology() {
+    ++topology_version_;
+    ++parameter_version_;
+  }
+  void touch_parameters() { ++parameter_version_; }
+
+ private:
+  std::uint64_t topology_version_ = 0;
+  std::uint64_t parameter_version_ = 0;
+};
+
+}  // namespace sewn::physics

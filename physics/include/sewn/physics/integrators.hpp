@@ -1,0 +1,128 @@
+#pragma once
+// Time integrators for a System (PHYSICS_NOTES §1.5-1.6):
+//   SymplecticEuler        V ← V + h M⁻¹F(P,V), then P ← P + h V (the seed's semi-implicit
+//                          scheme), refused above the stable-step bound unless opted out;
+//   LinearlyImplicitEuler  (M - h∂F/∂V - h²∂F/∂P) ΔV = h (F₀ + h ∂F/∂P V₀), V ← V + ΔV,
+//                          P ← P + h V, solved by block-Jacobi PCG with filtering.
+// Fixed axes keep their velocity (0 unless prescribed: kinematic). Both check the state
+// before using it: a non-finite position, velocity or force stops the step with a
+// BlowupError naming the node, leaving the state as it was; an energy watchdog stops runs
+// whose kinetic + internal energy outgrows what the initial state and external fields can
+// supply.
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "sewn/physics/aligned.hpp"
+#include "sewn/physics/cg.hpp"
+#include "sewn/physics/system.hpp"
+
+namespace sewn::physics {
+
+struct HealthOptions {
+  /// Check positions, velocities and forces for NaN/Inf every step (one pass over 9n values).
+  bool check_finite = true;
+  /// Steps between energy checks (0: never). Each check costs about one force evaluation.
+  int energy_check_interval = 100;
+  /// Blow-up when E_kin + E_internal > factor · (E_kin + E_internal at the baseline + work of
+  /// external fields since) + floor. Symplectic Euler's plain energy legitimately swings by
+  /// up to 1/(1 - hω/2) near the limit, hence the generous default.
+  double energy_growth_factor = 100.0;
+  /// floor = fraction · System::energy_scale() (springs: Σ ½kl²), so that round-off noise
+  /// around a rest state is not reported.
+  double energy_floor_fraction = 1e-6;
+};
+
+/// What a step did. Semi-implicit steps leave the CG fields at their defaults.
+struct StepReport {
+  int cg_iterations = 0;
+  double cg_relative_residual = 0.0;
+  bool cg_converged = true;
+  bool pattern_rebuilt = false;
+  double stable_step = std::numeric_limits<double>::quiet_NaN();  ///< bound in force (semi-implicit)
+};
+
+/// The energy watchdog shared by the integrators. Its baseline is taken before the first
+/// step and again whenever System::version() changes (a cut or an edit may legitimately
+/// change the energy).
+class EnergyWatchdog {
+ public:
+  /// Takes a baseline if there is none or the system changed. O(1), else O(elements).
+  void baseline_if_needed(const System& sys);
+  /// Throws BlowupError naming the fastest node if the energy outgrew its budget. O(elements).
+  void check(const System& sys, const HealthOptions& opt, std::uint64_t step) const;
+  void reset() { has_baseline_ = false; }
+
+ private:
+  bool has_baseline_ = false;
+  double internal0_ = 0, external0_ = 0;
+  std::uint64_t version_ = 0;
+};
+
+struct SymplecticEulerOptions {
+  /// Refuse (StabilityError) a step h ≥ the stable-step bound. Opt out for cost benchmarks
+  /// or when stability is ensured otherwise.
+  bool enforce_stable_step = true;
+  /// Steps between re-evaluations of the bound (it is also re-evaluated whenever the system
+  /// changes). It depends on the state through the spring directions and stretches.
+  int stable_step_recheck_interval = 100;
+  HealthOptions health;
+};
+
+class SymplecticEuler {
+ public:
+  explicit SymplecticEuler(SymplecticEulerOptions options = {});
+  /// Advances sys by h > 0. Throws InputError on a bad h, StabilityError (state unchanged)
+  /// if h is above the bound, BlowupError on a non-finite state (unchanged) or an energy
+  /// blow-up. Cost: one force evaluation and one pass over the nodes.
+  StepReport step(System& sys, double h);
+  /// The bound computed most recently (h_max = NaN before the first checked step).
+  [[nodiscard]] const StableStep& last_stable_step() const { return bound_; }
+  [[nodiscard]] SymplecticEulerOptions& options() { return opt_; }
+  /// Forgets the cached bound and the energy baseline.
+  void reset();
+
+ private:
+  SymplecticEulerOptions opt_;
+  StableStep bound_{std::numeric_limits<double>::quiet_NaN()};
+  std::uint64_t bound_version_ = 0;
+  std::uint64_t steps_ = 0, bound_step_ = 0;
+  EnergyWatchdog watchdog_;
+};
+
+struct ImplicitEulerOptions {
+  double cg_tolerance = 1e-6;   ///< relative residual ‖S(b - AΔV)‖/‖Sb‖
+  int cg_max_iterations = 1000;
+  bool warm_start = true;       ///< start CG from the previous step's ΔV
+  /// Throw SolverError (state unchanged) when CG misses its tolerance; if false the step is
+  /// applied and StepReport::cg_converged is false.
+  bool throw_on_cg_failure = true;
+  /// Simplifications of ∂F/∂x in the matrix (and in the ∂F/∂P·V₀ product, so the scheme is
+  /// the linearised implicit Euler of that approximate Jacobian). CG needs a symmetric matrix.
+  JacobianOptions jacobian;
+  HealthOptions health;
+};
+
+class LinearlyImplicitEuler {
+ public:
+  explicit LinearlyImplicitEuler(ImplicitEulerOptions options = {});
+  /// Advances sys by h > 0 (Baraff-Witkin form). Throws InputError on a bad h or a term whose
+  /// matrix would not be symmetric, SolverError if CG misses its tolerance (unless opted
+  /// out: then check the report), BlowupError as SymplecticEuler. Cost: one force and one
+  /// Jacobian evaluation, CG iterations × one block-sparse product; no allocation once the
+  /// work arrays are sized (they are resized after topology changes).
+  [[nodiscard]] StepReport step(System& sys, double h);
+  [[nodiscard]] ImplicitEulerOptions& options() { return opt_; }
+  /// Forgets the warm start and the energy baseline.
+  void reset();
+
+ private:
+  ImplicitEulerOptions opt_;
+  AlignedVector<double> b_, dv_, kv_, free_, precond_;
+  CgWorkspace ws_;
+  std::uint64_t steps_ = 0;
+  EnergyWatchdog watchdog_;
+};
+
+}  // namespace sewn::physics

@@ -1,0 +1,122 @@
+#pragma once
+// Springs: the mass-spring term of PHYSICS_NOTES §1.4. Spring s joins nodes (i, j) with
+// stiffness k, rest length l and (per-spring damping model) viscosity γ. With d = |Pj - Pi|,
+// U = (Pj - Pi)/d, the force on i is
+//   elastic   k (d - l) U
+//   viscous   γ ((Vj - Vi)·U) U                       (SpringDamping::viscous)
+//   Rayleigh  β K_s (Vj - Vi), K_s = k[UUᵀ + max(0, 1 - l/d)(I - UUᵀ)]   (::stiffness_proportional)
+// and the force on j is its opposite. Jacobians are the exact ones of §1.4 (∂Fe/∂P,
+// ∂Fv/∂P — non-symmetric — and ∂Fv/∂V; never the seed's W form), with the options of
+// JacobianOptions. The Rayleigh matrix K_s is treated as constant within a step (its position
+// derivative is not assembled), as is usual.
+//
+// Degenerate springs: below d = 1e-9·l (l > 0), or at d = 0, the direction is undefined; the
+// spring then exerts no force and adds no Jacobian (PHYSICS_NOTES §1.4(c), "skip").
+//
+// Indices are stable: remove() leaves a tombstone (k = γ = 0, endpoints (0, 0)) whose slot is
+// reused by the next add(); compact() renumbers and returns old -> new. The map's 1-attributes
+// can therefore hold spring indices.
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "sewn/physics/aligned.hpp"
+#include "sewn/physics/force_term.hpp"
+
+namespace sewn::physics {
+
+/// What a spring stands for, for callers that re-attach diagonals after a cut.
+enum class SpringKind : std::uint8_t { edge, diagonal, other };
+
+/// Damping model of the spring term (pick one; PHYSICS_NOTES §1.5).
+enum class SpringDamping : std::uint8_t {
+  none,
+  viscous,                ///< the seed's per-spring γ((Vj-Vi)·U)U; γ is stored per spring
+  stiffness_proportional  ///< Rayleigh's β·K_s part (add MassDamping(α) for the α·M part)
+};
+
+/// The seed's per-spring viscosity γ = 2 √(k (mi + mj)/2). Throws InputError on k < 0 or a
+/// mass ≤ 0 or non-finite. O(1).
+[[nodiscard]] double paper_viscosity(double k, double mi, double mj);
+
+class Springs final : public ForceTerm {
+ public:
+  explicit Springs(SpringDamping damping = SpringDamping::none, double rayleigh_beta = 0.0);
+
+  [[nodiscard]] std::string_view name() const override { return "springs"; }
+
+  // ---- editing (all O(1) amortised; each throws InputError on bad input, naming the spring)
+  /// Adds a spring between distinct nodes i and j (k ≥ 0, l ≥ 0, γ ≥ 0, all finite); returns
+  /// its index (a freed slot if any). Node indices are checked against the node table when the
+  /// system next steps. Bumps topology_version().
+  Index add(Index i, Index j, double k, double rest_length, SpringKind kind = SpringKind::edge, double gamma = 0.0);
+  /// Removes spring s (tombstone; its index may be reused). Bumps topology_version().
+  void remove(Index s);
+  void set_stiffness(Index s, double k);
+  void set_rest_length(Index s, double l);
+  void set_viscosity(Index s, double gamma);
+  /// Re-attaches spring s to nodes (i, j). Bumps topology_version().
+  void set_endpoints(Index s, Index i, Index j);
+  /// Moves the end of spring s that is at node `from` to node `to` (a cut's re-attachment).
+  /// Throws InputError if s does not end at `from`. Bumps topology_version().
+  void move_endpoint(Index s, Index from, Index to);
+  /// Sets γ of every live spring to paper_viscosity(k, mi, mj) from the given masses
+  /// (call again after masses or stiffnesses change). O(springs).
+  void set_paper_viscosity(std::span<const double> masses);
+  /// Chooses the damping model (β is used by stiffness_proportional only, β ≥ 0).
+  void set_damping(SpringDamping damping, double rayleigh_beta = 0.0);
+  /// Reserves room for n springs.
+  void reserve(Index n);
+  /// Drops removed springs, keeping order; returns old -> new (invalid_index for removed). O(springs).
+  std::vector<Index> compact();
+
+  // ---- queries (O(1); throw InputError on a bad or removed index)
+  [[nodiscard]] Index size() const { return static_cast<Index>(k_.size()); }  ///< slots, removed included
+  [[nodiscard]] Index num_alive() const { return alive_count_; }
+  [[nodiscard]] bool is_alive(Index s) const { return s < size() && alive_[s] != 0; }
+  [[nodiscard]] Index node_i(Index s) const;
+  [[nodiscard]] Index node_j(Index s) const;
+  [[nodiscard]] double stiffness(Index s) const;
+  [[nodiscard]] double rest_length(Index s) const;
+  [[nodiscard]] double viscosity(Index s) const;
+  [[nodiscard]] SpringKind kind(Index s) const;
+  [[nodiscard]] SpringDamping damping() const { return damping_; }
+  [[nodiscard]] double rayleigh_beta() const { return beta_; }
+
+  // ---- ForceTerm
+  void add_forces(const StateView& s, std::span<double> f) const override;
+  [[nodiscard]] double potential_energy(const StateView& s) const override;
+  [[nodiscard]] double energy_scale() const override;
+  void collect_pairs(std::vector<NodePair>& out) const override;
+  void bind_pattern(const BlockMatrix& pattern) override;
+  void add_jacobians(const StateView& s, const JacobianRequest& req) const override;
+  [[nodiscard]] bool jacobian_symmetric(const JacobianOptions& opt) const override;
+  void add_stability_rows(const StateView& s, StabilityRows& rows) const override;
+  void check_nodes(const NodeTable& nodes) const override;
+  void remap_nodes(std::span<const Index> old_to_new) override;
+
+ private:
+  void check_spring(Index s, const char* where) const;
+
+  // Structure of arrays: the force loop streams these in order.
+  AlignedVector<Index> ni_, nj_;
+  AlignedVector<double> k_, l_, gamma_;
+  std::vector<SpringKind> kind_;
+  std::vector<std::uint8_t> alive_;
+  std::vector<Index> free_;
+  Index alive_count_ = 0;
+  Index max_node_ = 0;  // largest endpoint ever stored (the force loop's bounds check)
+  SpringDamping damping_;
+  double beta_;
+  // Slots of blocks (i,j), (j,i), (i,i), (j,j) in the bound pattern.
+  std::vector<Index> slot_ij_, slot_ji_, slot_ii_, slot_jj_;
+  std::uint64_t bound_pattern_ = 0;
+  std::uint64_t bound_topology_ = ~std::uint64_t{0};
+  // Force accumulator with 4 doubles per node, so each spring end is one aligned 256-bit
+  // read-modify-write that store forwarding handles (see springs.cpp).
+  mutable AlignedVector<double> acc_;
+};
+
+}  // namespace sewn::physics

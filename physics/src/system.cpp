@@ -1,0 +1,159 @@
+#include "sewn/physics/system.hpp"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "sewn/physics/errors.hpp"
+
+namespace sewn::physics {
+
+// ------------------------------------------------------------------ StabilityRows
+
+StabilityRows::StabilityRows(std::span<const double> mass, std::span<const AxisMask> fixed) : mass_(mass), fixed_(fixed) {
+  for (int w = 0; w < 2; ++w) {
+    diag_[w].assign(9 * mass.size(), 0.0);
+    off_[w].assign(3 * mass.size(), 0.0);
+  }
+}
+
+void StabilityRows::add_diagonal(Which w, Index i, const Eigen::Matrix3d& B) {
+  double* d = diag_[w].data() + 9 * std::size_t{i};
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) d[3 * c + r] += B(r, c);
+}
+
+void StabilityRows::add_offdiagonal(Which w, Index i, Index j, const Eigen::Matrix3d& B) {
+  const double mi = mass_[i], mj = mass_[j];
+  if (!(mi > 0 && mj > 0)) return;  // removed node: no row, no column
+  const double scale = 1.0 / std::sqrt(mi * mj);
+  for (int a = 0; a < 3; ++a) {
+    double row_i = 0, row_j = 0;
+    for (int b = 0; b < 3; ++b) {
+      if (((fixed_[j] >> b) & 1u) == 0) row_i += std::abs(B(a, b));
+      if (((fixed_[i] >> b) & 1u) == 0) row_j += std::abs(B(b, a));
+    }
+    off_[w][3 * std::size_t{i} + a] += scale * row_i;
+    off_[w][3 * std::size_t{j} + a] += scale * row_j;
+  }
+}
+
+StabilityRows::Bound StabilityRows::bound(Which w) const {
+  Bound out;
+  for (Index i = 0; i < mass_.size(); ++i) {
+    if (!(mass_[i] > 0)) continue;
+    const double* d = diag_[w].data() + 9 * std::size_t{i};
+    for (int a = 0; a < 3; ++a) {
+      if ((fixed_[i] >> a) & 1u) continue;
+      double row = 0;
+      for (int b = 0; b < 3; ++b)
+        if (((fixed_[i] >> b) & 1u) == 0) row += std::abs(d[3 * b + a]);
+      row = row / mass_[i] + off_[w][3 * std::size_t{i} + a];
+      if (row > out.value || (std::isnan(row) && out.node == invalid_index)) {
+        out.value = row;
+        out.node = i;
+      }
+    }
+  }
+  return out;
+}
+
+// ------------------------------------------------------------------ System
+
+ForceTerm& System::add_term(std::unique_ptr<ForceTerm> term) {
+  if (!term) throw InputError("System::add_term: null term");
+  terms_.push_back(std::move(term));
+  return *terms_.back();
+}
+
+bool System::refresh() {
+  // Counters only increase, so their sum (plus the term count) changes iff one of them does.
+  std::uint64_t key = nodes_.topology_version() + terms_.size();
+  for (const auto& t : terms_) key += t->topology_version();
+  if (key == seen_topology_ && matrix_.size() == nodes_.size()) return false;
+  for (const auto& t : terms_) t->check_nodes(nodes_);
+  std::vector<NodePair> pairs;
+  for (const auto& t : terms_) t->collect_pairs(pairs);
+  matrix_.build_pattern(nodes_.size(), pairs);
+  for (const auto& t : terms_) t->bind_pattern(matrix_);
+  seen_topology_ = key;
+  return true;
+}
+
+void System::compute_forces() {
+  refresh();
+  auto f = nodes_.f();
+  std::fill(f.begin(), f.end(), 0.0);
+  add_forces(nodes_.state(), f);
+}
+
+void System::add_forces(const StateView& s, std::span<double> f) const {
+  for (const auto& t : terms_) t->add_forces(s, f);
+}
+
+void System::add_jacobians(const JacobianRequest& req) {
+  refresh();
+  for (const auto& t : terms_) t->add_jacobians(nodes_.state(), req);
+}
+
+double System::kinetic_energy() const {
+  const auto v = nodes_.v();
+  const auto m = nodes_.masses();
+  double e = 0;
+  for (std::size_t i = 0; i < m.size(); ++i) e += 0.5 * m[i] * (v[3 * i] * v[3 * i] + v[3 * i + 1] * v[3 * i + 1] + v[3 * i + 2] * v[3 * i + 2]);
+  return e;
+}
+
+double System::potential_energy() const {
+  double e = 0;
+  for (const auto& t : terms_) e += t->potential_energy(nodes_.state());
+  return e;
+}
+
+double System::potential_energy(EnergyKind kind) const {
+  double e = 0;
+  for (const auto& t : terms_)
+    if (t->energy_kind() == kind) e += t->potential_energy(nodes_.state());
+  return e;
+}
+
+double System::energy_scale() const {
+  double e = 0;
+  for (const auto& t : terms_) e += t->energy_scale();
+  return e;
+}
+
+StableStep System::stable_step() {
+  refresh();
+  StabilityRows rows(nodes_.masses(), nodes_.fixed_masks());
+  for (const auto& t : terms_) t->add_stability_rows(nodes_.state(), rows);
+  const auto k = rows.bound(StabilityRows::stiffness);
+  const auto c = rows.bound(StabilityRows::damping);
+  StableStep out;
+  out.stiffness_bound = k.value;
+  out.damping_bound = c.value;
+  out.stiffness_node = k.node;
+  out.damping_node = c.node;
+  // Largest root of λ_K h² + 2 λ_C h - 4 = 0, written to avoid cancellation.
+  if (k.value > 0 || c.value > 0)
+    out.h_max = 4.0 / (c.value + std::sqrt(c.value * c.value + 4.0 * k.value));
+  else
+    out.h_max = std::numeric_limits<double>::infinity();
+  return out;
+}
+
+std::vector<Index> System::compact_nodes() {
+  for (const auto& t : terms_) t->check_nodes(nodes_);
+  std::vector<Index> old_to_new = nodes_.compact();
+  for (const auto& t : terms_) t->remap_nodes(old_to_new);
+  refresh();
+  return old_to_new;
+}
+
+std::uint64_t System::version() const {
+  std::uint64_t key = nodes_.topology_version() + nodes_.parameter_version() + terms_.size();
+  for (const auto& t : terms_) key += t->topology_version() + t->parameter_version();
+  return key;
+}
+
+}  // namespace sewn::physics

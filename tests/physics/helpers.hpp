@@ -1,0 +1,54 @@
+#pragma once
+// Shared helpers of the physics tests: dense Jacobians from the assembled pattern and by
+// central finite differences of the forces.
+
+#include <random>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "sewn/physics/physics.hpp"
+
+namespace sewn::physics::test {
+
+inline Eigen::VectorXd forces(System& sys) {
+  sys.refresh();
+  std::vector<double> f(3 * std::size_t{sys.nodes().size()}, 0.0);
+  sys.add_forces(sys.nodes().state(), f);
+  return Eigen::Map<Eigen::VectorXd>(f.data(), static_cast<Eigen::Index>(f.size()));
+}
+
+/// cx·∂F/∂x + cv·∂F/∂v as assembled by the terms.
+inline Eigen::MatrixXd assembled(System& sys, double cx, double cv, JacobianOptions opt) {
+  sys.refresh();
+  BlockMatrix& A = sys.matrix();
+  A.set_zero();
+  JacobianRequest r;
+  r.matrix = &A;
+  r.cx = cx;
+  r.cv = cv;
+  r.options = opt;
+  sys.add_jacobians(r);
+  return Eigen::MatrixXd(A.to_sparse());
+}
+
+/// ∂F/∂x (or ∂F/∂v) by central differences with step delta.
+inline Eigen::MatrixXd finite_difference(System& sys, bool wrt_velocity, double delta) {
+  const Eigen::Index n3 = 3 * Eigen::Index{sys.nodes().size()};
+  Eigen::MatrixXd J(n3, n3);
+  auto values = wrt_velocity ? sys.nodes().v() : sys.nodes().x();
+  for (Eigen::Index c = 0; c < n3; ++c) {
+    const double keep = values[c];
+    values[c] = keep + delta;
+    const Eigen::VectorXd fp = forces(sys);
+    values[c] = keep - delta;
+    const Eigen::VectorXd fm = forces(sys);
+    values[c] = keep;
+    J.col(c) = (fp - fm) / (2 * delta);
+  }
+  return J;
+}
+
+inline double max_abs(const Eigen::MatrixXd& m) { return m.cwiseAbs().maxCoeff(); }
+
+}  // namespace sewn::physics::test
