@@ -229,6 +229,7 @@ void MssModel<D>::build_elements(const IndexedMesh& mesh, const BuildResult& bui
     const Vec3 x(mesh.points[q][0], mesh.points[q][1], mesh.points[q][2]);
     node_of_point_[q] = nodes.add(x, Vec3::Zero(), point_mass[q]);
     rest_.push_back(x);
+    point_of_node_.push_back(q);
   }
   vertices_of_node_.assign(nodes.size(), {});
   map_.template create_attributes<0>(
@@ -333,6 +334,17 @@ Index MssModel<D>::end_node(Dart d) const {
     if (!e) e = map_.beta(d, 2);
   if (!e) throw InputError(options_.source + ": an edge has a dangling end (dart " + std::to_string(d.index()) + ")");
   return node_of(e);
+}
+
+template <int D>
+std::vector<std::uint32_t> MssModel<D>::edges_at(Dart v) const {
+  std::vector<std::uint32_t> out;
+  for (Dart x : map_.template cell<0>(v)) {
+    if (const AttrId<1> a = map_.template attribute<1>(x)) out.push_back(a.index());
+    if (const Dart p = map_.beta(x, 0))
+      if (const AttrId<1> a = map_.template attribute<1>(p)) out.push_back(a.index());
+  }
+  return out;
 }
 
 template <int D>
@@ -443,6 +455,7 @@ void MssModel<D>::install_hooks() {
     const Index n = map_.value(a).node;
     const Index copy = system_.nodes().duplicate(n);
     rest_.push_back(rest_[n]);
+    point_of_node_.push_back(point_of_node_[n]);
     vertices_of_node_.emplace_back();
     map_.value(b).node = copy;
     vertices_of_node_[copy].push_back(b.index());
@@ -522,8 +535,7 @@ void MssModel<D>::resync() {
     if (!vattr.is_alive(v)) continue;
     const Dart d = map_.dart_of(AttrId<0>(v));
     dirty_nodes.push_back(map_.value(AttrId<0>(v)).node);
-    for (Dart y : map_.template incident<0, 1>(d))
-      if (const AttrId<1> a = map_.template attribute<1>(y)) edges.push_back(a.index());
+    for (std::uint32_t a : edges_at(d)) edges.push_back(a);
     if constexpr (D == 3)
       for (Dart y : map_.template incident<0, 3>(d))
         if (const AttrId<3> a = map_.template attribute<3>(y)) elems.push_back(map_.value(a).element);
@@ -568,8 +580,7 @@ void MssModel<D>::resync() {
       if (!nodes.is_alive(n)) continue;
       for (std::uint32_t v : vertices_of_node_[n]) {
         const Dart d = map_.dart_of(AttrId<0>(v));
-        for (Dart y : map_.template incident<0, 1>(d))
-          if (const AttrId<1> a = map_.template attribute<1>(y)) touched_springs.push_back(map_.value(a).spring);
+        for (std::uint32_t a : edges_at(d)) touched_springs.push_back(map_.value(AttrId<1>(a)).spring);
         auto diagonals = [&](Index e) {
           if (e != invalid_index && elements_[e].alive)
             for (Index s : elements_[e].diagonal)
@@ -588,6 +599,32 @@ void MssModel<D>::resync() {
         springs_->set_viscosity(s, paper_viscosity(springs_->stiffness(s), nodes.mass(springs_->node_i(s)),
                                                    nodes.mass(springs_->node_j(s))));
   }
+}
+
+template <int D>
+void MssModel<D>::compact() {
+  const std::vector<Index> node_map = system_.compact_nodes();
+  const std::vector<Index> spring_map = springs_->compact();
+  for (AttrId<0> a : map_.template attributes<0>()) map_.value(a).node = node_map[map_.value(a).node];
+  for (AttrId<1> a : map_.template attributes<1>()) map_.value(a).spring = spring_map[map_.value(a).spring];
+  for (Element& el : elements_)
+    for (Index& s : el.diagonal)
+      if (s != invalid_index) s = spring_map[s];
+  for (Index& n : node_of_point_)
+    if (n != invalid_index) n = node_map[n];
+  std::size_t kept = 0;
+  for (std::size_t old = 0; old < node_map.size(); ++old) {
+    if (node_map[old] == invalid_index) continue;
+    if (kept != old) {  // a vector moved onto itself would be emptied
+      rest_[kept] = rest_[old];
+      point_of_node_[kept] = point_of_node_[old];
+      vertices_of_node_[kept] = std::move(vertices_of_node_[old]);
+    }
+    ++kept;
+  }
+  rest_.resize(kept);
+  point_of_node_.resize(kept);
+  vertices_of_node_.resize(kept);
 }
 
 template class MssModel<2>;

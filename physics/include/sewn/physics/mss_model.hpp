@@ -153,6 +153,8 @@ class MssModel {
   [[nodiscard]] Index element_of(Dart d) const;
   /// Rest position of node i.
   [[nodiscard]] Eigen::Vector3d rest_position(Index i) const { return rest_[i]; }
+  /// The mesh point node i stands for (a particle duplicated by a cut keeps its original's).
+  [[nodiscard]] std::uint32_t point_of_node(Index i) const { return point_of_node_[i]; }
   /// Σ ρ·measure over live elements: what the node masses must add up to.
   [[nodiscard]] double element_mass() const;
   /// Σ of live node masses.
@@ -166,6 +168,10 @@ class MssModel {
 
   /// Recomputes the physics of every cell touched since the last resync (edit() calls it).
   void resync();
+  /// Drops removed particles and springs from the arrays, renumbering the rest and the map's
+  /// attributes. Invalidates node and spring indices held by the caller (node_of_point() is
+  /// kept up to date). O(particles + springs + attributes).
+  void compact();
 
  private:
   void build_elements(const IndexedMesh& mesh, const BuildResult& built, const std::vector<std::uint32_t>& material_of_cell);
@@ -179,6 +185,9 @@ class MssModel {
   [[nodiscard]] double vertex_mass(Dart vertex_dart) const;
   void attach_diagonals(Index e);
   [[nodiscard]] Index end_node(Dart d) const;
+  // The edge attributes around the vertex of v, duplicates possible. A boundary edge of a
+  // surface has a single dart, which may end at v: hence the β0 predecessors too.
+  [[nodiscard]] std::vector<std::uint32_t> edges_at(Dart v) const;
   template <int I>
   [[nodiscard]] bool attr_alive(std::uint32_t a) const {
     return map_.template attribute_container<I>().is_alive(a);
@@ -193,6 +202,7 @@ class MssModel {
   std::vector<Eigen::Vector3d> rest_;            // rest position per node
   std::vector<std::vector<std::uint32_t>> vertices_of_node_;  // 0-attributes naming each node
   std::vector<Index> node_of_point_;
+  std::vector<std::uint32_t> point_of_node_;
   // touched since the last resync
   std::vector<std::uint32_t> dirty_vertices_, dirty_edges_;
   std::vector<Index> dirty_elements_;
