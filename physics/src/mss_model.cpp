@@ -116,6 +116,7 @@ MssModel<D>::MssModel(const IndexedMesh& mesh, std::vector<MaterialParams> mater
 
   BuildOptions bopt;
   bopt.source = options_.source;
+  bopt.manifold_volumes = true;  // a face of three volumes is not a solid; shells may meet three at an edge
   const BuildResult built = sewn::build(map_, mesh, bopt);
   build_elements(mesh, built, material_of_cell);
   install_hooks();
