@@ -272,7 +272,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
                                          io::DataArray::ints("refinement_level", snap.level),
                                          io::DataArray::ints("mesh_cell", snap.mesh_cell)};
       io::write_vtu(sum.out / name, snap.points, snap.cells(), point_data, cell_data);
-      pvd->add(t, name);
+      pvd->add(t, sum.out / name);
     }
     if (csv) {
       const auto elements = std::count_if(model->elements().begin(), model->elements().end(), [](const auto& e) { return e.alive; });

@@ -267,7 +267,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
       check_material(rr.string("material"), path + ".regions[" + std::to_string(k) + "].material");
       m.regions.emplace_back(read_selector(rj.at("where"), *region_schema.member("where")), rr.string("material"));
     }
-    if (mr.has("cells") || m.type == "hex_grid" || m.type == "tet_grid" || m.type == "quad_grid" || m.type == "tri_grid") {
+    if (mesh_schema.member("cells", m.type)) {
       check_whole(mr["cells"], file, path + ".cells");
       const auto& c = mr["cells"];
       for (std::size_t k = 0; k < c.size(); ++k) m.cells[k] = static_cast<std::uint32_t>(c[k].get<double>());
