@@ -116,6 +116,8 @@ class CMap {
   static constexpr bool has_attribute = (I >= 0 && I <= D) && !std::is_void_v<attribute_type<I>>;
 
   CMap() = default;
+  /// Deep copy of darts, attributes and marks; the hooks are copied too (so they still refer to
+  /// whatever they captured). O(n).
   CMap(const CMap&) = default;
   CMap(CMap&&) noexcept = default;
   CMap& operator=(const CMap&) = default;
@@ -162,6 +164,7 @@ class CMap {
     Dart e = beta(d, i);
     return e ? beta(e, j, rest...) : null_dart;
   }
+  /// βI(d) with I checked at compile time; d as in beta(d, i). O(1).
   template <int I>
   [[nodiscard]] Dart beta(Dart d) const {
     static_assert(I >= 0 && I <= D);
@@ -177,6 +180,7 @@ class CMap {
   [[nodiscard]] Mark reserve_mark() const { return marks_.reserve(); }
   /// Unmarks every dart for m and releases it. O(1) when no or all live darts are marked.
   void free_mark(Mark m) const;
+  /// True if d is marked for m (m reserved, d live). O(1).
   [[nodiscard]] bool is_marked(Dart d, Mark m) const { return marks_.test(d.index(), m); }
   /// Marks d; returns false if it was already marked. O(1).
   bool mark(Dart d, Mark m) const { return marks_.set(d.index(), m); }
@@ -184,7 +188,9 @@ class CMap {
   bool unmark(Dart d, Mark m) const { return marks_.clear(d.index(), m); }
   /// Unmarks every dart. O(1) if all or none of the live darts are marked, else O(n/64).
   void unmark_all(Mark m) const { marks_.clear_all(m, alive_, dead_darts(), dart_capacity()); }
+  /// Number of live darts marked for m. O(1).
   [[nodiscard]] std::uint32_t num_marked(Mark m) const { return marks_.count(m); }
+  /// Number of marks currently reserved (0 when no traversal or guard is alive). O(1).
   [[nodiscard]] int num_reserved_marks() const { return marks_.reserved_count(); }
   /// Marks every dart of the I-cell of d; returns how many were newly marked. O(cell).
   template <int I>
@@ -204,6 +210,7 @@ class CMap {
     check_attr(a);
     return store<I>().values.value(a.index());
   }
+  /// Read-only value of attribute a; same checks. O(1).
   template <int I>
   const attribute_type<I>& value(AttrId<I> a) const {
     check_attr(a);
@@ -236,18 +243,22 @@ class CMap {
     return store<I>().values;
   }
 
+  /// Sets the hook run when an I-cell splits in two (see the firing order at the top). O(1).
   template <int I>
   void on_split(std::function<void(AttrId<I> orig, AttrId<I> copy)> f) {
     store<I>().on_split = std::move(f);
   }
+  /// Sets the hook run when two I-cells become one, before `gone` is freed. O(1).
   template <int I>
   void on_merge(std::function<void(AttrId<I> kept, AttrId<I> gone)> f) {
     store<I>().on_merge = std::move(f);
   }
+  /// Sets the hook run when the last dart of an I-cell is erased, before its slot is freed. O(1).
   template <int I>
   void on_erase(std::function<void(AttrId<I> gone)> f) {
     store<I>().on_erase = std::move(f);
   }
+  /// Pauses (false) or resumes every hook; attributes stay consistent either way. O(1).
   void set_hooks_enabled(bool on) { hooks_on_ = on; }
   [[nodiscard]] bool hooks_enabled() const { return hooks_on_; }
 
