@@ -13,6 +13,10 @@ set(expect_fig08_ten_faces       "110;45")  # 12 section points + 2 beside the n
 set(expect_fig10_knife           "104;45")  # the 8 points above the hinge row duplicated
 set(expect_fig11_three_then_nine "112;45")  # all 16 points of the section duplicated
 set(expect_fig12_pierce          "96;42")   # enclosed cavity: no point freed, 3 cubes removed
+set(expect_table1_hex            "8;1")     # the paper's timing set-ups: no cut
+set(expect_table1_tets           "8;5")
+set(expect_sofa_8x8x10           "891;640")
+set(expect_tet_beam_5x7x9        "480;1890")
 
 foreach(v SEWN SCENES WORK)
   if(NOT DEFINED ${v})
