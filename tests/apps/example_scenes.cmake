@@ -1,0 +1,76 @@
+# Runs every example scene in scenes/ (the 2013 paper's figures) to its end and checks, from the
+# last row of its frames.csv, that every scheduled cut was applied and that the model ended with
+# the particle and element counts the figure's cut implies (a cut that silently selected other
+# faces would change them). Output frames are cut to 2, so the run costs the stepping only.
+#
+#   cmake -DSEWN=<sewn executable> -DSCENES=<scenes dir> -DWORK=<scratch dir> -P example_scenes.cmake
+#
+# Expected counts per scene: particles after the cuts (3-unsew duplicates the particles that
+# stop being joined through other volumes) and live elements (piercing removes some). Every
+# scene must be listed, so a new scene cannot go unchecked.
+set(expect_fig05_unsew           "20;4")    # 18 points, v1 and v2 duplicated (paper's Fig. 5)
+set(expect_fig08_ten_faces       "110;45")  # 12 section points + 2 beside the neck duplicated
+set(expect_fig10_knife           "104;45")  # the 8 points above the hinge row duplicated
+set(expect_fig11_three_then_nine "112;45")  # all 16 points of the section duplicated
+set(expect_fig12_pierce          "96;42")   # enclosed cavity: no point freed, 3 cubes removed
+set(expect_table1_hex            "8;1")     # the paper's timing set-ups: no cut
+set(expect_table1_tets           "8;5")
+set(expect_sofa_8x8x10           "891;640")
+set(expect_tet_beam_5x7x9        "480;1890")
+
+foreach(v SEWN SCENES WORK)
+  if(NOT DEFINED ${v})
+    message(FATAL_ERROR "example_scenes.cmake: -D${v}=... is required")
+  endif()
+endforeach()
+
+file(GLOB scene_files "${SCENES}/*.json")
+list(LENGTH scene_files n)
+if(n EQUAL 0)
+  message(FATAL_ERROR "no scene in ${SCENES}")
+endif()
+file(REMOVE_RECURSE "${WORK}")
+set(failures "")
+foreach(scene IN LISTS scene_files)
+  get_filename_component(name "${scene}" NAME_WE)
+  if(NOT DEFINED expect_${name})
+    list(APPEND failures "${name}: no expected counts in example_scenes.cmake")
+    continue()
+  endif()
+  list(GET expect_${name} 0 want_particles)
+  list(GET expect_${name} 1 want_elements)
+  file(READ "${scene}" json)
+  string(JSON want_cuts ERROR_VARIABLE no_cuts LENGTH "${json}" cuts)
+  if(no_cuts)
+    set(want_cuts 0)
+  endif()
+  set(out "${WORK}/${name}")
+  execute_process(COMMAND "${SEWN}" run "${scene}" --out "${out}" --frames 2 --quiet
+                  RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    list(APPEND failures "${name}: sewn run exited with ${rc}: ${err}")
+    continue()
+  endif()
+  file(STRINGS "${out}/frames.csv" rows)
+  list(GET rows 0 header)
+  list(GET rows -1 last)
+  string(REPLACE "," ";" header "${header}")
+  string(REPLACE "," ";" last "${last}")
+  foreach(col cuts particles elements)
+    list(FIND header ${col} i)
+    if(i LESS 0)
+      message(FATAL_ERROR "frames.csv has no column '${col}'")
+    endif()
+    list(GET last ${i} got_${col})
+  endforeach()
+  foreach(col cuts particles elements)
+    if(NOT got_${col} EQUAL want_${col})
+      list(APPEND failures "${name}: ${col} at the end = ${got_${col}}, expected ${want_${col}}")
+    endif()
+  endforeach()
+  message(STATUS "${name}: ${got_cuts} cuts, ${got_particles} particles, ${got_elements} elements")
+endforeach()
+if(failures)
+  string(REPLACE ";" "\n  " failures "${failures}")
+  message(FATAL_ERROR "example scenes:\n  ${failures}")
+endif()
