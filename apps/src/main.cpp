@@ -40,6 +40,7 @@ Runs a scene (docs/scenes.md) and writes, in DIR (default out/<scene name>/):
                                  per point velocity, force, displacement, fixed flags)
   frames.csv                     per frame: time, kinetic/potential/elastic energy, particle,
                                  spring and element counts, ms per step, CG iterations, cuts
+                                 applied and faces they unsewed
   <name>.png                     a picture of the last frame
   --frames N   number of output frames (overrides the scene's output.frames)
   --quiet      no progress bar and no summary line

@@ -252,7 +252,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     csv = std::make_unique<io::CsvWriter>(
         sum.csv, std::vector<std::string>{"frame", "time", "kinetic_energy", "potential_energy", "elastic_energy",
                                           "particles", "springs", "elements", "steps", "ms_per_step",
-                                          "cg_iterations_mean", "cg_iterations_max", "cuts"});
+                                          "cg_iterations_mean", "cg_iterations_max", "cuts", "faces_cut"});
   }
   std::uint32_t frame = 0;
   double frame_ms = 0, frame_cg_sum = 0;
@@ -281,7 +281,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
                 static_cast<double>(model->springs().num_alive()), static_cast<double>(elements),
                 static_cast<double>(frame_steps), frame_steps ? frame_ms / static_cast<double>(frame_steps) : 0.0,
                 frame_steps ? frame_cg_sum / static_cast<double>(frame_steps) : 0.0, static_cast<double>(frame_cg_max),
-                static_cast<double>(sum.cuts)});
+                static_cast<double>(sum.cuts), static_cast<double>(sum.faces_cut)});
     }
     ++frame;
     frame_ms = frame_cg_sum = 0;
@@ -340,7 +340,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
         if (elements.empty()) throw SceneError(scene.file, path + ".where", "selects no element (at its time)");
         rep = refine::pierce(*model, elements, c.remove);
       }
-      (void)rep;
+      sum.faces_cut += rep.facets;
       ++sum.cuts;
     }
     int cg = 0;

@@ -34,6 +34,20 @@ int corners(ElementKind k) {
   return 0;
 }
 
+// Darts of an element starting at one of its corners: the faces meeting there in a polyhedron,
+// one in a polygon or a segment. A vertex cell's mass sums ρ·measure/(corners·this) per dart.
+int darts_per_corner(ElementKind k) {
+  return k == ElementKind::hexahedron || k == ElementKind::tetrahedron ? 3 : 1;
+}
+
+// Grows a stamp vector to cover i and stamps it; false if already stamped this generation.
+bool first_visit(std::vector<std::uint32_t>& stamp, std::size_t i, std::uint32_t generation) {
+  if (i >= stamp.size()) stamp.resize(i + 1 + i / 2, 0);
+  if (stamp[i] == generation) return false;
+  stamp[i] = generation;
+  return true;
+}
+
 std::span<const Edge> diagonals_of(ElementKind k) {
   if (k == ElementKind::hexahedron) return hex_diagonals;
   if (k == ElementKind::quad) return quad_diagonals;
@@ -63,12 +77,6 @@ void check_material(const MaterialParams& m, std::size_t i) {
 template <class V, class T>
 void erase_value(V& v, T x) {
   v.erase(std::remove(v.begin(), v.end(), x), v.end());
-}
-
-template <class V>
-void sort_unique(V& v) {
-  std::sort(v.begin(), v.end());
-  v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
 int local_edge_index(ElementKind k, std::uint8_t a, std::uint8_t b, std::span<const Edge> edges) {
@@ -238,7 +246,11 @@ void MssModel<D>::build_elements(const IndexedMesh& mesh, const BuildResult& bui
   for (AttrId<0> a : map_.template attributes<0>()) vertices_of_node_[map_.value(a).node].push_back(a.index());
 
   // 2) elements on their cells: volumes by 3-attributes, 2D cells by 2-attributes
+  live_elements_ = nc;
+  dart_vertex_.assign(map_.dart_capacity(), 0);
+  dart_edge_.assign(map_.dart_capacity(), 0);
   for (std::uint32_t c = 0; c < nc; ++c) {
+    index_darts(c);
     const Element& el = elements_[c];
     if (el.kind == ElementKind::hexahedron || el.kind == ElementKind::tetrahedron) {
       if constexpr (D == 3) map_.template set_attribute<3>(el.dart, ElementRef{c});
@@ -359,43 +371,72 @@ Index MssModel<D>::element_of(Dart d) const {
 }
 
 template <int D>
+void MssModel<D>::index_darts(Index e) {
+  const Element& el = elements_[e];
+  const auto edges = local_edges(el.kind);
+  // a polyhedron has two darts per edge (one per face), so one of them is flagged; a polygon or
+  // a segment's forward dart is the only one of its element on that edge
+  const bool polyhedron = el.kind == ElementKind::hexahedron || el.kind == ElementKind::tetrahedron;
+  for_each_local_dart(el, [&](Dart x, std::uint8_t a, std::uint8_t b) {
+    dart_vertex_[x.index()] = a;
+    const bool flagged = polyhedron ? a < b : !(el.kind == ElementKind::segment && a > b);
+    dart_edge_[x.index()] = static_cast<std::uint8_t>(local_edge_index(el.kind, a, b, edges) | (flagged ? 0x80 : 0));
+  });
+}
+
+template <int D>
 double MssModel<D>::edge_stiffness(Dart edge_dart) const {
   double k = 0;
   const SpringRef& ref = map_.value(map_.template attribute<1>(edge_dart));
-  if (ref.segment != invalid_index) k += elements_[ref.segment].edge_k[0];
-  // one dart per incident element (volume, or face carrying a 2D element), then its local edge
-  auto add_from = [&](Dart y, Index e) {
-    if (e == invalid_index || !elements_[e].alive) return;
-    const Element& el = elements_[e];
-    const auto edges = local_edges(el.kind);
-    for_each_local_dart(el, [&](Dart x, std::uint8_t a, std::uint8_t b) {
-      if (x == y) k += el.edge_k[static_cast<std::size_t>(local_edge_index(el.kind, a, b, edges))];
-    });
-  };
-  if constexpr (D == 3)
-    for (Dart y : map_.template incident<1, 3>(edge_dart))
-      if (const AttrId<3> v = map_.template attribute<3>(y)) add_from(y, map_.value(v).element);
-  for (Dart y : map_.template incident<1, 2>(edge_dart))
-    if (const AttrId<2> f = map_.template attribute<2>(y)) add_from(y, map_.value(f).element);
+  if (ref.segment != invalid_index && elements_[ref.segment].alive) k += elements_[ref.segment].edge_k[0];
+  for (Dart y : map_.template cell<1>(edge_dart)) {
+    const std::uint8_t code = dart_edge_[y.index()];
+    if (!(code & 0x80)) continue;
+    const Index e = element_of(y);  // segments carry none: counted above through their spring
+    if (e != invalid_index && elements_[e].alive) k += elements_[e].edge_k[code & 0x7f];
+  }
   return k;
 }
 
 template <int D>
-double MssModel<D>::vertex_mass(Dart v) const {
+double MssModel<D>::vertex_mass(Dart v, std::vector<Index>* springs) {
   double m = 0;
-  auto share = [&](Index e) {
-    if (e == invalid_index || !elements_[e].alive) return;
-    const Element& el = elements_[e];
-    m += materials_[el.material].density * el.measure / corners(el.kind);
-  };
-  if constexpr (D == 3)
-    for (Dart y : map_.template incident<0, 3>(v))
-      if (const AttrId<3> a = map_.template attribute<3>(y)) share(map_.value(a).element);
-  for (Dart y : map_.template incident<0, 2>(v))
-    if (const AttrId<2> a = map_.template attribute<2>(y)) share(map_.value(a).element);
-  for (Dart y : map_.template incident<0, 1>(v))
-    if (const AttrId<1> a = map_.template attribute<1>(y)) share(map_.value(a).segment);
+  for (Dart y : map_.template cell<0>(v)) {
+    Index e = element_of(y);
+    const AttrId<1> edge = map_.template attribute<1>(y);
+    if (e == invalid_index && edge) e = map_.value(edge).segment;
+    if (e != invalid_index && elements_[e].alive) {
+      const Element& el = elements_[e];
+      m += materials_[el.material].density * el.measure / (corners(el.kind) * darts_per_corner(el.kind));
+      if (springs && first_visit(seen_element_, e, generation_))
+        for (Index s : el.diagonal)
+          if (s != invalid_index) springs->push_back(s);
+    }
+    if (!springs) continue;
+    if (edge) springs->push_back(map_.value(edge).spring);
+    if (const Dart p = map_.beta(y, 0))  // a boundary edge of a surface may have only this dart
+      if (const AttrId<1> a = map_.template attribute<1>(p)) springs->push_back(map_.value(a).spring);
+  }
   return m;
+}
+
+template <int D>
+std::vector<Index> MssModel<D>::element_nodes(Index e) const {
+  const Element& el = elements_.at(e);
+  std::vector<Index> out(static_cast<std::size_t>(corners(el.kind)), invalid_index);
+  if (el.kind == ElementKind::segment) {
+    out[0] = node_of(el.dart);
+    out[1] = end_node(el.dart);
+    return out;
+  }
+  DartList darts;
+  if constexpr (D == 3)
+    darts = el.kind == ElementKind::hexahedron || el.kind == ElementKind::tetrahedron ? map_.template cell<3>(el.dart)
+                                                                                     : map_.template cell<2>(el.dart);
+  else
+    darts = map_.template cell<2>(el.dart);
+  for (Dart x : darts) out[dart_vertex_[x.index()]] = node_of(x);
+  return out;
 }
 
 template <int D>
@@ -403,23 +444,13 @@ void MssModel<D>::attach_diagonals(Index e) {
   Element& el = elements_[e];
   const auto diags = diagonals_of(el.kind);
   if (diags.empty() || !el.alive) return;
-  std::array<Index, 8> corner{};
-  corner.fill(invalid_index);
-  for_each_local_dart(el, [&](Dart x, std::uint8_t a, std::uint8_t) { corner[a] = node_of(x); });
+  const std::vector<Index> corner = element_nodes(e);
   for (std::size_t k = 0; k < diags.size(); ++k) {
     const Index i = corner[diags[k][0]], j = corner[diags[k][1]];
     const Index s = el.diagonal[k];
     if (springs_->node_i(s) != i || springs_->node_j(s) != j) springs_->set_endpoints(s, i, j);
     springs_->set_rest_length(s, (rest_[j] - rest_[i]).norm());
   }
-}
-
-template <int D>
-std::vector<Index> MssModel<D>::element_nodes(Index e) const {
-  const Element& el = elements_.at(e);
-  std::vector<Index> out(static_cast<std::size_t>(corners(el.kind)), invalid_index);
-  for_each_local_dart(el, [&](Dart x, std::uint8_t a, std::uint8_t) { out[a] = node_of(x); });
-  return out;
 }
 
 template <int D>
@@ -494,6 +525,7 @@ void MssModel<D>::install_hooks() {
   auto element_erased = [this](Index e) {
     Element& el = elements_[e];
     el.alive = false;
+    --live_elements_;
     for (Index& s : el.diagonal)
       if (s != invalid_index) {
         springs_->remove(s);
@@ -524,82 +556,65 @@ void MssModel<D>::resync() {
     dirty_edges_.clear();
     throw InputError(what);
   }
+  if (dirty_vertices_.empty() && dirty_edges_.empty()) return;
+  if (++generation_ == 0) {  // wrapped: old stamps could collide
+    for (auto* v : {&seen_vertex_, &seen_edge_, &seen_element_, &seen_node_, &seen_spring_}) std::fill(v->begin(), v->end(), 0u);
+    generation_ = 1;
+  }
   const auto& vattr = map_.template attribute_container<0>();
   const auto& eattr = map_.template attribute_container<1>();
   std::vector<std::uint32_t> vertices = std::move(dirty_vertices_), edges = std::move(dirty_edges_);
   dirty_vertices_.clear();
   dirty_edges_.clear();
-  std::vector<Index> elems, dirty_nodes;
-  sort_unique(vertices);
-  // 1) a touched vertex touches its edges, its elements and its particle
+  std::vector<Index> elems, touched_nodes, touched_springs;
+  auto touch_node = [&](Index n) {
+    if (first_visit(seen_node_, n, generation_)) touched_nodes.push_back(n);
+  };
+  // 1) a touched vertex touches its edges (those whose darts end there too), elements and particle
+  std::vector<std::uint32_t> all_edges;
   for (std::uint32_t v : vertices) {
-    if (!vattr.is_alive(v)) continue;
-    const Dart d = map_.dart_of(AttrId<0>(v));
-    dirty_nodes.push_back(map_.value(AttrId<0>(v)).node);
-    for (std::uint32_t a : edges_at(d)) edges.push_back(a);
-    if constexpr (D == 3)
-      for (Dart y : map_.template incident<0, 3>(d))
-        if (const AttrId<3> a = map_.template attribute<3>(y)) elems.push_back(map_.value(a).element);
-    for (Dart y : map_.template incident<0, 2>(d))
-      if (const AttrId<2> a = map_.template attribute<2>(y)) elems.push_back(map_.value(a).element);
+    if (!vattr.is_alive(v) || !first_visit(seen_vertex_, v, generation_)) continue;
+    touch_node(map_.value(AttrId<0>(v)).node);
+    for (Dart y : map_.template cell<0>(map_.dart_of(AttrId<0>(v)))) {
+      for (Dart x : {y, map_.beta(y, 0)})
+        if (x)
+          if (const AttrId<1> a = map_.template attribute<1>(x)) edges.push_back(a.index());
+      const Index e = element_of(y);
+      if (e != invalid_index && first_visit(seen_element_, e, generation_)) elems.push_back(e);
+    }
   }
-  sort_unique(edges);
-  sort_unique(elems);
   // 2) edge springs: end particles, stiffness from the elements still around, rest length
-  std::vector<Index> touched_springs;
   for (std::uint32_t e : edges) {
-    if (!eattr.is_alive(e)) continue;
+    if (!eattr.is_alive(e) || !first_visit(seen_edge_, e, generation_)) continue;
     const Dart d = map_.dart_of(AttrId<1>(e));
     const Index s = map_.value(AttrId<1>(e)).spring, i = node_of(d), j = end_node(d);
     if (springs_->node_i(s) != i || springs_->node_j(s) != j) springs_->set_endpoints(s, i, j);
     springs_->set_stiffness(s, edge_stiffness(d));
     springs_->set_rest_length(s, (rest_[j] - rest_[i]).norm());
-    touched_springs.push_back(s);
-    dirty_nodes.insert(dirty_nodes.end(), {i, j});
+    touch_node(i);
+    touch_node(j);
   }
   // 3) diagonals follow the particles their element's corners now carry
-  for (Index e : elems) {
-    if (!elements_[e].alive) continue;
-    attach_diagonals(e);
-    for (Index s : elements_[e].diagonal)
-      if (s != invalid_index) touched_springs.push_back(s);
-  }
-  // 4) masses from the elements around each touched particle (all its vertex cells)
-  sort_unique(dirty_nodes);
+  for (Index e : elems) attach_diagonals(e);
+  // 4) masses from the elements around each touched particle (all its vertex cells), collecting
+  //    on the way the springs whose per-spring viscosity depends on that mass
+  ++generation_;  // elements are listed again below, for their diagonals
+  const bool viscous = options_.damping == DampingModel::viscous;
   NodeTable& nodes = system_.nodes();
-  for (Index n : dirty_nodes) {
+  for (Index n : touched_nodes) {
     if (!nodes.is_alive(n)) continue;
     double m = 0;
-    for (std::uint32_t v : vertices_of_node_[n]) m += vertex_mass(map_.dart_of(AttrId<0>(v)));
+    for (std::uint32_t v : vertices_of_node_[n]) m += vertex_mass(map_.dart_of(AttrId<0>(v)), viscous ? &touched_springs : nullptr);
     if (!(m > 0))
       throw InputError(options_.source + ": particle " + std::to_string(n) + " is left with no element after the edit");
     nodes.set_mass(n, m);
   }
-  // 5) per-spring viscosity depends on both masses: every spring at a touched particle
-  if (options_.damping == DampingModel::viscous) {
-    for (Index n : dirty_nodes) {
-      if (!nodes.is_alive(n)) continue;
-      for (std::uint32_t v : vertices_of_node_[n]) {
-        const Dart d = map_.dart_of(AttrId<0>(v));
-        for (std::uint32_t a : edges_at(d)) touched_springs.push_back(map_.value(AttrId<1>(a)).spring);
-        auto diagonals = [&](Index e) {
-          if (e != invalid_index && elements_[e].alive)
-            for (Index s : elements_[e].diagonal)
-              if (s != invalid_index) touched_springs.push_back(s);
-        };
-        if constexpr (D == 3)
-          for (Dart y : map_.template incident<0, 3>(d))
-            if (const AttrId<3> a = map_.template attribute<3>(y)) diagonals(map_.value(a).element);
-        for (Dart y : map_.template incident<0, 2>(d))
-          if (const AttrId<2> a = map_.template attribute<2>(y)) diagonals(map_.value(a).element);
-      }
-    }
-    sort_unique(touched_springs);
+  // 5) per-spring viscosity, now that both masses are known
+  if (viscous)
     for (Index s : touched_springs)
-      if (springs_->is_alive(s))
+      if (first_visit(seen_spring_, s, generation_) && springs_->is_alive(s))
         springs_->set_viscosity(s, paper_viscosity(springs_->stiffness(s), nodes.mass(springs_->node_i(s)),
                                                    nodes.mass(springs_->node_j(s))));
-  }
 }
 
 template <int D>

@@ -70,14 +70,22 @@ bool System::refresh() {
   // Counters only increase, so their sum (plus the term count) changes iff one of them does.
   std::uint64_t key = nodes_.topology_version() + terms_.size();
   for (const auto& t : terms_) key += t->topology_version();
-  if (key == seen_topology_ && matrix_.size() == nodes_.size()) return false;
+  if (key == seen_topology_) return false;
   for (const auto& t : terms_) t->check_nodes(nodes_);
-  std::vector<NodePair> pairs;
-  for (const auto& t : terms_) t->collect_pairs(pairs);
-  matrix_.build_pattern(nodes_.size(), pairs);
-  for (const auto& t : terms_) t->bind_pattern(matrix_);
   seen_topology_ = key;
   return true;
+}
+
+BlockMatrix& System::matrix() {
+  refresh();
+  if (pattern_topology_ != seen_topology_ || matrix_.size() != nodes_.size()) {
+    std::vector<NodePair> pairs;
+    for (const auto& t : terms_) t->collect_pairs(pairs);
+    matrix_.build_pattern(nodes_.size(), pairs);
+    for (const auto& t : terms_) t->bind_pattern(matrix_);
+    pattern_topology_ = seen_topology_;
+  }
+  return matrix_;
 }
 
 void System::compute_forces() {
@@ -92,7 +100,7 @@ void System::add_forces(const StateView& s, std::span<double> f) const {
 }
 
 void System::add_jacobians(const JacobianRequest& req) {
-  refresh();
+  (void)matrix();  // the pattern the terms assemble into
   for (const auto& t : terms_) t->add_jacobians(nodes_.state(), req);
 }
 

@@ -61,8 +61,7 @@ template <int D>
 struct Counts {
   std::int64_t particles, springs, elements;
   explicit Counts(const MssModel<D>& m)
-      : particles(m.nodes().num_alive()), springs(m.springs().num_alive()), elements(std::count_if(
-            m.elements().begin(), m.elements().end(), [](const physics::Element& e) { return e.alive; })) {}
+      : particles(m.nodes().num_alive()), springs(m.springs().num_alive()), elements(m.num_live_elements()) {}
 };
 
 template <int D>
@@ -100,15 +99,31 @@ template <int D>
 std::vector<Facet> facets_with_points(const MssModel<D>& m, std::span<const std::vector<std::uint32_t>> faces) {
   std::map<std::vector<std::uint32_t>, Facet> by_points;
   for (const Facet& f : inner_facets(m)) by_points.emplace(facet_points(m, f), f);
+  // facets some cut already separated: both sides still name the same mesh points
+  std::map<std::vector<std::uint32_t>, int> free_sides;  // a cut facet has two, a boundary facet one
+  auto record_free = [&](Dart x, int index) {
+    if (!m.map().beta(x, index)) ++free_sides[facet_points(m, Facet{x, index})];
+  };
+  if constexpr (D == 3)
+    for (Dart d : m.map().template cells<2>())
+      if (m.map().template attribute<3>(d)) record_free(d, 3);
+  for (Dart d : m.map().template cells<1>())
+    if (m.map().template attribute<2>(d)) {
+      if constexpr (D == 3)
+        if (m.map().template attribute<3>(d)) continue;
+      record_free(d, 2);
+    }
   std::vector<Facet> out;
   for (std::size_t k = 0; k < faces.size(); ++k) {
     std::vector<std::uint32_t> key = faces[k];
     std::sort(key.begin(), key.end());
-    const auto it = by_points.find(key);
-    if (it == by_points.end())
-      throw InputError("face " + std::to_string(k) + " (points " + point_list(faces[k]) +
-                       ") is not a face between two elements: it does not exist, lies on the boundary, or is already cut");
-    out.push_back(it->second);
+    if (const auto it = by_points.find(key); it != by_points.end()) {
+      out.push_back(it->second);
+      continue;
+    }
+    if (const auto it = free_sides.find(key); it != free_sides.end() && it->second >= 2) continue;  // already cut
+    throw InputError("face " + std::to_string(k) + " (points " + point_list(faces[k]) +
+                     ") is not a face between two elements: no such face, or it lies on the boundary");
   }
   return out;
 }

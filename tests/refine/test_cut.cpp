@@ -116,8 +116,10 @@ TEST_CASE("Fig. 5 and Fig. 6 through the cutting API") {
   std::set<std::uint32_t> duplicated;
   for (Index i = before; i < m.nodes().size(); ++i) duplicated.insert(m.point_of_node(i));
   CHECK(duplicated == std::set<std::uint32_t>{point(1, 0, 2), point(1, 1, 2)});
-  // cutting it again selects nothing: it is no longer a face between two elements
-  CHECK_THROWS_WITH_AS(facets_with_points(m, std::span(face)), doctest::Contains("already cut"), InputError);
+  // naming it again selects nothing (it is already cut); a boundary face is an error
+  CHECK(facets_with_points(m, std::span(face)).empty());
+  const std::vector<std::vector<std::uint32_t>> bottom{{point(0, 0, 0), point(1, 0, 0), point(1, 1, 0), point(0, 1, 0)}};
+  CHECK_THROWS_WITH_AS(facets_with_points(m, std::span(bottom)), doctest::Contains("boundary"), InputError);
 }
 
 TEST_CASE("a cut between two steps conserves mass and momentum") {

@@ -39,6 +39,7 @@ struct RunSummary {
   std::uint64_t steps = 0;
   std::uint32_t frames = 0;         ///< frames written, frame 0 included
   std::uint32_t cuts = 0;           ///< scheduled cuts applied
+  std::uint32_t faces_cut = 0;      ///< facets those cuts unsewed
   double simulated = 0;             ///< s
   double wall = 0;                  ///< s, stepping and cuts (output excluded)
   double ms_per_step = 0;

@@ -119,6 +119,8 @@ class MssModel {
   [[nodiscard]] const Springs& springs() const { return *springs_; }
   [[nodiscard]] const Map& map() const { return map_; }
   [[nodiscard]] const std::vector<Element>& elements() const { return elements_; }
+  /// Number of elements not removed. O(1).
+  [[nodiscard]] Index num_live_elements() const { return live_elements_; }
   [[nodiscard]] const std::vector<MaterialParams>& materials() const { return materials_; }
   [[nodiscard]] const MssOptions& options() const { return options_; }
 
@@ -181,8 +183,12 @@ class MssModel {
   // local end vertex). Walks the element's darts from its canonical dart.
   template <class F>
   void for_each_local_dart(const Element& el, F&& f) const;
+  // Records, for every dart of element e, its local start vertex and local edge.
+  void index_darts(Index e);
   [[nodiscard]] double edge_stiffness(Dart edge_dart) const;
-  [[nodiscard]] double vertex_mass(Dart vertex_dart) const;
+  // Mass of a vertex cell, and (if springs is non-null) the springs at it: its edges' and the
+  // diagonals of its elements. One pass over the cell's darts.
+  [[nodiscard]] double vertex_mass(Dart vertex_dart, std::vector<Index>* springs = nullptr);
   void attach_diagonals(Index e);
   [[nodiscard]] Index end_node(Dart d) const;
   // The edge attributes around the vertex of v, duplicates possible. A boundary edge of a
@@ -203,8 +209,15 @@ class MssModel {
   std::vector<std::vector<std::uint32_t>> vertices_of_node_;  // 0-attributes naming each node
   std::vector<Index> node_of_point_;
   std::vector<std::uint32_t> point_of_node_;
+  // Per dart: its local start vertex in its element, and its local edge index with bit 7 set on
+  // one dart per element and edge, so that sums over an edge's darts count each element once.
+  std::vector<std::uint8_t> dart_vertex_, dart_edge_;
+  Index live_elements_ = 0;
   // touched since the last resync
   std::vector<std::uint32_t> dirty_vertices_, dirty_edges_;
+  // generation stamps: an index is listed once per resync without sorting
+  std::uint32_t generation_ = 0;
+  std::vector<std::uint32_t> seen_vertex_, seen_edge_, seen_element_, seen_node_, seen_spring_;
   std::vector<Index> dirty_elements_;
   std::string unsupported_;  // an edit the model cannot follow (element merge), reported by resync
 };

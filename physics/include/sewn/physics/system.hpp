@@ -48,7 +48,7 @@ class System {
   [[nodiscard]] const NodeTable& nodes() const { return nodes_; }
 
   /// Constructs a term of type T in place and returns it (the reference stays valid for the
-  /// System's lifetime). The pattern is rebuilt at the next refresh(). O(1).
+  /// System's lifetime). The pattern is rebuilt when next needed. O(1).
   template <class T, class... Args>
   T& add(Args&&... args) {
     static_assert(std::is_base_of_v<ForceTerm, T>);
@@ -62,11 +62,12 @@ class System {
   [[nodiscard]] std::span<const std::unique_ptr<ForceTerm>> terms() const { return terms_; }
 
   /// Makes the system consistent after edits: when nodes or any term changed topology, checks
-  /// every element's node references (InputError naming it) and rebuilds the pattern. Returns
-  /// true if it rebuilt. O(terms) when nothing changed, O(elements·log) otherwise.
+  /// every element's node references (InputError naming it) and marks the Jacobian pattern
+  /// stale. Returns true if the topology changed. O(terms) when nothing changed, else O(elements).
   bool refresh();
-  /// The Jacobian pattern and value storage, valid after refresh(). Integrators assemble into it.
-  [[nodiscard]] BlockMatrix& matrix() { return matrix_; }
+  /// The Jacobian pattern and value storage, (re)built first if the topology changed: only
+  /// integrators that assemble Jacobians pay for it. O(elements·log) after a change, else O(terms).
+  [[nodiscard]] BlockMatrix& matrix();
   [[nodiscard]] const BlockMatrix& matrix() const { return matrix_; }
 
   /// Sets the nodes' force array to the sum of all terms at the current state. Calls
@@ -105,7 +106,8 @@ class System {
   NodeTable nodes_;
   std::vector<std::unique_ptr<ForceTerm>> terms_;
   BlockMatrix matrix_;
-  std::uint64_t seen_topology_ = ~std::uint64_t{0};
+  std::uint64_t seen_topology_ = ~std::uint64_t{0};    // topology last checked by refresh()
+  std::uint64_t pattern_topology_ = ~std::uint64_t{0};  // topology the matrix pattern was built for
 };
 
 }  // namespace sewn::physics

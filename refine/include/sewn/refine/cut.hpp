@@ -44,8 +44,9 @@ template <int D>
 std::vector<Facet> inner_facets(const MssModel<D>& m);
 
 /// The inner facets given by their mesh point indices (3 or 4 per face, 2 per edge of a 2D
-/// mesh). Throws physics::InputError naming the first list that is not a facet between two
-/// elements (never was one, or was already cut). O(darts + faces).
+/// mesh); a facet an earlier cut already separated is skipped. Throws physics::InputError
+/// naming the first list that is no facet between two elements (no such face, or a boundary
+/// face). O(darts + faces).
 template <int D>
 std::vector<Facet> facets_with_points(const MssModel<D>& m, std::span<const std::vector<std::uint32_t>> faces);
 
