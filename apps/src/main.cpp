@@ -1,44 +1,187 @@
-// The `sewn` command-line tool.
+// The `sewn` command-line tool: run a scene, check a mesh, print the scene reference.
 #include <cstdio>
 #include <cstring>
 #include <exception>
 #include <iostream>
+#include <optional>
 #include <string>
+#include <vector>
 
+#include "sewn/apps/runner.hpp"
 #include "sewn/apps/scene.hpp"
+#include "sewn/cmap/build.hpp"
+#include "sewn/io/errors.hpp"
+#include "sewn/io/geometry.hpp"
+#include "sewn/io/read.hpp"
+#include "sewn/physics/errors.hpp"
 
 namespace {
+
+constexpr int ok = 0, run_failed = 1, bad_input = 2;
 
 constexpr const char* usage = R"(sewn: simulate deformable bodies whose topology changes while they move
 
 usage:
-  sewn scene-doc          print the scene file reference (Markdown; docs/scenes.md)
-  sewn --help             this text
+  sewn run [SCENE.json] [--out DIR] [--frames N] [--quiet]
+                          run a scene (with no scene: the built-in default, a cantilever
+                          beam sagging under gravity and cut part-way through)
+  sewn check MESH         load a mesh (.msh 2.2/4.1, .mesh, .vtk), check its geometry, build the
+                          combinatorial map and print its validation report and cell counts
+  sewn scene-doc          print the scene file reference (docs/scenes.md)
+  sewn --help | sewn <command> --help
 
 exit codes: 0 ok, 1 the run failed, 2 bad input
 )";
 
+constexpr const char* run_usage = R"(usage: sewn run [SCENE.json] [--out DIR] [--frames N] [--quiet]
+
+Runs a scene (docs/scenes.md) and writes, in DIR (default out/<scene name>/):
+  <name>.pvd + frame_NNNNN.vtu   the ParaView series (cells with material and refinement level;
+                                 per point velocity, force, displacement, fixed flags)
+  frames.csv                     per frame: time, kinetic/potential/elastic energy, particle,
+                                 spring and element counts, ms per step, CG iterations, cuts
+  <name>.png                     a picture of the last frame
+  --frames N   number of output frames (overrides the scene's output.frames)
+  --quiet      no progress bar and no summary line
+The progress bar is drawn only when standard error is a terminal.
+)";
+
+constexpr const char* check_usage = R"(usage: sewn check MESH
+
+Loads MESH (Gmsh .msh 2.2 or 4.1 ASCII, MEDIT .mesh, legacy VTK .vtk), lists every geometric
+problem (non-finite coordinates, inverted or degenerate cells), builds the combinatorial map
+and prints its validation report, cell counts, components and boundary. Exit 0 when the mesh
+is sound, 2 otherwise.
+)";
+
+int cmd_run(const std::vector<std::string>& args) {
+  std::optional<std::string> scene_path;
+  sewn::app::RunOptions opt;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--help" || a == "-h") {
+      std::fputs(run_usage, stdout);
+      return ok;
+    } else if (a == "--quiet" || a == "-q") {
+      opt.quiet = true;
+    } else if (a == "--out" || a == "--frames") {
+      if (i + 1 >= args.size()) {
+        std::fprintf(stderr, "sewn run: %s needs a value\n", a.c_str());
+        return bad_input;
+      }
+      const std::string& v = args[++i];
+      if (a == "--out") {
+        opt.out = v;
+      } else {
+        char* end = nullptr;
+        const long n = std::strtol(v.c_str(), &end, 10);
+        if (end == v.c_str() || *end != '\0' || n < 1 || n > 100000) {
+          std::fprintf(stderr, "sewn run: --frames needs a whole number between 1 and 100000, got '%s'\n", v.c_str());
+          return bad_input;
+        }
+        opt.frames = static_cast<std::uint32_t>(n);
+      }
+    } else if (!a.empty() && a[0] == '-') {
+      std::fprintf(stderr, "sewn run: unknown option '%s' (see sewn run --help)\n", a.c_str());
+      return bad_input;
+    } else if (scene_path) {
+      std::fprintf(stderr, "sewn run: one scene at a time (got '%s' and '%s')\n", scene_path->c_str(), a.c_str());
+      return bad_input;
+    } else {
+      scene_path = a;
+    }
+  }
+  const sewn::app::Scene scene = scene_path ? sewn::app::load_scene(*scene_path) : sewn::app::default_scene();
+  const sewn::app::RunSummary s = sewn::app::run(scene, opt);
+  if (!opt.quiet) {
+    std::printf("sewn: %s: %llu steps (%.4g s simulated) in %.3g s, %.3g ms/step, %u cut%s; %u frames in %s",
+                scene.name.c_str(), static_cast<unsigned long long>(s.steps), s.simulated, s.wall, s.ms_per_step, s.cuts,
+                s.cuts == 1 ? "" : "s", s.frames, s.out.string().c_str());
+    if (!s.picture.empty()) std::printf(" (picture: %s)", s.picture.string().c_str());
+    std::printf("\n");
+  }
+  return ok;
+}
+
+int cmd_check(const std::vector<std::string>& args) {
+  if (args.size() == 1 && (args[0] == "--help" || args[0] == "-h")) {
+    std::fputs(check_usage, stdout);
+    return ok;
+  }
+  if (args.size() != 1) {
+    std::fprintf(stderr, "usage: sewn check MESH (see sewn check --help)\n");
+    return bad_input;
+  }
+  const std::string& path = args[0];
+  const sewn::io::MeshFile file = sewn::io::read_mesh_file(path);
+  const sewn::IndexedMesh& mesh = file.mesh;
+  const auto by_dim = mesh.count_by_dimension();
+  std::printf("%s: %u points, %u cells (%u volumes, %u surface cells, %u segments)\n", path.c_str(), mesh.num_points(),
+              mesh.num_cells(), by_dim[3], by_dim[2], by_dim[1]);
+  bool sound = true;
+  const auto issues = sewn::io::find_geometry_issues(mesh, path);
+  for (const auto& issue : issues) std::printf("  geometry: %s\n", issue.message.c_str());
+  if (!issues.empty()) sound = false;
+  sewn::CMap<3, std::uint32_t> map;
+  sewn::BuildOptions bopt;
+  bopt.source = path;
+  const sewn::BuildResult built = sewn::build(map, mesh, bopt);
+  map.create_attributes<0>([&](sewn::Dart d) { return built.vertex_of_dart[d.index()]; });
+  const auto report = map.validate();
+  const auto n = map.count_all();
+  std::printf("map: %u darts; %u vertices, %u edges, %u faces, %u volumes; %u component%s; %zu boundary faces\n",
+              map.num_darts(), n[0], n[1], n[2], n[3], map.count_components(), map.count_components() == 1 ? "" : "s",
+              map.boundary_facets().size());
+  std::printf("sewing: %u facets glued, %u non-manifold facets left unsewn, %u edges with clashing orientation\n",
+              built.sewn_facets, built.nonmanifold_facets, built.unorientable_edges);
+  std::printf("validation: %s\n", report.str().c_str());
+  if (!report.ok()) sound = false;
+  return sound ? ok : bad_input;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string cmd = argc > 1 ? argv[1] : "--help";
+  const std::vector<std::string> all(argv + 1, argv + argc);
+  const std::string cmd = all.empty() ? "--help" : all[0];
+  const std::vector<std::string> args(all.begin() + (all.empty() ? 0 : 1), all.end());
   try {
     if (cmd == "--help" || cmd == "-h" || cmd == "help") {
       std::fputs(usage, stdout);
-      return 0;
+      return ok;
     }
+    if (cmd == "run") return cmd_run(args);
+    if (cmd == "check") return cmd_check(args);
     if (cmd == "scene-doc") {
       std::cout << "<!-- Generated by `sewn scene-doc` from the schema in apps/src/scene.cpp; do not edit by hand. -->\n\n"
                 << sewn::app::to_markdown(sewn::app::scene_schema(), "Scene files");
-      return 0;
+      return ok;
     }
     std::fprintf(stderr, "sewn: unknown command '%s'\n\n%s", cmd.c_str(), usage);
-    return 2;
+    return bad_input;
   } catch (const sewn::app::SceneError& e) {
+    std::fprintf(stderr, "sewn: bad scene: %s\n", e.what());
+    return bad_input;
+  } catch (const sewn::io::IoError& e) {
+    std::fprintf(stderr, "sewn: bad mesh file: %s\n", e.what());
+    return bad_input;
+  } catch (const sewn::MeshError& e) {
+    std::fprintf(stderr, "sewn: bad mesh: %s\n", e.what());
+    return bad_input;
+  } catch (const sewn::physics::InputError& e) {
+    std::fprintf(stderr, "sewn: bad input: %s\n", e.what());
+    return bad_input;
+  } catch (const sewn::physics::StabilityError& e) {
     std::fprintf(stderr, "sewn: %s\n", e.what());
-    return 2;
+    return bad_input;
+  } catch (const sewn::physics::BlowupError& e) {
+    std::fprintf(stderr, "sewn: the run failed: %s\n", e.what());
+    return run_failed;
+  } catch (const sewn::physics::SolverError& e) {
+    std::fprintf(stderr, "sewn: the run failed: %s\n", e.what());
+    return run_failed;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "sewn: %s\n", e.what());
-    return 1;
+    std::fprintf(stderr, "sewn: the run failed: %s\n", e.what());
+    return run_failed;
   }
 }

@@ -1,21 +1,25 @@
-// Builds a small hexahedral beam with the installed library and checks it.
+// Uses the installed library as an outside project would: a map, the mass-spring model on it,
+// a cut, an implicit step, and the io module (which brings cairo along).
 #include <cstdio>
 
 #include "sewn/cmap/build.hpp"
-#include "sewn/cmap/cmap.hpp"
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/render.hpp"
+#include "sewn/physics/integrators.hpp"
+#include "sewn/refine/cut.hpp"
 
 int main() {
-  sewn::CMap<3, std::uint32_t> map;
-  const auto mesh = sewn::hex_grid(3, 2, 2);
-  const auto built = sewn::build(map, mesh);
-  sewn::io::check_mesh_geometry(mesh, "consumer beam");  // links sewn::io and, through it, cairo
+  const auto mesh = sewn::hex_grid(3, 2, 2, {{0.1, 0.1, 0.1}, {}});
+  sewn::io::check_mesh_geometry(mesh, "consumer beam");
   (void)sewn::io::boundary_faces(sewn::io::CellsView::of(mesh));
-  map.create_attributes<0>([&](sewn::Dart d) { return built.vertex_of_dart[d.index()]; });
-  const auto report = map.validate();
-  const auto n = map.count_all();
-  std::printf("consumer: %u vertices, %u edges, %u faces, %u volumes, %s\n", n[0], n[1], n[2], n[3],
-              report.ok() ? "valid" : report.str().c_str());
-  return report.ok() && n[3] == 12 && n[0] == 36 ? 0 : 1;
+  sewn::physics::MssModel<3> beam(mesh, {{1e6, 0.3, 1000}}, {});
+  const auto faces = sewn::refine::facets_across_plane(beam, {0.1, 0, 0}, {1, 0, 0});  // the faces at x = 0.1
+  const auto cut = sewn::refine::cut(beam, faces);
+  sewn::physics::LinearlyImplicitEuler euler;
+  const auto step = euler.step(beam.system(), 1e-3);
+  const auto report = beam.map().validate();
+  const auto n = beam.map().count_all();
+  std::printf("consumer: %u vertices, %u volumes, %u components after cutting %u faces; CG %d iterations; %s\n", n[0],
+              n[3], beam.map().count_components(), cut.facets, step.cg_iterations, report.ok() ? "valid" : report.str().c_str());
+  return report.ok() && n[3] == 12 && cut.facets == 4 && beam.map().count_components() == 2 && step.cg_converged ? 0 : 1;
 }

@@ -27,6 +27,7 @@ struct BuildOptions {
   bool sew = true;                ///< glue cells that share a facet
   bool orient_surfaces = true;    ///< reverse 2D cells so that neighbours can be glued
   bool allow_nonmanifold = true;  ///< leave facets of 3+ cells unsewn (false: throw MeshError)
+  bool manifold_volumes = false;  ///< throw MeshError for a face of 3+ volumes even if the above allows it (solids)
   std::string source = "mesh";    ///< name used in error messages (a file name, say)
 };
 
@@ -252,7 +253,7 @@ BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOption
     if (count == 1) return;
     const bool volume = first->n != 2;
     if (count > 2) {
-      if (!opt.allow_nonmanifold)
+      if (!opt.allow_nonmanifold || (volume && opt.manifold_volumes))
         throw MeshError(opt.source + ": " + std::to_string(count) + " cells share one " + (volume ? "face" : "edge") +
                         ", among them " + describe(first->cell) + " and " + describe((first + 1)->cell) +
                         " (a non-manifold " + (volume ? "face" : "edge") + " where a manifold is required)");

@@ -1,0 +1,54 @@
+#pragma once
+// Running a scene: assembling its bodies into one mesh, building the mass-spring model on the
+// map, stepping it with scheduled cuts, and writing what a person opens afterwards (a ParaView
+// series, frames.csv, a picture of the last frame).
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sewn/apps/scene.hpp"
+#include "sewn/cmap/mesh.hpp"
+
+namespace sewn::app {
+
+/// All bodies of a scene in one mesh, each cell with its material index (materials in name order).
+struct Assembly {
+  IndexedMesh mesh;
+  std::vector<std::uint32_t> material_of_cell;
+  std::vector<std::string> material_names;
+  std::vector<std::uint32_t> first_cell;  ///< per scene mesh, its first cell in `mesh`
+};
+
+/// Generates or reads every mesh of the scene, places it, and assigns materials by region.
+/// Throws SceneError (scene values), io::IoError (files) or MeshError (geometry), each naming
+/// the mesh and what is wrong.
+Assembly assemble(const Scene& scene);
+
+struct RunOptions {
+  std::filesystem::path out;                 ///< empty: out/<scene name>/
+  std::optional<std::uint32_t> frames;       ///< overrides the scene's output frames
+  bool quiet = false;                        ///< no progress bar, no summary
+  bool progress = true;                      ///< draw the progress bar (only on a terminal)
+};
+
+struct RunSummary {
+  std::uint64_t steps = 0;
+  std::uint32_t frames = 0;         ///< frames written, frame 0 included
+  std::uint32_t cuts = 0;           ///< scheduled cuts applied
+  double simulated = 0;             ///< s
+  double wall = 0;                  ///< s, stepping and cuts (output excluded)
+  double ms_per_step = 0;
+  double kinetic_start = 0, kinetic_end = 0, kinetic_max = 0;  ///< J
+  std::filesystem::path out, pvd, csv, picture;
+};
+
+/// Runs the scene to its end. Throws SceneError / io errors / physics::InputError for bad input
+/// (exit 2), physics::StabilityError when a semi-implicit step is above its stable bound
+/// (exit 2: choose a smaller step), physics::BlowupError / SolverError when the run fails (exit 1).
+RunSummary run(const Scene& scene, const RunOptions& options);
+
+}  // namespace sewn::app

@@ -1,0 +1,215 @@
+#pragma once
+// MssModel<D>: the mass-spring system of the 2013 paper living on a combinatorial map (an
+// "LCC+MSS"). The map's 0-attributes hold node indices (particles), its 1-attributes edge-spring
+// indices, and the attributes of its volumes (D = 3) and faces (2D cells) element indices.
+// Particles, springs and elements live in dense arrays (the System's node table and Springs
+// term); the map is consulted only when the topology changes.
+//
+// Elements: hexahedra (Baudet box stiffness, 4 body diagonals), tetrahedra (van Gelder),
+// quads (Baudet rectangle, 2 diagonals) and triangles (van Gelder) with per-element material;
+// segments (polylines) are axial springs k = E·A/l. Masses are lumped ρ·measure/corners. An
+// edge spring's stiffness is the sum of its incident elements' contributions (PHYSICS_NOTES §1).
+//
+// Topology changes go through edit(): the map's split/merge/erase hooks create or retire
+// particles and springs, and the model then recomputes, from the elements that remain incident,
+// the masses of the touched particles, the stiffness and end particles of the touched springs,
+// the particles each diagonal spring is attached to (the paper's Fig. 6) and the per-spring
+// viscosities. Total mass is conserved up to the rounding of these sums.
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <type_traits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "sewn/cmap/build.hpp"
+#include "sewn/cmap/cmap.hpp"
+#include "sewn/cmap/mesh.hpp"
+#include "sewn/physics/basic_terms.hpp"
+#include "sewn/physics/errors.hpp"
+#include "sewn/physics/springs.hpp"
+#include "sewn/physics/system.hpp"
+
+namespace sewn::physics {
+
+/// Attribute values stored in the map.
+struct NodeRef {
+  Index node = invalid_index;
+};
+struct SpringRef {
+  Index spring = invalid_index;
+  Index segment = invalid_index;  ///< the element of a polyline segment (rods), else invalid_index
+};
+struct ElementRef {
+  Index element = invalid_index;
+};
+
+/// What to do with a box element whose Baudet edge stiffness is negative (an elongated box,
+/// PHYSICS_NOTES §1.2): refuse it with a message naming it, or drop its negative edge
+/// contributions (clamp them to 0: the diagonals then carry the load along the long axis).
+enum class ElongatedPolicy : std::uint8_t { refuse, clamp };
+
+struct MaterialParams {
+  double young = 0;       ///< E, Pa (> 0)
+  double poisson = 0.3;   ///< ν, in (-1, 0.5)
+  double density = 0;     ///< ρ, kg/m³ (> 0)
+  double thickness = 1;   ///< 2D cells: thickness, m (scales mass and stiffness)
+  double area = 1e-4;     ///< segments: cross-section, m²
+  ElongatedPolicy elongated = ElongatedPolicy::refuse;
+};
+
+enum class DampingModel : std::uint8_t {
+  none,
+  viscous,   ///< the 2013 paper's per-spring γ = 2√(k(mi+mj)/2), in forces and Jacobians
+  rayleigh,  ///< C = αM + βK, in forces and Jacobians
+};
+
+struct MssOptions {
+  DampingModel damping = DampingModel::viscous;
+  double rayleigh_alpha = 0;  ///< 1/s
+  double rayleigh_beta = 0;   ///< s
+  double environment = 0;     ///< drag −c·m·v, 1/s
+  Eigen::Vector3d gravity{0.0, 0.0, -9.81};
+  std::string source = "mesh";  ///< names the mesh in error messages
+};
+
+enum class ElementKind : std::uint8_t { hexahedron, tetrahedron, quad, triangle, segment };
+
+/// One element: its rest data and its contributions to the springs of its edges.
+struct Element {
+  ElementKind kind{};
+  bool alive = true;
+  std::uint32_t material = 0;
+  std::uint32_t mesh_cell = 0;  ///< index of the source mesh cell
+  Dart dart;                    ///< the dart starting at its local vertex 0 (to 1, or to the last vertex if reversed)
+  bool reversed = false;        ///< a 2D cell the builder reversed to orient its surface
+  double measure = 0;           ///< rest volume, area × thickness, or length × area
+  std::array<double, 12> edge_k{};  ///< stiffness contribution to each local edge (see local_edges())
+  double diagonal_k = 0;            ///< stiffness of each internal diagonal (hexahedra, quads)
+  std::array<Index, 4> diagonal{invalid_index, invalid_index, invalid_index, invalid_index};
+};
+
+template <int D>
+class MssModel {
+  static_assert(D == 2 || D == 3, "MssModel is defined for 2- and 3-maps");
+
+ public:
+  using Map = std::conditional_t<D == 3, CMap<3, NodeRef, SpringRef, ElementRef, ElementRef>,
+                                 CMap<2, NodeRef, SpringRef, ElementRef>>;
+
+  /// Builds the map and the mass-spring system of `mesh`. `material_of_cell` gives each mesh
+  /// cell's index into `materials` (empty: every cell uses materials[0]). Throws InputError
+  /// naming the cell for a degenerate element, a negative Baudet stiffness under the refuse
+  /// policy, a bad material or a cell the map cannot hold, and MeshError for a malformed mesh.
+  /// O(cells).
+  MssModel(const IndexedMesh& mesh, std::vector<MaterialParams> materials, std::vector<std::uint32_t> material_of_cell,
+           MssOptions options = {});
+  MssModel(const MssModel&) = delete;  // the map's hooks refer to this object
+  MssModel& operator=(const MssModel&) = delete;
+
+  [[nodiscard]] System& system() { return system_; }
+  [[nodiscard]] const System& system() const { return system_; }
+  [[nodiscard]] NodeTable& nodes() { return system_.nodes(); }
+  [[nodiscard]] const NodeTable& nodes() const { return system_.nodes(); }
+  [[nodiscard]] Springs& springs() { return *springs_; }
+  [[nodiscard]] const Springs& springs() const { return *springs_; }
+  [[nodiscard]] const Map& map() const { return map_; }
+  [[nodiscard]] const std::vector<Element>& elements() const { return elements_; }
+  [[nodiscard]] const std::vector<MaterialParams>& materials() const { return materials_; }
+  [[nodiscard]] const MssOptions& options() const { return options_; }
+
+  /// Changes the topology: f(map) runs with the hooks installed, then the physics is brought
+  /// back in line (resync). Returns what f returns. Cost: f plus O(touched cells).
+  template <class F>
+  decltype(auto) edit(F&& f) {
+    try {
+      if constexpr (std::is_void_v<std::invoke_result_t<F, Map&>>) {
+        f(map_);
+        resync();
+      } else {
+        decltype(auto) result = f(map_);
+        resync();
+        return result;
+      }
+    } catch (...) {
+      // a failed map operation leaves the map unchanged, but earlier ones in f may have fired
+      // hooks: bring the physics in line with whatever the map now is
+      resync();
+      throw;
+    }
+  }
+
+  /// The node of mesh point p, as built (before any cut): invalid_index for unused points.
+  [[nodiscard]] Index node_of_point(std::uint32_t p) const { return p < node_of_point_.size() ? node_of_point_[p] : invalid_index; }
+  /// The node carried by the vertex of dart d.
+  [[nodiscard]] Index node_of(Dart d) const { return map_.value(map_.template attribute<0>(d)).node; }
+  /// The spring carried by the edge of dart d.
+  [[nodiscard]] Index spring_of(Dart d) const { return map_.value(map_.template attribute<1>(d)).spring; }
+  /// The element of the cell of dart d (its volume in 3D, else its face; invalid_index if none).
+  [[nodiscard]] Index element_of(Dart d) const;
+  /// Rest position of node i.
+  [[nodiscard]] Eigen::Vector3d rest_position(Index i) const { return rest_[i]; }
+  /// The mesh point node i stands for (a particle duplicated by a cut keeps its original's).
+  [[nodiscard]] std::uint32_t point_of_node(Index i) const { return point_of_node_[i]; }
+  /// Σ ρ·measure over live elements: what the node masses must add up to.
+  [[nodiscard]] double element_mass() const;
+  /// Σ of live node masses.
+  [[nodiscard]] double node_mass() const;
+  /// Nodes of element e's corners, in its local (VTK) order.
+  [[nodiscard]] std::vector<Index> element_nodes(Index e) const;
+  /// Rest centroid of element e.
+  [[nodiscard]] Eigen::Vector3d element_centroid(Index e) const;
+  /// Local edges of a kind, as (local vertex, local vertex), in the order of Element::edge_k.
+  static std::span<const std::array<std::uint8_t, 2>> local_edges(ElementKind k);
+
+  /// Recomputes the physics of every cell touched since the last resync (edit() calls it).
+  void resync();
+  /// Drops removed particles and springs from the arrays, renumbering the rest and the map's
+  /// attributes. Invalidates node and spring indices held by the caller (node_of_point() is
+  /// kept up to date). O(particles + springs + attributes).
+  void compact();
+
+ private:
+  void build_elements(const IndexedMesh& mesh, const BuildResult& built, const std::vector<std::uint32_t>& material_of_cell);
+  void install_hooks();
+  Element make_element(const IndexedMesh& mesh, std::uint32_t cell, std::uint32_t material, Dart dart) const;
+  // For each dart of element e, its local half-edge start vertex; calls f(dart, local vertex,
+  // local end vertex). Walks the element's darts from its canonical dart.
+  template <class F>
+  void for_each_local_dart(const Element& el, F&& f) const;
+  [[nodiscard]] double edge_stiffness(Dart edge_dart) const;
+  [[nodiscard]] double vertex_mass(Dart vertex_dart) const;
+  void attach_diagonals(Index e);
+  [[nodiscard]] Index end_node(Dart d) const;
+  // The edge attributes around the vertex of v, duplicates possible. A boundary edge of a
+  // surface has a single dart, which may end at v: hence the β0 predecessors too.
+  [[nodiscard]] std::vector<std::uint32_t> edges_at(Dart v) const;
+  template <int I>
+  [[nodiscard]] bool attr_alive(std::uint32_t a) const {
+    return map_.template attribute_container<I>().is_alive(a);
+  }
+
+  Map map_;
+  System system_;
+  Springs* springs_ = nullptr;
+  std::vector<MaterialParams> materials_;
+  MssOptions options_;
+  std::vector<Element> elements_;
+  std::vector<Eigen::Vector3d> rest_;            // rest position per node
+  std::vector<std::vector<std::uint32_t>> vertices_of_node_;  // 0-attributes naming each node
+  std::vector<Index> node_of_point_;
+  std::vector<std::uint32_t> point_of_node_;
+  // touched since the last resync
+  std::vector<std::uint32_t> dirty_vertices_, dirty_edges_;
+  std::vector<Index> dirty_elements_;
+  std::string unsupported_;  // an edit the model cannot follow (element merge), reported by resync
+};
+
+extern template class MssModel<2>;
+extern template class MssModel<3>;
+
+}  // namespace sewn::physics

@@ -1,0 +1,226 @@
+#include "sewn/refine/cut.hpp"
+
+#include <algorithm>
+#include <map>
+#include <set>
+#include <string>
+
+namespace sewn::refine {
+
+using physics::ElementKind;
+using physics::InputError;
+using physics::invalid_index;
+using Vec3 = Eigen::Vector3d;
+
+namespace {
+
+bool is_volume(ElementKind k) { return k == ElementKind::hexahedron || k == ElementKind::tetrahedron; }
+bool is_surface(ElementKind k) { return k == ElementKind::quad || k == ElementKind::triangle; }
+
+// The darts of a facet on one side: a face's β1 cycle, or the single dart of an edge.
+template <int D>
+std::vector<Dart> facet_darts(const MssModel<D>& m, const Facet& f) {
+  std::vector<Dart> out{f.dart};
+  if (f.index == 3)
+    for (Dart x = m.map().beta(f.dart, 1); x && x != f.dart; x = m.map().beta(x, 1)) out.push_back(x);
+  return out;
+}
+
+// Sorted mesh points of a facet (through the particles' original points).
+template <int D>
+std::vector<std::uint32_t> facet_points(const MssModel<D>& m, const Facet& f) {
+  std::vector<std::uint32_t> pts;
+  for (Dart x : facet_darts(m, f)) pts.push_back(m.point_of_node(m.node_of(x)));
+  if (f.index == 2) pts.push_back(m.point_of_node(m.node_of(m.map().beta(f.dart, 2))));
+  std::sort(pts.begin(), pts.end());
+  return pts;
+}
+
+template <int D>
+Vec3 facet_centroid(const MssModel<D>& m, const Facet& f) {
+  Vec3 c = Vec3::Zero();
+  std::size_t n = 0;
+  for (Dart x : facet_darts(m, f)) {
+    c += m.rest_position(m.node_of(x));
+    ++n;
+  }
+  if (f.index == 2) {
+    c += m.rest_position(m.node_of(m.map().beta(f.dart, 2)));
+    ++n;
+  }
+  return c / static_cast<double>(n);
+}
+
+std::string point_list(std::span<const std::uint32_t> pts) {
+  std::string s;
+  for (std::uint32_t p : pts) s += (s.empty() ? "" : " ") + std::to_string(p);
+  return s;
+}
+
+template <int D>
+struct Counts {
+  std::int64_t particles, springs, elements;
+  explicit Counts(const MssModel<D>& m)
+      : particles(m.nodes().num_alive()), springs(m.springs().num_alive()), elements(std::count_if(
+            m.elements().begin(), m.elements().end(), [](const physics::Element& e) { return e.alive; })) {}
+};
+
+template <int D>
+CutReport difference(const Counts<D>& before, const MssModel<D>& m, std::uint32_t facets) {
+  const Counts<D> after(m);
+  return {facets, after.particles - before.particles, after.springs - before.springs, after.elements - before.elements};
+}
+
+}  // namespace
+
+template <int D>
+std::vector<Facet> inner_facets(const MssModel<D>& m) {
+  std::vector<Facet> out;
+  const auto& map = m.map();
+  if constexpr (D == 3) {
+    // faces between two volume elements
+    for (Dart d : map.template cells<2>())
+      if (map.beta(d, 3) && map.template attribute<3>(d) && map.template attribute<3>(map.beta(d, 3))) out.push_back({d, 3});
+  }
+  // edges between two 2D elements: β2 joins two face elements (never the faces of one volume)
+  for (Dart d : map.template cells<1>()) {
+    for (Dart x : map.template cell<1>(d)) {
+      const Dart y = map.beta(x, 2);
+      if (!y || !map.template attribute<2>(x) || !map.template attribute<2>(y)) continue;
+      if constexpr (D == 3)
+        if (map.template attribute<3>(x)) continue;
+      out.push_back({x, 2});
+      break;
+    }
+  }
+  return out;
+}
+
+template <int D>
+std::vector<Facet> facets_with_points(const MssModel<D>& m, std::span<const std::vector<std::uint32_t>> faces) {
+  std::map<std::vector<std::uint32_t>, Facet> by_points;
+  for (const Facet& f : inner_facets(m)) by_points.emplace(facet_points(m, f), f);
+  std::vector<Facet> out;
+  for (std::size_t k = 0; k < faces.size(); ++k) {
+    std::vector<std::uint32_t> key = faces[k];
+    std::sort(key.begin(), key.end());
+    const auto it = by_points.find(key);
+    if (it == by_points.end())
+      throw InputError("face " + std::to_string(k) + " (points " + point_list(faces[k]) +
+                       ") is not a face between two elements: it does not exist, lies on the boundary, or is already cut");
+    out.push_back(it->second);
+  }
+  return out;
+}
+
+template <int D>
+std::vector<Facet> facets_across_plane(const MssModel<D>& m, const Vec3& point, const Vec3& normal, const Region& within) {
+  if (!(normal.norm() > 0) || !normal.allFinite() || !point.allFinite())
+    throw InputError("facets_across_plane: the plane needs a finite point and a non-zero normal");
+  std::vector<Facet> out;
+  for (const Facet& f : inner_facets(m)) {
+    const double a = normal.dot(m.element_centroid(m.element_of(f.dart)) - point);
+    const double b = normal.dot(m.element_centroid(m.element_of(m.map().beta(f.dart, f.index))) - point);
+    if (!((a < 0 && b > 0) || (a > 0 && b < 0))) continue;
+    if (within && !within(facet_centroid(m, f))) continue;
+    out.push_back(f);
+  }
+  return out;
+}
+
+template <int D>
+std::vector<Facet> facets_among_points(const MssModel<D>& m, std::span<const std::uint32_t> points) {
+  std::vector<std::uint32_t> sorted(points.begin(), points.end());
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<Facet> out;
+  for (const Facet& f : inner_facets(m)) {
+    const auto pts = facet_points(m, f);
+    if (std::all_of(pts.begin(), pts.end(), [&](std::uint32_t p) { return std::binary_search(sorted.begin(), sorted.end(), p); }))
+      out.push_back(f);
+  }
+  return out;
+}
+
+template <int D>
+std::vector<Index> elements_in(const MssModel<D>& m, const Region& region) {
+  std::vector<Index> out;
+  for (Index e = 0; e < m.elements().size(); ++e) {
+    const physics::Element& el = m.elements()[e];
+    if (el.alive && (is_volume(el.kind) || is_surface(el.kind)) && region(m.element_centroid(e))) out.push_back(e);
+  }
+  return out;
+}
+
+template <int D>
+CutReport cut(MssModel<D>& m, std::span<const Facet> facets) {
+  const Counts<D> before(m);
+  std::uint32_t done = 0;
+  m.edit([&](auto& map) {
+    for (const Facet& f : facets) {
+      if (!map.is_alive(f.dart) || !map.beta(f.dart, f.index)) continue;  // already separated
+      if (f.index == 3) {
+        if constexpr (D == 3) map.template unsew<3>(f.dart);
+      } else {
+        map.template unsew<2>(f.dart);
+      }
+      ++done;
+    }
+  });
+  return difference(before, m, done);
+}
+
+template <int D>
+CutReport pierce(MssModel<D>& m, std::span<const Index> elements, bool remove) {
+  for (Index e : elements)
+    if (e >= m.elements().size() || !m.elements()[e].alive)
+      throw InputError("pierce: element " + std::to_string(e) + " does not exist or was already removed");
+  const Counts<D> before(m);
+  std::uint32_t done = 0;
+  const std::set<Index> chosen(elements.begin(), elements.end());
+  m.edit([&](auto& map) {
+    for (Index e : elements) {
+      const physics::Element& el = m.elements()[e];
+      const int index = is_volume(el.kind) ? 3 : 2;
+      // every facet that joins the element to one not chosen: the chosen elements come out as
+      // one piece (the paper's 3 cubes freed by 14 faces)
+      DartList darts;
+      if (index == 2)
+        darts = map.template cell<2>(el.dart);
+      else if constexpr (D == 3)
+        darts = map.template cell<3>(el.dart);
+      for (Dart x : darts) {
+        const Dart y = map.beta(x, index);
+        if (!y || chosen.count(m.element_of(y))) continue;
+        if (index == 3) {
+          if constexpr (D == 3) map.template unsew<3>(x);
+        } else {
+          map.template unsew<2>(x);
+        }
+        ++done;
+      }
+    }
+    if (remove)
+      for (Index e : elements) {
+        const Dart d = m.elements()[e].dart;
+        if (!map.is_alive(d)) continue;  // removed with a chosen neighbour
+        // the freed piece is a connected component now: erase all of it
+        for (Dart x : map.component(d))
+          if (map.is_alive(x)) map.template remove_cell<D>(x);
+      }
+  });
+  if (remove) m.compact();
+  return difference(before, m, done);
+}
+
+#define SEWN_REFINE_INSTANTIATE(D)                                                                                        \
+  template std::vector<Facet> inner_facets(const MssModel<D>&);                                                           \
+  template std::vector<Facet> facets_with_points(const MssModel<D>&, std::span<const std::vector<std::uint32_t>>);        \
+  template std::vector<Facet> facets_across_plane(const MssModel<D>&, const Vec3&, const Vec3&, const Region&);           \
+  template std::vector<Facet> facets_among_points(const MssModel<D>&, std::span<const std::uint32_t>);                    \
+  template std::vector<Index> elements_in(const MssModel<D>&, const Region&);                                             \
+  template CutReport cut(MssModel<D>&, std::span<const Facet>);                                                           \
+  template CutReport pierce(MssModel<D>&, std::span<const Index>, bool);
+SEWN_REFINE_INSTANTIATE(2)
+SEWN_REFINE_INSTANTIATE(3)
+
+}  // namespace sewn::refine
