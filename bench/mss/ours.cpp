@@ -2,42 +2,47 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+
+#include "sewn/physics/mss_model.hpp"
 
 namespace sewn::bench::mss {
 
 using physics::Index;
 
-// Until sewn::physics::MssModel (the system built on the combinatorial map) is on main, "ours"
-// is the library's System filled from mass_spring(): the same nodes, springs, gravity and drag
-// terms and the same integrators, without the map.
+// The library's mass-spring system living on the combinatorial map (physics::MssModel<3>): the
+// map's attributes name the particles and springs, which live in a physics::System stepped by
+// the library's integrators. The suite fixes the clamped points on its node table.
 struct Ours::Impl {
-  physics::System sys;
-  physics::Springs* springs = nullptr;
+  std::unique_ptr<physics::MssModel<3>> model;
   std::vector<Index> node_of_point;
   std::vector<double> saved_x, saved_v;
+  physics::System& sys;
+  physics::Springs* springs;
 
-  explicit Impl(const ModelSpec& spec) {
-    const MassSpring ms = mass_spring(spec);
-    physics::NodeTable& nodes = sys.nodes();
-    nodes.reserve(static_cast<Index>(spec.mesh.num_points()));
-    for (std::uint32_t p = 0; p < spec.mesh.num_points(); ++p) {
-      const Point3& x = spec.mesh.points[p];
-      node_of_point.push_back(nodes.add({x[0], x[1], x[2]}, Eigen::Vector3d::Zero(), ms.mass[p]));
-    }
-    springs = &sys.add<physics::Springs>(physics::SpringDamping::viscous);
-    springs->reserve(static_cast<Index>(ms.springs()));
-    for (std::size_t s = 0; s < ms.springs(); ++s)
-      springs->add(node_of_point[ms.i[s]], node_of_point[ms.j[s]], ms.k[s], ms.l[s],
-                   s < ms.edges ? physics::SpringKind::edge : physics::SpringKind::diagonal, ms.gamma[s]);
-    sys.add<physics::Gravity>(Eigen::Vector3d(spec.gravity[0], spec.gravity[1], spec.gravity[2]));
-    if (spec.environment > 0) sys.add<physics::MassDamping>(spec.environment);
+  explicit Impl(const ModelSpec& spec) : model(build(spec)), sys(model->system()), springs(&model->springs()) {
+    for (std::uint32_t p = 0; p < spec.mesh.num_points(); ++p) node_of_point.push_back(model->node_of_point(p));
     for (std::uint32_t p = 0; p < spec.fixed.size(); ++p)
-      if (spec.fixed[p] != 0) nodes.fix(node_of_point[p]);
+      if (spec.fixed[p] != 0) sys.nodes().fix(node_of_point[p]);
     sys.refresh();
+  }
+
+  static std::unique_ptr<physics::MssModel<3>> build(const ModelSpec& spec) {
+    physics::MaterialParams material;
+    material.young = spec.material.young;
+    material.poisson = spec.material.poisson;
+    material.density = spec.material.density;
+    physics::MssOptions options;
+    options.damping = physics::DampingModel::viscous;  // the seed's per-spring viscosity
+    options.environment = spec.environment;
+    options.gravity = Eigen::Vector3d(spec.gravity[0], spec.gravity[1], spec.gravity[2]);
+    options.source = spec.name;
+    return std::make_unique<physics::MssModel<3>>(spec.mesh, std::vector<physics::MaterialParams>{material},
+                                                  std::vector<std::uint32_t>{}, options);
   }
 };
 
-const char* Ours::builder() { return "physics::System filled from the mesh (MssModel not yet on main)"; }
+const char* Ours::builder() { return "physics::MssModel<3> (the system built on the combinatorial map)"; }
 
 Ours::Ours(const ModelSpec& spec) : impl_(std::make_unique<Impl>(spec)) { save(); }
 Ours::~Ours() = default;

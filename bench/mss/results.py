@@ -153,11 +153,22 @@ def run_label(case):
     return "semi-implicit", None
 
 
-def pareto(points):
-    """Indices of the points (x, y) not dominated (no other point has x' ≤ x and y' ≤ y, one strictly)."""
+def pareto(points, rel_tol=1e-3):
+    """Indices of the points (error, cost) no other point dominates: j dominates i if its error is
+    no larger and its cost no larger, one of them strictly. Errors within rel_tol of each other
+    count as equal: runs of one resolution settle on the same equilibrium to about 1e-6, and the
+    extrapolated reference is itself uncertain by about 1e-3 (see derive)."""
     front = []
     for i, (x, y) in enumerate(points):
-        dominated = any((x2 <= x and y2 <= y and (x2 < x or y2 < y)) for j, (x2, y2) in enumerate(points) if j != i)
+        dominated = False
+        for j, (x2, y2) in enumerate(points):
+            if j == i:
+                continue
+            no_worse = x2 <= x * (1 + rel_tol) and y2 <= y
+            better = x2 < x * (1 - rel_tol) or y2 < y
+            if no_worse and better:
+                dominated = True
+                break
         if not dominated:
             front.append(i)
     return front
