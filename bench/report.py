@@ -16,6 +16,13 @@ written, so a broken operation cannot leave a fast-looking number behind.
 The published sidecar maps a case to a paper's figure:
     {"hex32/step": {"published": 0.55, "source": "seed 002, Table 1", "metric": "ms"}}
 ("metric" defaults to the case's time unit).
+
+A counter whose name starts with "_" is a fact for a suite's scripts (a mesh size, a step),
+not a row. A suite may also pass --derived, the output of its bench/<suite>/derive script
+(run by bench/run.sh on the same raw results): {"rows": [...], "sections": [{"title": ...,
+"markdown": ...}]}. Its rows (the same shape as ours: slopes, ratios, values computed from
+several benchmarks) join the table and the JSON; its sections (summaries, goal checks) are
+printed after the header. --notes adds a suite's static method notes at the end.
 """
 
 import argparse
@@ -80,7 +87,7 @@ def collect(raw, suite):
         if b.get("label"):
             r["label"] = b["label"]
         for k, v in b.items():
-            if k not in STANDARD_FIELDS and isinstance(v, (int, float)):
+            if k not in STANDARD_FIELDS and not k.startswith("_") and isinstance(v, (int, float)):
                 r["counters"].setdefault(k, []).append(v)
     if not runs:
         fail("no benchmark ran")
@@ -147,7 +154,25 @@ def fmt(v):
     return f"{v:.3g}"
 
 
-def markdown(suite, header, rows, reps, scale, date, plots, written):
+ROW_KEYS = ("case", "metric", "ours", "peer", "peer_name", "published", "source")
+
+
+def load_derived(path):
+    """Rows and sections a suite's derive script computed; checked for the shared row shape."""
+    with open(path, encoding="utf-8") as f:
+        derived = json.load(f)
+    rows = derived.get("rows", [])
+    for r in rows:
+        if set(r) != set(ROW_KEYS):
+            fail(f"{path}: derived row {r} does not have exactly the keys {list(ROW_KEYS)}")
+    sections = derived.get("sections", [])
+    for sec in sections:
+        if not isinstance(sec.get("title"), str) or not isinstance(sec.get("markdown"), str):
+            fail(f"{path}: a derived section needs a 'title' and a 'markdown' string")
+    return rows, sections
+
+
+def markdown(suite, header, rows, reps, scale, date, plots, written, sections=(), notes=None):
     out = [f"# {suite} benchmarks" + ("" if scale == "full" else f" ({scale} sizes)"), ""]
     if written:
         out += [f"Written by `bench/run.sh {suite}`: regenerate, never edit.", ""]
@@ -158,6 +183,8 @@ def markdown(suite, header, rows, reps, scale, date, plots, written):
                "run; times are CPU time of the benchmark thread.")
     out.append("- ours/peer and ours/published below 1 favour ours, except for metrics marked "
                "\"higher is better\".")
+    for sec in sections:
+        out += ["", f"## {sec['title']}", "", sec["markdown"].rstrip("\n")]
     groups = {}
     for r in rows:
         groups.setdefault(r["peer_name"], []).append(r)
@@ -172,6 +199,8 @@ def markdown(suite, header, rows, reps, scale, date, plots, written):
     if plots:
         out += ["", "## Plots", ""]
         out += [f"![{os.path.basename(p)}]({os.path.basename(p)})" for p in plots]
+    if notes:
+        out += ["", notes.rstrip("\n")]
     return "\n".join(out) + "\n"
 
 
@@ -181,6 +210,8 @@ def main():
     ap.add_argument("--raw", required=True, help="Google Benchmark JSON output")
     ap.add_argument("--published", help="the suite's published.json, if any")
     ap.add_argument("--plot", action="append", default=[], help="an SVG written beside the report")
+    ap.add_argument("--derived", help="rows and sections from the suite's derive script (JSON)")
+    ap.add_argument("--notes", help="the suite's method notes (markdown), appended to the report")
     dest = ap.add_mutually_exclusive_group(required=True)
     dest.add_argument("--out-dir", help="write <suite>.md and <suite>.json here")
     dest.add_argument("--print", action="store_true", help="print the table, write nothing")
@@ -196,6 +227,14 @@ def main():
     ctx = raw.get("context", {})
     runs = collect(raw, args.suite)
     rows = build_rows(runs, published)
+    sections = []
+    if args.derived:
+        extra, sections = load_derived(args.derived)
+        rows += extra
+    notes = None
+    if args.notes:
+        with open(args.notes, encoding="utf-8") as f:
+            notes = f.read()
     cpus = ctx.get("num_cpus") or os.cpu_count()
     header = {
         "suite": args.suite,
@@ -205,7 +244,7 @@ def main():
     reps = max(len(r["time"]) for r in runs.values())
     date = ctx.get("date") or datetime.now().isoformat(timespec="seconds")
     md = markdown(args.suite, header, rows, reps, ctx.get("sewn_scale", "full"), date, args.plot,
-                  written=not args.print)
+                  written=not args.print, sections=sections, notes=notes)
     if args.print:
         sys.stdout.write(md)
         return

@@ -21,7 +21,10 @@
 #
 # A suite may add bench/<suite>/published.json (published figures, see bench/report.py) and an
 # executable bench/<suite>/plot hook, run as `plot RAW.json OUT_DIR` after the benchmarks, which
-# writes OUT_DIR/<suite>-*.svg with gnuplot; the report links those plots.
+# writes OUT_DIR/<suite>-*.svg with gnuplot; the report links those plots. An executable
+# bench/<suite>/derive, run as `derive RAW.json`, prints rows and sections computed from several
+# benchmarks (fitted slopes, goal checks; see bench/report.py), and bench/<suite>/notes.md holds
+# the suite's method notes; the report includes both.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -97,7 +100,14 @@ for s in "${suites[@]}"; do
     "bench/$s/plot" "$raw" "$out"
     for p in "$out/$s"-*.svg; do [[ -e "$p" ]] && plots+=(--plot "$p"); done
   fi
-  report=(python3 bench/report.py --suite "$s" --raw "$raw" --published "bench/$s/published.json" "${plots[@]}")
+  extra=()
+  if [[ -x "bench/$s/derive" ]]; then
+    "bench/$s/derive" "$raw" >"$tmp/$s.derived.json"
+    extra+=(--derived "$tmp/$s.derived.json")
+  fi
+  [[ -f "bench/$s/notes.md" ]] && extra+=(--notes "bench/$s/notes.md")
+  report=(python3 bench/report.py --suite "$s" --raw "$raw" --published "bench/$s/published.json" "${plots[@]}"
+          "${extra[@]}")
   if [[ $mode == small ]]; then
     "${report[@]}" --print
   else

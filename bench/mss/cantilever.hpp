@@ -1,0 +1,18 @@
+#pragma once
+// Speed against error on a cantilever under gravity (PHYSICS_NOTES §4): L = 1 m, b = h = 0.1 m,
+// E = 100 MPa, ν = 0.3, ρ = 1000 kg/m³, g = 9.81 m/s², clamped at x = 0, meshed as 10N×N×N
+// cubes. Registered by mss.cpp after the cost cases.
+//   mss/cantilever/static/N<n>/ours          the MSS's own static equilibrium (the reference
+//                                            family): time of the solve, tip deflection
+//   mss/cantilever/N<n>/<integrator>/ours    a damped dynamic run from rest to rest: time of
+//                                            the run, per step, per simulated second, tip
+// The derive script (bench/mss/derive) turns the tips into errors against the extrapolated
+// reference and draws the Pareto plot.
+
+#include "sewn_bench.hpp"
+
+namespace sewn::bench::mss {
+
+void register_cantilever(Scale scale);
+
+}  // namespace sewn::bench::mss
