@@ -74,6 +74,39 @@ void check_material(const MaterialParams& m, std::size_t i) {
     throw InputError(name + ": Poisson's ratio must be in (-1, 0.5) (got " + std::to_string(m.poisson) + ")");
 }
 
+// For each local vertex of a polyhedron, the shortest sequence of β1 / β2 steps from the
+// canonical dart (the template's `first` half-edge) to a dart starting at that vertex: corners
+// are then found in a few link reads instead of walking the whole volume.
+using CornerPaths = std::array<std::vector<std::uint8_t>, 8>;
+CornerPaths corner_paths(const CellTemplate& t) {
+  const std::size_t n = t.from.size();
+  std::vector<std::uint32_t> next(n), face_of(n);
+  for (std::size_t h = 0, f = 0; f < t.face_size.size(); h += t.face_size[f], ++f)
+    for (std::uint32_t k = 0; k < t.face_size[f]; ++k) next[h + k] = static_cast<std::uint32_t>(h + (k + 1) % t.face_size[f]);
+  std::vector<std::vector<std::uint8_t>> path(n);
+  std::vector<char> seen(n, 0);
+  std::vector<std::uint32_t> queue{t.first};
+  seen[t.first] = 1;
+  for (std::size_t q = 0; q < queue.size(); ++q) {
+    const std::uint32_t h = queue[q];
+    for (auto [op, g] : {std::pair<std::uint8_t, std::uint32_t>{1, next[h]}, {2, t.mate[h]}}) {
+      if (seen[g]) continue;
+      seen[g] = 1;
+      path[g] = path[h];
+      path[g].push_back(op);
+      queue.push_back(g);
+    }
+  }
+  CornerPaths out;
+  std::array<bool, 8> found{};
+  for (std::uint32_t h : queue)  // breadth-first order: the first half-edge met per vertex is nearest
+    if (!found[t.from[h]]) {
+      found[t.from[h]] = true;
+      out[t.from[h]] = path[h];
+    }
+  return out;
+}
+
 template <class V, class T>
 void erase_value(V& v, T x) {
   v.erase(std::remove(v.begin(), v.end(), x), v.end());
@@ -282,6 +315,14 @@ void MssModel<D>::build_elements(const IndexedMesh& mesh, const BuildResult& bui
     attach_diagonals(e);
   }
   if (options_.damping == DampingModel::viscous) springs_->set_paper_viscosity(nodes.masses());
+  // Cuts add particles and springs: headroom now spares a cut the reallocation of every array
+  // (and its page faults), and the stamp vectors are sized once.
+  nodes.reserve(nodes.size() + nodes.size() / 4 + 16);
+  springs_->reserve(springs_->size() + springs_->size() / 4 + 16);
+  for (auto* v : {&seen_node_, &seen_spring_}) v->assign(nodes.size() + springs_->size(), 0u);
+  seen_element_.assign(elements_.size(), 0u);
+  seen_vertex_.assign(map_.template attribute_container<0>().capacity() + 16, 0u);
+  seen_edge_.assign(map_.template attribute_container<1>().capacity() + 16, 0u);
 
   // 4) fields
   if (options_.gravity.squaredNorm() > 0) system_.template add<Gravity>(options_.gravity);
@@ -362,12 +403,13 @@ std::vector<std::uint32_t> MssModel<D>::edges_at(Dart v) const {
 
 template <int D>
 Index MssModel<D>::element_of(Dart d) const {
+  constexpr std::uint32_t null = Dart::null_index;
   if constexpr (D == 3) {
-    const AttrId<3> v = map_.template attribute<3>(d);
-    if (v) return map_.value(v).element;
+    const std::uint32_t v = map_.template attribute_index<3>(d.index());
+    if (v != null) return map_.template attribute_container<3>().value(v).element;
   }
-  const AttrId<2> f = map_.template attribute<2>(d);
-  return f ? map_.value(f).element : invalid_index;
+  const std::uint32_t f = map_.template attribute_index<2>(d.index());
+  return f != null ? map_.template attribute_container<2>().value(f).element : invalid_index;
 }
 
 template <int D>
@@ -385,26 +427,47 @@ void MssModel<D>::index_darts(Index e) {
 }
 
 template <int D>
+template <class F>
+void MssModel<D>::for_each_edge_dart(std::uint32_t d, F&& f) const {
+  // An edge's darts are linked by β2 and β3 only, which alternate along a path or a cycle:
+  // walk it both ways from d, no marks needed.
+  constexpr std::uint32_t null = Dart::null_index;
+  f(d);
+  int j = 2;
+  std::uint32_t x = map_.b(d, j);
+  for (; x != null && x != d; x = map_.b(x, j)) {
+    f(x);
+    if constexpr (D == 3) j = 5 - j;
+  }
+  if (x == d) return;  // a cycle
+  if constexpr (D == 3)
+    for (std::uint32_t y = map_.b(d, 3), jj = 2; y != null; y = map_.b(y, static_cast<int>(jj)), jj = 5 - jj) f(y);
+}
+
+template <int D>
 double MssModel<D>::edge_stiffness(Dart edge_dart) const {
   double k = 0;
-  const SpringRef& ref = map_.value(map_.template attribute<1>(edge_dart));
+  const SpringRef& ref = map_.template attribute_container<1>().value(map_.template attribute_index<1>(edge_dart.index()));
   if (ref.segment != invalid_index && elements_[ref.segment].alive) k += elements_[ref.segment].edge_k[0];
-  for (Dart y : map_.template cell<1>(edge_dart)) {
-    const std::uint8_t code = dart_edge_[y.index()];
-    if (!(code & 0x80)) continue;
-    const Index e = element_of(y);  // segments carry none: counted above through their spring
+  auto add = [&](std::uint32_t y) {
+    const std::uint8_t code = dart_edge_[y];
+    if (!(code & 0x80)) return;
+    const Index e = element_of(Dart(y));  // segments carry none: counted above through their spring
     if (e != invalid_index && elements_[e].alive) k += elements_[e].edge_k[code & 0x7f];
-  }
+  };
+  for_each_edge_dart(edge_dart.index(), add);
   return k;
 }
 
 template <int D>
 double MssModel<D>::vertex_mass(Dart v, std::vector<Index>* springs) {
+  constexpr std::uint32_t null = Dart::null_index;
+  const auto& edges = map_.template attribute_container<1>();
   double m = 0;
   for (Dart y : map_.template cell<0>(v)) {
     Index e = element_of(y);
-    const AttrId<1> edge = map_.template attribute<1>(y);
-    if (e == invalid_index && edge) e = map_.value(edge).segment;
+    const std::uint32_t edge = map_.template attribute_index<1>(y.index());
+    if (e == invalid_index && edge != null) e = edges.value(edge).segment;
     if (e != invalid_index && elements_[e].alive) {
       const Element& el = elements_[e];
       m += materials_[el.material].density * el.measure / (corners(el.kind) * darts_per_corner(el.kind));
@@ -413,9 +476,9 @@ double MssModel<D>::vertex_mass(Dart v, std::vector<Index>* springs) {
           if (s != invalid_index) springs->push_back(s);
     }
     if (!springs) continue;
-    if (edge) springs->push_back(map_.value(edge).spring);
-    if (const Dart p = map_.beta(y, 0))  // a boundary edge of a surface may have only this dart
-      if (const AttrId<1> a = map_.template attribute<1>(p)) springs->push_back(map_.value(a).spring);
+    if (edge != null) springs->push_back(edges.value(edge).spring);
+    if (const std::uint32_t p = map_.b(y.index(), 0); p != null)  // a surface's boundary edge may have only this dart
+      if (const std::uint32_t a = map_.template attribute_index<1>(p); a != null) springs->push_back(edges.value(a).spring);
   }
   return m;
 }
@@ -424,18 +487,22 @@ template <int D>
 std::vector<Index> MssModel<D>::element_nodes(Index e) const {
   const Element& el = elements_.at(e);
   std::vector<Index> out(static_cast<std::size_t>(corners(el.kind)), invalid_index);
-  if (el.kind == ElementKind::segment) {
+  if (el.kind == ElementKind::hexahedron || el.kind == ElementKind::tetrahedron) {
+    static const CornerPaths hex = corner_paths(template_of(ElementKind::hexahedron));
+    static const CornerPaths tet = corner_paths(template_of(ElementKind::tetrahedron));
+    const CornerPaths& paths = el.kind == ElementKind::hexahedron ? hex : tet;
+    for (std::size_t v = 0; v < out.size(); ++v) {
+      std::uint32_t x = el.dart.index();
+      for (std::uint8_t op : paths[v]) x = map_.b(x, op);
+      out[v] = node_of(Dart(x));
+    }
+  } else if (el.kind == ElementKind::segment) {
     out[0] = node_of(el.dart);
     out[1] = end_node(el.dart);
-    return out;
+  } else {
+    std::uint32_t x = el.dart.index();
+    for (std::size_t k = 0; k < out.size(); ++k, x = map_.b(x, 1)) out[dart_vertex_[x]] = node_of(Dart(x));
   }
-  DartList darts;
-  if constexpr (D == 3)
-    darts = el.kind == ElementKind::hexahedron || el.kind == ElementKind::tetrahedron ? map_.template cell<3>(el.dart)
-                                                                                     : map_.template cell<2>(el.dart);
-  else
-    darts = map_.template cell<2>(el.dart);
-  for (Dart x : darts) out[dart_vertex_[x.index()]] = node_of(x);
   return out;
 }
 
@@ -576,9 +643,9 @@ void MssModel<D>::resync() {
     if (!vattr.is_alive(v) || !first_visit(seen_vertex_, v, generation_)) continue;
     touch_node(map_.value(AttrId<0>(v)).node);
     for (Dart y : map_.template cell<0>(map_.dart_of(AttrId<0>(v)))) {
-      for (Dart x : {y, map_.beta(y, 0)})
-        if (x)
-          if (const AttrId<1> a = map_.template attribute<1>(x)) edges.push_back(a.index());
+      for (std::uint32_t x : {y.index(), map_.b(y.index(), 0)})
+        if (x != Dart::null_index)
+          if (const std::uint32_t a = map_.template attribute_index<1>(x); a != Dart::null_index) edges.push_back(a);
       const Index e = element_of(y);
       if (e != invalid_index && first_visit(seen_element_, e, generation_)) elems.push_back(e);
     }

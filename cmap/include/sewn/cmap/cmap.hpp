@@ -403,6 +403,12 @@ class CMap {
   // ---------------------------------------------------------------- internals for sibling headers
   /// Raw β without checks (builders and operations). i ∈ [0, D], x a live dart index.
   [[nodiscard]] std::uint32_t b(std::uint32_t x, int i) const { return beta_[x][static_cast<std::size_t>(i)]; }
+  /// Raw index of the I-attribute of dart x (null_index if none), without checks: for hot loops
+  /// of modules built on the map; x must be a live dart index. Values: attribute_container<I>().
+  template <int I>
+  [[nodiscard]] std::uint32_t attribute_index(std::uint32_t x) const {
+    return store<I>().of_dart[x];
+  }
 
  private:
   using Stores = typename detail::StoreTuple<std::make_integer_sequence<int, D + 1>, Attrs...>::type;

@@ -147,10 +147,14 @@ class MssModel {
 
   /// The node of mesh point p, as built (before any cut): invalid_index for unused points.
   [[nodiscard]] Index node_of_point(std::uint32_t p) const { return p < node_of_point_.size() ? node_of_point_[p] : invalid_index; }
-  /// The node carried by the vertex of dart d.
-  [[nodiscard]] Index node_of(Dart d) const { return map_.value(map_.template attribute<0>(d)).node; }
-  /// The spring carried by the edge of dart d.
-  [[nodiscard]] Index spring_of(Dart d) const { return map_.value(map_.template attribute<1>(d)).spring; }
+  /// The node carried by the vertex of dart d (d a live dart of the map; unchecked: hot loops).
+  [[nodiscard]] Index node_of(Dart d) const {
+    return map_.template attribute_container<0>().value(map_.template attribute_index<0>(d.index())).node;
+  }
+  /// The spring carried by the edge of dart d (unchecked, as node_of).
+  [[nodiscard]] Index spring_of(Dart d) const {
+    return map_.template attribute_container<1>().value(map_.template attribute_index<1>(d.index())).spring;
+  }
   /// The element of the cell of dart d (its volume in 3D, else its face; invalid_index if none).
   [[nodiscard]] Index element_of(Dart d) const;
   /// Rest position of node i.
@@ -186,6 +190,8 @@ class MssModel {
   // Records, for every dart of element e, its local start vertex and local edge.
   void index_darts(Index e);
   [[nodiscard]] double edge_stiffness(Dart edge_dart) const;
+  template <class F>
+  void for_each_edge_dart(std::uint32_t d, F&& f) const;
   // Mass of a vertex cell, and (if springs is non-null) the springs at it: its edges' and the
   // diagonals of its elements. One pass over the cell's darts.
   [[nodiscard]] double vertex_mass(Dart vertex_dart, std::vector<Index>* springs = nullptr);
