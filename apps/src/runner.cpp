@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <limits>
+#include <map>
 #include <set>
 
 #include "sewn/io/cleanup.hpp"
@@ -146,6 +148,33 @@ struct Snapshot {
   }
   [[nodiscard]] io::CellsView cells() const { return {types, offsets, conn}; }
 };
+
+// A face as its sorted points (through `point`), padded: a set key.
+template <class F>
+std::array<std::uint32_t, 4> face_key(std::span<const std::uint32_t> face, F&& point) {
+  std::array<std::uint32_t, 4> k;
+  k.fill(std::numeric_limits<std::uint32_t>::max());
+  for (std::size_t i = 0; i < face.size() && i < 4; ++i) k[i] = point(face[i]);
+  std::sort(k.begin(), k.end());
+  return k;
+}
+
+// Faces shared by two volume cells of a mesh.
+std::set<std::array<std::uint32_t, 4>> interior_faces(const IndexedMesh& m) {
+  std::map<std::array<std::uint32_t, 4>, int> count;
+  for (std::uint32_t c = 0; c < m.num_cells(); ++c) {
+    const auto v = m.cell(c);
+    for (const auto& f : cell_faces(m.types[c])) {
+      std::array<std::uint32_t, 4> pts{};
+      for (std::size_t i = 0; i < f.size(); ++i) pts[i] = v[f[i]];
+      ++count[face_key(std::span<const std::uint32_t>(pts.data(), f.size()), [](std::uint32_t q) { return q; })];
+    }
+  }
+  std::set<std::array<std::uint32_t, 4>> out;
+  for (const auto& [k, n] : count)
+    if (n == 2) out.insert(k);
+  return out;
+}
 
 std::string format_seconds(double s) {
   char buf[32];
@@ -392,6 +421,13 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     std::snprintf(title, sizeof title, "%s, t = %.3g s", scene.name.c_str(), sum.simulated);
     ro.title = title;
     ro.scalar_name = label;
+    // Faces a cut opened: boundary faces now, whose particles stand for the points of a face
+    // that two volumes shared in the original mesh (the paper draws them red).
+    const auto interior = interior_faces(mesh);
+    if (!interior.empty())
+      ro.highlight = [&](std::span<const std::uint32_t> face) {
+        return interior.count(face_key(face, [&](std::uint32_t q) { return model->point_of_node(q); })) > 0;
+      };
     sum.picture = sum.out / (scene.name + ".png");
     io::render_png(sum.picture, snap.points, snap.cells(), *scalar, ro);
   }

@@ -73,6 +73,7 @@ struct Primitive {
   std::uint8_t n;  // 2 = segment, 3 or 4 = face
   std::array<std::uint32_t, 4> v;
   double shade;  // Lambert factor (faces)
+  bool highlighted = false;
 };
 
 std::string format_tick(double x) {
@@ -319,7 +320,8 @@ void render_png(const std::filesystem::path& path, std::span<const Point3> point
     const double lambert = std::max(0.0, dot(n, light));
     double depth = 0;
     for (std::size_t k = 0; k < f.size; ++k) depth += cam[f.v[k]][2];
-    prims.push_back({depth / f.size, f.size, f.v, 0.30 + 0.50 * lambert + 0.25 * facing});
+    const bool highlighted = opt.highlight && opt.highlight(std::span<const std::uint32_t>(f.v.data(), f.size));
+    prims.push_back({depth / f.size, f.size, f.v, 0.30 + 0.50 * lambert + 0.25 * facing, highlighted});
   }
   for (std::uint32_t c = 0; c < cells.size(); ++c) {
     if (cells.types[c] != CellType::segment) continue;
@@ -380,9 +382,9 @@ void render_png(const std::filesystem::path& path, std::span<const Point3> point
     if (opt.mode == RenderMode::wireframe) {
       // farther edges fade a little so the front of the object reads first
       const double t = depth_hi > depth_lo ? (p.depth - depth_lo) / (depth_hi - depth_lo) : 0;
-      const auto c = coloured ? mean_colour(p) : std::array<double, 3>{0.1, 0.15, 0.25};
+      const auto c = p.highlighted ? opt.highlight_colour : coloured ? mean_colour(p) : std::array<double, 3>{0.1, 0.15, 0.25};
       cairo_set_source_rgba(cr, c[0], c[1], c[2], 1.0 - 0.55 * t);
-      cairo_set_line_width(cr, p.n == 2 ? 2.5 * edge_width : edge_width);
+      cairo_set_line_width(cr, p.n == 2 || p.highlighted ? 2.5 * edge_width : edge_width);
       trace(p);
       cairo_stroke(cr);
       continue;
@@ -417,7 +419,10 @@ void render_png(const std::filesystem::path& path, std::span<const Point3> point
           t[k] = span > 0 ? (scalar[v] - lo) / span : 0.5;
         }
       }
-      fill_triangle(cr, px, t, valued, coloured ? no_value_colour : plain_colour, p.shade);
+      if (p.highlighted)
+        fill_triangle(cr, px, t, false, opt.highlight_colour, p.shade);
+      else
+        fill_triangle(cr, px, t, valued, coloured ? no_value_colour : plain_colour, p.shade);
     }
     if (opt.edges) {
       cairo_set_source_rgba(cr, 0.08, 0.08, 0.1, 0.55);

@@ -13,6 +13,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -53,6 +54,10 @@ struct RenderOptions {
   std::string scalar_name;  ///< label of the colour bar
   /// Colour range; unset = the finite minimum and maximum of the scalar.
   std::optional<std::pair<double, double>> range;
+  /// Boundary faces (given by their point indices) to draw in highlight_colour instead of the
+  /// scalar's colours, e.g. the faces a cut opened (the 2013 paper draws them red). Unset: none.
+  std::function<bool(std::span<const std::uint32_t>)> highlight;
+  std::array<double, 3> highlight_colour{0.86, 0.12, 0.10};
 };
 
 /// Viridis (matplotlib's perceptually uniform map) at t in [0, 1] (clamped), as RGB in [0, 1].
