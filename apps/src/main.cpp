@@ -1,4 +1,5 @@
 // The `sewn` command-line tool: run a scene, check a mesh, print the scene reference.
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -22,7 +23,7 @@ constexpr int ok = 0, run_failed = 1, bad_input = 2;
 constexpr const char* usage = R"(sewn: simulate deformable bodies whose topology changes while they move
 
 usage:
-  sewn run [SCENE.json] [--out DIR] [--frames N] [--quiet]
+  sewn run [SCENE.json] [--out DIR] [--frames N] [--until T] [--quiet]
                           run a scene (with no scene: the built-in default, a cantilever
                           beam sagging under gravity and cut part-way through)
   sewn check MESH         load a mesh (.msh 2.2/4.1, .mesh, .vtk), check its geometry, build the
@@ -33,7 +34,7 @@ usage:
 exit codes: 0 ok, 1 the run failed, 2 bad input
 )";
 
-constexpr const char* run_usage = R"(usage: sewn run [SCENE.json] [--out DIR] [--frames N] [--quiet]
+constexpr const char* run_usage = R"(usage: sewn run [SCENE.json] [--out DIR] [--frames N] [--until T] [--quiet]
 
 Runs a scene (docs/scenes.md) and writes, in DIR (default out/<scene name>/):
   <name>.pvd + frame_NNNNN.vtu   the ParaView series (cells with material and refinement level;
@@ -43,6 +44,8 @@ Runs a scene (docs/scenes.md) and writes, in DIR (default out/<scene name>/):
                                  applied and faces they unsewed
   <name>.png                     a picture of the last frame
   --frames N   number of output frames (overrides the scene's output.frames)
+  --until T    stop at simulated time T seconds, if that is before the scene's end; cuts
+               scheduled after T are not applied
   --quiet      no progress bar and no summary line
 The progress bar is drawn only when standard error is a terminal.
 )";
@@ -65,7 +68,7 @@ int cmd_run(const std::vector<std::string>& args) {
       return ok;
     } else if (a == "--quiet" || a == "-q") {
       opt.quiet = true;
-    } else if (a == "--out" || a == "--frames") {
+    } else if (a == "--out" || a == "--frames" || a == "--until") {
       if (i + 1 >= args.size()) {
         std::fprintf(stderr, "sewn run: %s needs a value\n", a.c_str());
         return bad_input;
@@ -73,6 +76,14 @@ int cmd_run(const std::vector<std::string>& args) {
       const std::string& v = args[++i];
       if (a == "--out") {
         opt.out = v;
+      } else if (a == "--until") {
+        char* end = nullptr;
+        const double t = std::strtod(v.c_str(), &end);
+        if (end == v.c_str() || *end != '\0' || !std::isfinite(t) || t <= 0) {
+          std::fprintf(stderr, "sewn run: --until needs a positive time in seconds, got '%s'\n", v.c_str());
+          return bad_input;
+        }
+        opt.until = t;
       } else {
         char* end = nullptr;
         const long n = std::strtol(v.c_str(), &end, 10);

@@ -52,7 +52,7 @@ bool selects_cell(const Selector& s, const IndexedMesh& m, std::uint32_t c) {
   }
 }
 
-IndexedMesh generate(const MeshSpec& spec, const std::string& path) {
+IndexedMesh generate(const MeshSpec& spec, const std::string& file, const std::string& path) {
   IndexedMesh m;
   if (spec.type == "hex_grid" || spec.type == "tet_grid") {
     GridSpec g;
@@ -76,13 +76,21 @@ IndexedMesh generate(const MeshSpec& spec, const std::string& path) {
   } else if (spec.type == "cylinder") {
     m = cylinder(spec.radius, spec.height, spec.rings, spec.sectors, spec.layers);
     transform(m, 1.0, spec.origin);
+  } else if (spec.type == "boxes") {
+    std::vector<LatticeBox> boxes;
+    for (const auto& b : spec.boxes) boxes.push_back({b.lo, b.hi});
+    try {
+      m = box_union(boxes, GridSpec{{spec.size[0], spec.size[1], spec.size[2]}, {spec.origin[0], spec.origin[1], spec.origin[2]}});
+    } catch (const MeshError& e) {
+      throw SceneError(file, path + ".boxes", e.what());
+    }
   } else if (spec.type == "polyline") {
     std::vector<Point3> pts;
     for (const Vec3& p : spec.points) pts.push_back({p[0], p[1], p[2]});
     try {
       m = polyline(pts);
     } catch (const MeshError& e) {
-      throw SceneError("", path + ".points", e.what());
+      throw SceneError(file, path + ".points", e.what());
     }
   } else if (spec.type == "file") {
     m = io::read_mesh(spec.path);
@@ -196,7 +204,7 @@ Assembly assemble(const Scene& scene) {
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     const MeshSpec& spec = scene.meshes[i];
     const std::string path = "meshes[" + std::to_string(i) + "]";
-    IndexedMesh piece = generate(spec, path);
+    IndexedMesh piece = generate(spec, scene.file, path);
     if (piece.num_cells() == 0) throw SceneError(scene.file, path, "the mesh has no cell");
     a.first_cell.push_back(a.mesh.num_cells());
     std::vector<std::uint32_t> mat(piece.num_cells(), material_index(spec.material));
@@ -259,7 +267,8 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
 
   // 3) time line: steps, frames and scheduled cuts
   const double h = scene.step;
-  const auto steps = static_cast<std::uint64_t>(std::ceil(scene.duration / h - 1e-9));
+  const double end = std::min(scene.duration, options.until.value_or(scene.duration));
+  const auto steps = static_cast<std::uint64_t>(std::ceil(end / h - 1e-9));
   const std::uint32_t frames = options.frames.value_or(scene.frames);
   std::vector<std::pair<double, std::size_t>> cuts;  // (time, index) in time order
   for (std::size_t k = 0; k < scene.cuts.size(); ++k) cuts.emplace_back(scene.cuts[k].time, k);

@@ -77,6 +77,14 @@ Field build_schema() {
                 field("sectors", Kind::integer).fallback(6).at_least(3).at_most(1000).doc("Points on the first ring."),
                 field("layers", Kind::integer).required().at_least(1).at_most(10000).doc("Layers along z."),
                 origin});
+  Field box = field("box", Kind::object);
+  box.doc("Lattice cells [min, max) along x, y, z (whole numbers, max exclusive).")
+      .members({field("min", Kind::number_list).items(3, 3).at_least(-1e6).at_most(1e6).required().doc("First cell."),
+                field("max", Kind::number_list).items(3, 3).at_least(-1e6).at_most(1e6).required().doc("One past the last cell.")});
+  mesh.variant("boxes",
+               "A union of boxes of hexahedra on one lattice (a voxel shape): boxes that touch share points, so they form one body.",
+               {field("spacing", Kind::vec3).unit("m").above(0).required().doc("Size of a lattice cell."), origin,
+                field("boxes", Kind::array).of(box).items(1, 1u << 20).required().doc("The boxes.")});
   mesh.variant("polyline", "A chain of segments (a rope of axial springs).",
                {field("points", Kind::array).of(field("point", Kind::vec3).unit("m")).items(2, 1u << 24).required()
                     .doc("The points, in order.")});
@@ -285,6 +293,22 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     if (m.type == "cylinder") {
       m.height = mr.number("height");
       m.layers = static_cast<std::uint32_t>(mr.integer("layers"));
+    }
+    if (m.type == "boxes") {
+      m.size = mr.vec3("spacing");
+      for (std::size_t k = 0; k < mr["boxes"].size(); ++k) {
+        const auto& bj = mr["boxes"][k];
+        const std::string bpath = path + ".boxes[" + std::to_string(k) + "]";
+        check_whole(bj.at("min"), file, bpath + ".min");
+        check_whole(bj.at("max"), file, bpath + ".max");
+        LatticeBoxSpec b;
+        for (std::size_t a = 0; a < 3; ++a) {
+          b.lo[a] = static_cast<int>(bj.at("min")[a].get<double>());
+          b.hi[a] = static_cast<int>(bj.at("max")[a].get<double>());
+          if (b.hi[a] <= b.lo[a]) throw SceneError(file, bpath, "max must exceed min along every axis");
+        }
+        m.boxes.push_back(b);
+      }
     }
     if (m.type == "polyline")
       for (const auto& p : mr["points"]) m.points.push_back({p[0].get<double>(), p[1].get<double>(), p[2].get<double>()});

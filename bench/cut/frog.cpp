@@ -4,16 +4,10 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 namespace sewn::bench::cut {
 namespace {
-
-// A box of lattice cells [lo, hi) along x, y, z.
-struct Box {
-  std::array<int, 3> lo, hi;
-};
 
 // The frog, swimming: a flat body, a head on its front face, hind legs stretched backwards
 // (a thigh out to the side, then a shin along -x, then 4 toes from the shin's end face, one at
@@ -28,11 +22,11 @@ struct Box {
 //   front legs, 2 x (3 x 3 x 11)      198 cells,    352 new points (2 x 4² x 11)
 //   toes, 8 x (1 x 1 x 5)              40 cells,    160 new points (8 x 2² x 5)
 // (The body is flat because only a thin one leaves enough points for frog-like limbs.)
-std::vector<Box> frog_boxes() {
+std::vector<LatticeBox> frog_boxes() {
   constexpr int bx = 76, by = 55, bz = 5;  // body
   constexpr int s = 4, thigh = 13, shin = 28, toe = 5;
   constexpr int f = 3, arm = 11, arm_x = 60;
-  std::vector<Box> b;
+  std::vector<LatticeBox> b;
   b.push_back({{0, 0, 0}, {bx, by, bz}});                  // body
   b.push_back({{bx, 3, 0}, {bx + 15, by - 3, bz}});        // head, centred in y, flush with the belly
   for (int side = 0; side < 2; ++side) {
@@ -53,28 +47,8 @@ std::vector<Box> frog_boxes() {
 }  // namespace
 
 IndexedMesh frog_mesh(double a) {
-  IndexedMesh m;
-  std::unordered_map<std::uint64_t, std::uint32_t> point_index;
-  auto key = [](int i, int j, int k) {
-    // lattice coordinates are within [-64, 128): shift them to non-negative 21-bit fields
-    return (static_cast<std::uint64_t>(i + 1024) << 42) | (static_cast<std::uint64_t>(j + 1024) << 21) |
-           static_cast<std::uint64_t>(k + 1024);
-  };
-  auto point = [&](int i, int j, int k) {
-    const auto [it, fresh] = point_index.try_emplace(key(i, j, k), static_cast<std::uint32_t>(m.points.size()));
-    if (fresh) m.points.push_back({i * a, j * a, k * a});
-    return it->second;
-  };
-  std::unordered_map<std::uint64_t, bool> used;  // a cell claimed by two boxes would be a bug
-  for (const Box& b : frog_boxes())
-    for (int k = b.lo[2]; k < b.hi[2]; ++k)
-      for (int j = b.lo[1]; j < b.hi[1]; ++j)
-        for (int i = b.lo[0]; i < b.hi[0]; ++i) {
-          if (!used.emplace(key(i, j, k), true).second) throw std::logic_error("frog_mesh: two boxes overlap");
-          m.add_cell(CellType::hexahedron, {point(i, j, k), point(i + 1, j, k), point(i + 1, j + 1, k),
-                                            point(i, j + 1, k), point(i, j, k + 1), point(i + 1, j, k + 1),
-                                            point(i + 1, j + 1, k + 1), point(i, j + 1, k + 1)});
-        }
+  const auto boxes = frog_boxes();
+  IndexedMesh m = box_union(boxes, GridSpec{{a, a, a}, {0, 0, 0}});
   if (m.num_cells() != frog_hexahedra || m.num_points() != frog_particles)
     throw std::logic_error("frog_mesh: " + std::to_string(m.num_cells()) + " hexahedra and " +
                            std::to_string(m.num_points()) + " particles, expected " + std::to_string(frog_hexahedra) +

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <numbers>
 
 #include "sewn/cmap/errors.hpp"
@@ -188,6 +190,56 @@ IndexedMesh polyline_x(std::uint32_t n, double spacing) {
   IndexedMesh m;
   for (std::uint32_t i = 0; i <= n; ++i) m.points.push_back({i * spacing, 0.0, 0.0});
   for (std::uint32_t i = 0; i < n; ++i) m.add_cell(CellType::segment, {i, i + 1});
+  return m;
+}
+
+IndexedMesh box_union(std::span<const LatticeBox> boxes, const GridSpec& g) {
+  check_grid(1, 1, 1, g, "box_union");
+  if (boxes.empty()) throw MeshError("box_union: no box");
+  // 64-bit bounds: hi - lo of two ints may not fit in an int
+  std::array<std::int64_t, 3> lo{}, hi{};
+  for (std::size_t b = 0; b < boxes.size(); ++b)
+    for (std::size_t a = 0; a < 3; ++a) {
+      if (boxes[b].hi[a] <= boxes[b].lo[a])
+        throw MeshError("box_union: box " + std::to_string(b) + " is empty or inverted along axis " + std::to_string(a));
+      lo[a] = b ? std::min<std::int64_t>(lo[a], boxes[b].lo[a]) : boxes[b].lo[a];
+      hi[a] = b ? std::max<std::int64_t>(hi[a], boxes[b].hi[a]) : boxes[b].hi[a];
+    }
+  constexpr std::int64_t max_cells = std::int64_t{1} << 28;
+  if (hi[0] - lo[0] > max_cells || hi[1] - lo[1] > max_cells || hi[2] - lo[2] > max_cells ||
+      (hi[0] - lo[0]) * (hi[1] - lo[1]) > max_cells || (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]) > max_cells)
+    throw MeshError("box_union: the boxes' bounding box spans more than 2^28 cells");
+  // dense flags over the bounding box of the union: which cells are covered, which points used
+  const std::array<std::size_t, 3> n{static_cast<std::size_t>(hi[0] - lo[0]), static_cast<std::size_t>(hi[1] - lo[1]),
+                                     static_cast<std::size_t>(hi[2] - lo[2])};
+  std::vector<char> covered(n[0] * n[1] * n[2], 0);
+  auto cell = [&](std::size_t i, std::size_t j, std::size_t k) { return i + n[0] * (j + n[1] * k); };
+  for (const LatticeBox& b : boxes)
+    for (int k = b.lo[2]; k < b.hi[2]; ++k)
+      for (int j = b.lo[1]; j < b.hi[1]; ++j)
+        for (int i = b.lo[0]; i < b.hi[0]; ++i)
+          covered[cell(static_cast<std::size_t>(i - lo[0]), static_cast<std::size_t>(j - lo[1]), static_cast<std::size_t>(k - lo[2]))] = 1;
+  const std::array<std::size_t, 3> p{n[0] + 1, n[1] + 1, n[2] + 1};
+  std::vector<std::uint32_t> point_of(p[0] * p[1] * p[2], std::numeric_limits<std::uint32_t>::max());
+  IndexedMesh m;
+  auto point = [&](std::size_t i, std::size_t j, std::size_t k) {
+    std::uint32_t& q = point_of[i + p[0] * (j + p[1] * k)];
+    if (q == std::numeric_limits<std::uint32_t>::max()) {
+      q = static_cast<std::uint32_t>(m.points.size());
+      const std::array<std::size_t, 3> at{i, j, k};
+      Point3 x;
+      for (std::size_t a = 0; a < 3; ++a) x[a] = g.origin[a] + (static_cast<double>(at[a]) + static_cast<double>(lo[a])) * g.spacing[a];
+      m.points.push_back(x);
+    }
+    return q;
+  };
+  for (std::size_t k = 0; k < n[2]; ++k)
+    for (std::size_t j = 0; j < n[1]; ++j)
+      for (std::size_t i = 0; i < n[0]; ++i)
+        if (covered[cell(i, j, k)])
+          m.add_cell(CellType::hexahedron, {point(i, j, k), point(i + 1, j, k), point(i + 1, j + 1, k), point(i, j + 1, k),
+                                            point(i, j, k + 1), point(i + 1, j, k + 1), point(i + 1, j + 1, k + 1),
+                                            point(i, j + 1, k + 1)});
   return m;
 }
 

@@ -194,6 +194,15 @@ TEST_CASE("bad input: each problem gives its own error class") {
             "meshes": [{"type": "hex_grid", "material": "m", "cells": [2, 1, 1], "size": [0.2, 0.1, 0.1]}],
             "duration": 0.01, "cuts": [{"type": "plane", "time": 0, "point": [5, 0, 0], "normal": [1, 0, 0]}]})",
         "cuts[0]");
+    expect_run_error<SceneError>(
+        R"({"materials": {"m": {"young": 1e6, "density": 1000}},
+            "meshes": [{"type": "boxes", "material": "m", "spacing": [1, 1, 1],
+                        "boxes": [{"min": [-1000000, -1000000, 0], "max": [1000000, 1000000, 1]}]}]})",
+        "scene.json: meshes[0].boxes");
+    expect_run_error<SceneError>(
+        R"({"materials": {"m": {"young": 1e6, "density": 1000}},
+            "meshes": [{"type": "polyline", "material": "m", "points": [[0, 0, 0], [0, 0, 0]]}]})",
+        "scene.json: meshes[0].points");
   }
 }
 
@@ -208,6 +217,8 @@ TEST_CASE("the sewn binary: exit codes and messages") {
   CHECK(err.find("/nonexistent.json") != std::string::npos);
   CHECK(run_binary("run --frames zero", err) == 2);
   CHECK(err.find("--frames") != std::string::npos);
+  CHECK(run_binary("run --until 0", err) == 2);
+  CHECK(err.find("--until") != std::string::npos);
   const fs::path scene = scratch("typo.json");
   write(scene, R"({"materials": {"m": {"yung": 1e6, "density": 1000}}, "meshes": []})");
   CHECK(run_binary("run " + scene.string(), err) == 2);

@@ -272,3 +272,29 @@ TEST_CASE("discs, cylinders and polylines through points") {
   const Point3 dup[] = {{0, 0, 0}, {0, 0, 0}};
   CHECK_THROWS_AS(polyline(dup), MeshError);
 }
+
+TEST_CASE("unions of lattice boxes: overlaps counted once, touching boxes glued") {
+  // an L of two overlapping boxes on a negative-going lattice, and a third box glued to its end
+  const LatticeBox boxes[] = {{{-2, 0, 0}, {2, 1, 1}}, {{1, 0, 0}, {2, 3, 1}}, {{2, 2, 0}, {4, 3, 2}}};
+  const IndexedMesh mesh = box_union(boxes, GridSpec{{0.5, 0.5, 0.5}, {1, 0, 0}});
+  CHECK(mesh.num_cells() == 4 + 2 + 4);  // the overlap cell (1, 0, 0) once
+  for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) CHECK(mesh.types[c] == CellType::hexahedron);
+  CHECK(mesh.points[mesh.cell(0)[0]] == Point3{0, 0, 0});  // cell (-2, 0, 0) starts at origin - 2 spacings
+  Map3 m;
+  const auto r = build_with_points(m, mesh);
+  check_map(m);
+  CHECK(r.nonmanifold_facets == 0);
+  CHECK(m.count_components() == 1);  // shared points: every box is sewn to the next
+  CHECK(m.euler_characteristic() == 1);
+  CHECK(r.sewn_facets == 3 + 2 + 1 + 4);  // inside the first box, along the arm, arm to third box, inside the third
+  // the same cells from one box each: the same mesh up to point numbering
+  const LatticeBox single[] = {{{0, 0, 0}, {3, 2, 1}}};
+  CHECK(box_union(single).num_points() == hex_grid(3, 2, 1).num_points());
+  CHECK(box_union(single).num_cells() == 6);
+  const LatticeBox inverted[] = {{{0, 0, 0}, {1, 1, 1}}, {{0, 2, 0}, {1, 2, 1}}};
+  CHECK_THROWS_WITH_AS(box_union(inverted), doctest::Contains("box 1 is empty or inverted along axis 1"), MeshError);
+  CHECK_THROWS_AS(box_union(std::span<const LatticeBox>{}), MeshError);
+  const LatticeBox huge[] = {{{-1000000000, -1000000000, 0}, {1000000000, 1000000000, 1}}};
+  CHECK_THROWS_WITH_AS(box_union(huge), doctest::Contains("2^28"), MeshError);
+  CHECK_THROWS_AS(box_union(single, GridSpec{{1, 0, 1}, {}}), MeshError);
+}

@@ -31,6 +31,7 @@ Assembly assemble(const Scene& scene);
 struct RunOptions {
   std::filesystem::path out;                 ///< empty: out/<scene name>/
   std::optional<std::uint32_t> frames;       ///< overrides the scene's output frames
+  std::optional<double> until;               ///< s; ends the run early (never extends it)
   bool quiet = false;                        ///< no progress bar, no summary
   bool progress = true;                      ///< draw the progress bar (only on a terminal)
 };

@@ -34,8 +34,12 @@ struct MaterialSpec {
   bool clamp_elongated = false;  // Baudet edge stiffness < 0: clamp instead of refusing
 };
 
+struct LatticeBoxSpec {
+  std::array<int, 3> lo{}, hi{};
+};
+
 struct MeshSpec {
-  std::string type;  // hex_grid, tet_grid, quad_grid, tri_grid, disc, cylinder, polyline, file
+  std::string type;  // hex_grid, tet_grid, quad_grid, tri_grid, disc, cylinder, boxes, polyline, file
   std::string name;
   std::string material;
   std::vector<std::pair<Selector, std::string>> regions;  // later rules win
@@ -46,6 +50,7 @@ struct MeshSpec {
   double radius = 0, height = 0;
   std::uint32_t rings = 0, sectors = 0, layers = 0;
   std::vector<Vec3> points;  // polyline
+  std::vector<LatticeBoxSpec> boxes;  // boxes (size holds the lattice spacing)
   std::string path;          // file (resolved against the scene's folder)
   double scale = 1;
   Vec3 translate{0, 0, 0};

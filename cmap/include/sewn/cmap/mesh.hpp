@@ -85,6 +85,17 @@ IndexedMesh tet_grid(std::uint32_t nx, std::uint32_t ny, std::uint32_t nz, TetSp
 IndexedMesh quad_grid(std::uint32_t nx, std::uint32_t ny, const GridSpec& g = {});
 /// nx × ny quads each cut into 2 triangles along the (i,j)-(i+1,j+1) diagonal.
 IndexedMesh tri_grid(std::uint32_t nx, std::uint32_t ny, const GridSpec& g = {});
+/// A box of lattice cells [lo, hi) along x, y and z (integer cell coordinates, may be negative).
+struct LatticeBox {
+  std::array<int, 3> lo{}, hi{};
+};
+/// The hexahedra of a union of lattice boxes: cells covered by several boxes appear once and
+/// neighbouring boxes share their points, so boxes that touch by a face form one glued body
+/// (a voxel shape); boxes touching only along an edge or at a corner share those points.
+/// Cell (i, j, k) spans origin + (i, j, k)·spacing to origin + (i+1, j+1, k+1)·spacing.
+/// Throws MeshError for an empty box list, an empty or inverted box, a bad spacing, or a
+/// bounding box of more than 2^28 cells.
+IndexedMesh box_union(std::span<const LatticeBox> boxes, const GridSpec& g = {});
 /// A straight polyline of n segments along x.
 IndexedMesh polyline_x(std::uint32_t n, double spacing = 1.0);
 /// A polyline through the given points (at least 2), in order.
