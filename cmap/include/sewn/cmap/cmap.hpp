@@ -44,6 +44,7 @@
 #include <boost/container/small_vector.hpp>
 
 #include "sewn/cmap/attributes.hpp"
+#include "sewn/cmap/detail/dart_buffer.hpp"
 #include "sewn/cmap/dart.hpp"
 #include "sewn/cmap/errors.hpp"
 #include "sewn/cmap/marks.hpp"
@@ -413,47 +414,61 @@ class CMap {
     }(std::make_integer_sequence<int, D + 1>{});
   }
 
-  // Orbit descriptions: a bit per β index (bit 1 stands for β1 and β0), or the vertex orbit.
-  struct Orbit {
-    unsigned mask;
-    bool vertex;
-  };
+  // Orbits, as a compile-time mask: a bit per β index (bit 1 stands for β1 and β0), or
+  // vertex_orbit (bit 0, which no β mask uses) for the darts starting at one vertex.
+  static constexpr unsigned vertex_orbit = 1u;
   static constexpr unsigned all_betas = ((1u << (D + 1)) - 1u) & ~1u;
-  static constexpr Orbit cell_orbit(int i) {
-    return i == 0 ? Orbit{0, true} : Orbit{all_betas & ~(1u << i), false};
-  }
-  static constexpr Orbit component_orbit() { return Orbit{all_betas, false}; }
+  template <int I>
+  static constexpr unsigned cell_mask = I == 0 ? vertex_orbit : all_betas & ~(1u << I);
+  static constexpr unsigned component_mask = all_betas;
+  using MarkView = detail::MarkPlanes::View;
 
   void set_b(std::uint32_t x, int i, std::uint32_t y) { beta_[x][static_cast<std::size_t>(i)] = y; }
   // Links x -> y for βi, with the inverse (β0/β1 pair or involution). Null y makes x i-free.
   void raw_link(std::uint32_t x, int i, std::uint32_t y);
-  void check_alive(Dart d, const char* where) const;
+  void check_alive(Dart d, const char* where) const {
+    if (!is_alive(d)) [[unlikely]]
+      throw_dead(d, where);
+  }
+  [[noreturn]] void throw_dead(Dart d, const char* where) const;
   template <int I>
   void check_attr(AttrId<I> a) const;
   [[nodiscard]] std::vector<std::uint32_t> dead_darts() const;
 
-  template <class F>
-  void for_each_neighbor(std::uint32_t x, Orbit o, F&& f) const;
-  // Breadth-first collection of an orbit; marks visited darts with m and appends them to out.
+  // Calls f(y) for each neighbour y of x in the orbit (the generators, not the closure).
+  template <unsigned Mask, class F>
+  void for_each_neighbor(std::uint32_t x, F&& f) const;
+  // Walks mark the darts they visit through a view and append exactly those darts to `out`,
+  // which is how callers know how many to add to the mark's count (see MarkPlanes::View).
+  // Breadth-first walk of an orbit from root.
+  template <unsigned Mask, class Out>
+  void walk(std::uint32_t root, MarkView mk, Out& out) const;
+  // Continues a breadth-first walk: expands out[head..] (already marked) until closed.
+  template <unsigned Mask, class Out>
+  void expand(std::size_t head, MarkView mk, Out& out) const;
+  // The I-cell of root, with walks specialised per dimension (β1 chains for faces and volumes,
+  // alternating involutions for edges, generator maps around vertices) that fall back to the
+  // generic search where the map is open.
+  template <int I, class Out>
+  void walk_cell(std::uint32_t root, MarkView mk, Out& out) const;
   template <class Out>
-  void collect(std::uint32_t root, Orbit o, Mark m, Out& out) const;
-  // Continues a breadth-first collection: expands out[head..] (already marked) until closed.
-  template <class Out>
-  void expand(std::size_t head, Orbit o, Mark m, Out& out) const;
-  // As collect() for the I-cell of root, with walks specialised per dimension (β1 chains for
-  // faces and volumes, alternating involutions for edges, forward generators around interior
-  // vertices) that fall back to the generic search where the map is open.
+  void walk_chain(std::uint32_t x, MarkView mk, Out& out) const;
+  // walk_cell with the mark's count kept.
   template <int I, class Out>
   void collect_cell(std::uint32_t root, Mark m, Out& out) const;
-  template <class Out>
-  void collect_chain(std::uint32_t x, Mark m, Out& out) const;
-  template <int I>
-  [[nodiscard]] std::uint32_t count_cells() const;
+  // As collect_cell / walk with a mark of their own, left clear on return.
   template <int I, class Out>
   void collect_cell_unmarked(std::uint32_t root, Out& out) const;
-  template <class Out>
-  void collect_unmarked(std::uint32_t root, Orbit o, Out& out) const;
-  [[nodiscard]] std::uint32_t count_orbits(Orbit o) const;
+  template <unsigned Mask, class Out>
+  void collect_unmarked(std::uint32_t root, Out& out) const;
+  [[nodiscard]] bool is_live_index(std::uint32_t x) const { return beta_[x][0] != detail::dead_marker; }
+  // Calls f(x) for the smallest dart x of each I-cell (I < 0: each connected component), in
+  // increasing order, after marking the cell with m; unmarked darts start new cells.
+  template <int I, class F>
+  void for_each_cell_root(Mark m, F&& f) const;
+  // Number of I-cells (I < 0: connected components).
+  template <int I>
+  [[nodiscard]] std::uint32_t count_cells() const;
 
   template <int I>
   bool sew_pairs(std::uint32_t a, std::uint32_t b, std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) const;

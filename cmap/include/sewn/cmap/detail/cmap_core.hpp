@@ -4,13 +4,11 @@
 namespace sewn {
 
 template <int D, class... A>
-void CMap<D, A...>::check_alive(Dart d, const char* where) const {
-  if (!is_alive(d)) [[unlikely]] {
-    if (d.is_null()) throw TopologyError(std::string("cmap::") + where + ": null dart");
-    throw TopologyError(std::string("cmap::") + where + ": dart " + std::to_string(d.index()) +
-                        (d.index() < beta_.size() ? " has been erased" : " is out of range (capacity " +
-                                                                            std::to_string(beta_.size()) + ")"));
-  }
+void CMap<D, A...>::throw_dead(Dart d, const char* where) const {
+  if (d.is_null()) throw TopologyError(std::string("cmap::") + where + ": null dart");
+  throw TopologyError(std::string("cmap::") + where + ": dart " + std::to_string(d.index()) +
+                      (d.index() < beta_.size() ? " has been erased" : " is out of range (capacity " +
+                                                                          std::to_string(beta_.size()) + ")"));
 }
 
 template <int D, class... A>

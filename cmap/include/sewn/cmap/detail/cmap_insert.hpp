@@ -10,7 +10,7 @@ Dart CMap<D, A...>::insert_vertex_in_edge(Dart d) {
   constexpr std::uint32_t null = detail::null_index;
   // 1) the darts of the edge (every dart on it, in every face and volume)
   std::vector<std::uint32_t> edge;
-  collect_unmarked(d.index(), cell_orbit(1), edge);
+  collect_unmarked<cell_mask<1>>(d.index(), edge);
   // 2) a new dart after each of them, in its face: x -> x' -> old β1(x)
   std::vector<std::uint32_t> split(edge.size());
   std::vector<std::uint32_t> touched;

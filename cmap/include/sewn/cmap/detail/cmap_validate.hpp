@@ -99,7 +99,7 @@ ValidationReport CMap<D, A...>::validate() const {
           }
           ++counted[a];
         }
-        for_each_neighbor(x, cell_orbit(I), [&](std::uint32_t y) {
+        for_each_neighbor<cell_mask<I>>(x, [&](std::uint32_t y) {
           if (st.of_dart[y] != a)
             r.add(K::attribute_mismatch, x, I,
                   "darts " + s(x) + " and " + s(y) + " are in one " + std::to_string(I) + "-cell but carry " + dim +
