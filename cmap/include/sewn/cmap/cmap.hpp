@@ -30,6 +30,7 @@
 //
 // Not thread-safe, not even for const traversals: they use the map's marks.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -462,8 +463,9 @@ class CMap {
   template <unsigned Mask, class Out>
   void collect_unmarked(std::uint32_t root, Out& out) const;
   [[nodiscard]] bool is_live_index(std::uint32_t x) const { return beta_[x][0] != detail::dead_marker; }
-  // Calls f(x) for the smallest dart x of each I-cell (I < 0: each connected component), in
-  // increasing order, after marking the cell with m; unmarked darts start new cells.
+  // Calls f(x, darts) for the smallest dart x of each I-cell (I < 0: each connected component)
+  // in increasing order, with the darts of the cell, after marking them with m (so unmarked
+  // darts start new cells). f must not create darts.
   template <int I, class F>
   void for_each_cell_root(Mark m, F&& f) const;
   // Number of I-cells (I < 0: connected components).

@@ -364,7 +364,7 @@ void CMap<D, A...>::for_each_cell_root(Mark m, F&& f) const {
     else
       walk_cell<I>(x, mk, queue);
     marked += static_cast<std::int64_t>(queue.size());
-    f(x);
+    f(x, std::as_const(queue));
   }
   marks_.add_count(m, marked);
 }
@@ -374,7 +374,7 @@ template <int I>
 std::uint32_t CMap<D, A...>::count_cells() const {
   const Mark m = marks_.reserve();
   std::uint32_t n = 0;
-  for_each_cell_root<I>(m, [&](std::uint32_t) { ++n; });
+  for_each_cell_root<I>(m, [&](std::uint32_t, const auto&) { ++n; });
   free_mark(m);
   return n;
 }
