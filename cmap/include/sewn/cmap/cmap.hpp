@@ -262,9 +262,10 @@ class CMap {
   [[nodiscard]] DartList cell(Dart d) const;
   /// Darts of the connected component of d. O(component).
   [[nodiscard]] std::vector<Dart> component(Dart d) const;
-  /// Range yielding one dart per I-cell, in increasing order of the cell's smallest dart.
-  /// Holds a mark while alive (released on destruction, early break included). Do not modify
-  /// the map while iterating.
+  /// Range yielding the smallest dart of each I-cell, in increasing order. Holds a mark while
+  /// alive (released on destruction, early break included), except for cells that are single
+  /// chains of darts (every cell of a 1- or 2-map, edges of a 3-map), found without one. Do not
+  /// modify the map while iterating.
   template <int I>
   [[nodiscard]] auto cells() const;
   /// One dart per J-cell incident to the I-cell of d (J < I: its faces; J > I: the cells it
@@ -463,11 +464,23 @@ class CMap {
   template <unsigned Mask, class Out>
   void collect_unmarked(std::uint32_t root, Out& out) const;
   [[nodiscard]] bool is_live_index(std::uint32_t x) const { return beta_[x][0] != detail::dead_marker; }
+  // I-cells whose orbit is a single path or cycle of darts: every cell of a 1- or 2-map, and
+  // the edges of a 3-map. Whether a dart is the smallest of such a cell is found by walking
+  // the chain until a smaller dart comes up, without marks: no stores, so the walks from
+  // successive darts overlap in the processor instead of queueing behind each mark update.
+  template <int I>
+  static constexpr bool chain_cell = D <= 2 || (D == 3 && I == 1);
+  // True if x is the smallest dart of its I-cell (a chain cell). Gives up after
+  // dart_capacity() steps (answering true), which only a map with inconsistent links
+  // (β0 ≠ β1⁻¹, a βi not an involution) can take.
+  template <int I>
+  [[nodiscard]] bool is_chain_root(std::uint32_t x) const;
   // Calls f(x, darts) for the smallest dart x of each I-cell (I < 0: each connected component)
-  // in increasing order, with the darts of the cell, after marking them with m (so unmarked
-  // darts start new cells). f must not create darts.
+  // in increasing order, with the darts of the cell (x first), found by marking: each dart is
+  // walked once (chain walks revisit darts, which only pays when the darts are not wanted).
+  // f must not change the map.
   template <int I, class F>
-  void for_each_cell_root(Mark m, F&& f) const;
+  void for_each_cell_root(F&& f) const;
   // Number of I-cells (I < 0: connected components).
   template <int I>
   [[nodiscard]] std::uint32_t count_cells() const;

@@ -198,6 +198,64 @@ void CMap<D, A...>::collect_cell_unmarked(std::uint32_t root, Out& out) const {
 }
 
 template <int D, class... A>
+template <int I>
+bool CMap<D, A...>::is_chain_root(std::uint32_t x) const {
+  constexpr std::uint32_t null = detail::null_index;
+  auto smaller = [x](std::uint32_t y) { return y != null && y < x; };
+  std::uint32_t budget = dart_capacity();
+  // The chain through x by `next` (and its inverse `prev`). Both neighbours of x are looked at
+  // first, as two independent loads: most darts are not the smallest and stop there.
+  auto chain = [&](auto next, auto prev) {
+    const std::uint32_t n1 = next(x), p1 = prev(x);
+    if (smaller(n1) || smaller(p1)) return false;
+    std::uint32_t y = n1;
+    for (; y != null && y != x; y = next(y)) {
+      if (y < x) return false;
+      if (--budget == 0) return true;
+    }
+    if (y == x) return true;
+    for (y = p1; y != null && y != x; y = prev(y)) {
+      if (y < x) return false;
+      if (--budget == 0) return true;
+    }
+    return true;
+  };
+  if constexpr (D == 1) {
+    return true;  // no generator: every cell is one dart
+  } else if constexpr (D == 2 && I == 1) {
+    return !smaller(b(x, 2));
+  } else if constexpr (D == 2 && I == 2) {
+    return chain([&](std::uint32_t y) { return b(y, 1); }, [&](std::uint32_t y) { return b(y, 0); });
+  } else if constexpr (D == 2 && I == 0) {
+    // β1∘β2 and its inverse β2∘β0
+    return chain(
+        [&](std::uint32_t y) {
+          const std::uint32_t t = b(y, 2);
+          return t == null ? null : b(t, 1);
+        },
+        [&](std::uint32_t y) {
+          const std::uint32_t t = b(y, 0);
+          return t == null ? null : b(t, 2);
+        });
+  } else {
+    static_assert(D == 3 && I == 1);
+    // β2 and β3 alternately from x, then, if that path ends, alternately from x's β3
+    if (smaller(b(x, 2)) || smaller(b(x, 3))) return false;
+    for (int first = 2; first <= 3; ++first) {
+      std::uint32_t y = x;
+      for (int j = first;; j = 5 - j) {
+        y = b(y, j);
+        if (y == null) break;
+        if (y == x) return true;
+        if (y < x) return false;
+        if (--budget == 0) return true;
+      }
+    }
+    return true;
+  }
+}
+
+template <int D, class... A>
 template <int... B>
 DartList CMap<D, A...>::orbit(Dart d) const {
   static_assert(((B >= 0 && B <= D) && ...), "beta index outside [0, D]");
@@ -248,49 +306,77 @@ template <int D, class... A>
 template <int I>
 auto CMap<D, A...>::cells() const {
   static_assert(I >= 0 && I <= D);
-  // The range owns a mark: each yielded dart's cell is marked before the loop body runs, so
-  // the next unmarked dart starts a new cell. The destructor unmarks (O(1) after a full pass).
-  class Range {
-   public:
-    explicit Range(const CMap* m) : map_(m), mark_(m->marks_.reserve()) {}
-    ~Range() {
-      if (map_) map_->free_mark(mark_);
-    }
-    Range(const Range&) = delete;
-    Range& operator=(const Range&) = delete;
-    Range(Range&& o) noexcept : map_(o.map_), mark_(o.mark_), queue_(std::move(o.queue_)) { o.map_ = nullptr; }
-
-    struct Iter {
-      Range* r;
-      std::uint32_t x;
-      Dart operator*() const { return Dart(x); }
-      Iter& operator++() {
-        x = r->next(x + 1);
-        return *this;
-      }
-      bool operator==(const Iter& o) const { return x == o.x; }
-    };
-    Iter begin() { return Iter{this, next(0)}; }
-    Iter end() { return Iter{this, map_->dart_capacity()}; }
-
-   private:
-    std::uint32_t next(std::uint32_t x) {
-      const std::uint32_t n = map_->dart_capacity();
-      const MarkView mk = map_->marks_.view(mark_);
-      x = mk.next_unmarked(x, n);
-      while (x < n && !map_->is_live_index(x)) x = mk.next_unmarked(x + 1, n);
-      if (x < n) {
-        queue_.clear();
-        map_->template walk_cell<I>(x, mk, queue_);
-        map_->marks_.add_count(mark_, static_cast<std::int64_t>(queue_.size()));
-      }
-      return x;
-    }
-    const CMap* map_;
-    Mark mark_;
-    detail::DartBuffer<64> queue_;
+  struct Iter {
+    std::uint32_t x;
+    Dart operator*() const { return Dart(x); }
+    bool operator==(const Iter& o) const { return x == o.x; }
   };
-  return Range(this);
+  if constexpr (chain_cell<I>) {
+    // Each live dart that is the smallest of its cell, found by walking the cell's chain.
+    class Range {
+     public:
+      explicit Range(const CMap* m) : map_(m) {}
+      struct It : Iter {
+        const CMap* map;
+        It& operator++() {
+          this->x = next(map, this->x + 1);
+          return *this;
+        }
+      };
+      It begin() const { return It{{next(map_, 0)}, map_}; }
+      It end() const { return It{{map_->dart_capacity()}, map_}; }
+
+     private:
+      static std::uint32_t next(const CMap* map, std::uint32_t x) {
+        const std::uint32_t n = map->dart_capacity();
+        while (x < n && !(map->is_live_index(x) && map->template is_chain_root<I>(x))) ++x;
+        return x;
+      }
+      const CMap* map_;
+    };
+    return Range(this);
+  } else {
+    // The range owns a mark: each yielded dart's cell is marked before the loop body runs, so
+    // the next unmarked dart starts a new cell. The destructor unmarks (O(1) after a full pass).
+    class Range {
+     public:
+      explicit Range(const CMap* m) : map_(m), mark_(m->marks_.reserve()) {}
+      ~Range() {
+        if (map_) map_->free_mark(mark_);
+      }
+      Range(const Range&) = delete;
+      Range& operator=(const Range&) = delete;
+      Range(Range&& o) noexcept : map_(o.map_), mark_(o.mark_), queue_(std::move(o.queue_)) { o.map_ = nullptr; }
+
+      struct It : Iter {
+        Range* r;
+        It& operator++() {
+          this->x = r->next(this->x + 1);
+          return *this;
+        }
+      };
+      It begin() { return It{{next(0)}, this}; }
+      It end() { return It{{map_->dart_capacity()}, this}; }
+
+     private:
+      std::uint32_t next(std::uint32_t x) {
+        const std::uint32_t n = map_->dart_capacity();
+        const MarkView mk = map_->marks_.view(mark_);
+        x = mk.next_unmarked(x, n);
+        while (x < n && !map_->is_live_index(x)) x = mk.next_unmarked(x + 1, n);
+        if (x < n) {
+          queue_.clear();
+          map_->template walk_cell<I>(x, mk, queue_);
+          map_->marks_.add_count(mark_, static_cast<std::int64_t>(queue_.size()));
+        }
+        return x;
+      }
+      const CMap* map_;
+      Mark mark_;
+      detail::DartBuffer<64> queue_;
+    };
+    return Range(this);
+  }
 }
 
 template <int D, class... A>
@@ -351,31 +437,36 @@ DartList CMap<D, A...>::adjacent(Dart d) const {
 
 template <int D, class... A>
 template <int I, class F>
-void CMap<D, A...>::for_each_cell_root(Mark m, F&& f) const {
-  detail::DartBuffer<64> queue;
-  const MarkView mk = marks_.view(m);
+void CMap<D, A...>::for_each_cell_root(F&& f) const {
+  detail::DartBuffer<64> darts;
   const std::uint32_t cap = dart_capacity();
+  const Mark m = marks_.reserve();
+  const MarkView mk = marks_.view(m);
   std::int64_t marked = 0;
   for (std::uint32_t x = mk.next_unmarked(0, cap); x < cap; x = mk.next_unmarked(x + 1, cap)) {
     if (!is_live_index(x)) continue;
-    queue.clear();
+    darts.clear();
     if constexpr (I < 0)
-      walk<component_mask>(x, mk, queue);
+      walk<component_mask>(x, mk, darts);
     else
-      walk_cell<I>(x, mk, queue);
-    marked += static_cast<std::int64_t>(queue.size());
-    f(x, std::as_const(queue));
+      walk_cell<I>(x, mk, darts);
+    marked += static_cast<std::int64_t>(darts.size());
+    f(x, std::as_const(darts));
   }
   marks_.add_count(m, marked);
+  free_mark(m);
 }
 
 template <int D, class... A>
 template <int I>
 std::uint32_t CMap<D, A...>::count_cells() const {
-  const Mark m = marks_.reserve();
   std::uint32_t n = 0;
-  for_each_cell_root<I>(m, [&](std::uint32_t, const auto&) { ++n; });
-  free_mark(m);
+  if constexpr (I >= 0 && chain_cell<I>) {
+    const std::uint32_t cap = dart_capacity();
+    for (std::uint32_t x = 0; x < cap; ++x) n += is_live_index(x) && is_chain_root<I>(x) ? 1u : 0u;
+  } else {
+    for_each_cell_root<I>([&](std::uint32_t, const auto&) { ++n; });
+  }
   return n;
 }
 

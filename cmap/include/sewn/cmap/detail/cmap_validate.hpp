@@ -99,8 +99,7 @@ ValidationReport CMap<D, A...>::validate() const {
       // Whether the dart each attribute records was met carrying it: checked during the walks
       // (every live dart is met once) rather than by looking each recorded dart up afterwards.
       std::vector<std::uint8_t> recorded_ok(vals.capacity(), 0);
-      const Mark m = marks_.reserve();
-      for_each_cell_root<I>(m, [&](std::uint32_t root, const auto& darts) {
+      for_each_cell_root<I>([&](std::uint32_t root, const auto& darts) {
         const std::uint32_t a0 = st.of_dart[root];
         for (std::uint32_t y : darts) {
           const std::uint32_t a = st.of_dart[y];
@@ -126,7 +125,6 @@ ValidationReport CMap<D, A...>::validate() const {
           }
         }
       });
-      free_mark(m);
       for (std::uint32_t a = 0; a < vals.capacity(); ++a) {
         if (!vals.is_alive(a)) continue;
         if (vals.count(a) != counted[a]) [[unlikely]]
