@@ -485,24 +485,31 @@ class CMap {
   template <int I>
   [[nodiscard]] std::uint32_t count_cells() const;
 
+  // Dart pairs an operation links or unlinks; a sew or unsew of a face has a handful.
+  using DartPairs = boost::container::small_vector<std::pair<std::uint32_t, std::uint32_t>, 16>;
   template <int I>
   bool sew_pairs(std::uint32_t a, std::uint32_t b, std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) const;
   template <int I>
-  void unsew_pairs(std::uint32_t d, std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const;
+  void unsew_pairs(std::uint32_t d, DartPairs& out) const;
 
   std::uint32_t new_dart();
   void erase_dart_raw(std::uint32_t x);
+  // A bit per dimension whose attributes are enabled: work that only serves attributes is
+  // skipped at compile time when an operation's dimensions have none.
+  static constexpr unsigned attribute_dims = []<int... I>(std::integer_sequence<int, I...>) {
+    return (0u | ... | (has_attribute<I> ? 1u << I : 0u));
+  }(std::make_integer_sequence<int, D + 1>{});
   // Re-derives attributes after a topological change: `touched` holds the darts whose β links
   // changed (first the operation's first dart); `dims` a bit per dimension to update.
-  void update_attributes(const std::vector<std::uint32_t>& touched, unsigned dims);
+  void update_attributes(std::span<const std::uint32_t> touched, unsigned dims);
   template <int I>
-  void update_attributes_of(const std::vector<std::uint32_t>& touched);
-  template <int I>
-  void process_new_cell(const std::vector<std::uint32_t>& cell, std::vector<std::uint32_t>& claimed);
+  void update_attributes_of(std::span<const std::uint32_t> touched);
+  template <int I, class Claimed>
+  void process_new_cell(std::span<const std::uint32_t> cell, Claimed& claimed);
   template <int I>
   std::uint32_t copy_attribute(std::uint32_t a);
   template <int I>
-  void relabel(const std::vector<std::uint32_t>& cell, std::uint32_t from, std::uint32_t to);
+  void relabel(std::span<const std::uint32_t> cell, std::uint32_t from, std::uint32_t to);
   void flush_erased();
 
   // Gives `to` the attributes of `from` for every dimension whose bit is set in dims.
