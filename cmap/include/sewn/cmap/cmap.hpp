@@ -46,6 +46,7 @@
 
 #include "sewn/cmap/attributes.hpp"
 #include "sewn/cmap/detail/dart_buffer.hpp"
+#include "sewn/cmap/detail/pod_array.hpp"
 #include "sewn/cmap/dart.hpp"
 #include "sewn/cmap/errors.hpp"
 #include "sewn/cmap/marks.hpp"
@@ -74,7 +75,7 @@ struct nth_or_void<I, H, T...> {
 
 template <int I, class T>
 struct AttrStore {
-  std::vector<std::uint32_t> of_dart;  // attribute index of each dart's I-cell
+  PodArray<std::uint32_t> of_dart;  // attribute index of each dart's I-cell
   AttributeContainer<T> values;
   std::function<void(AttrId<I>, AttrId<I>)> on_split, on_merge;
   std::function<void(AttrId<I>)> on_erase;
@@ -470,9 +471,13 @@ class CMap {
   // successive darts overlap in the processor instead of queueing behind each mark update.
   template <int I>
   static constexpr bool chain_cell = D <= 2 || (D == 3 && I == 1);
-  // True if x is the smallest dart of its I-cell (a chain cell). Gives up after
-  // dart_capacity() steps (answering true), which only a map with inconsistent links
-  // (β0 ≠ β1⁻¹, a βi not an involution) can take.
+  // Calls f(y) for each dart of x's chain cell after x, in walk order (one way along the chain
+  // and, if it is open, the other way), until f returns false; returns false if f stopped it.
+  // Gives up after dart_capacity() steps, which only a map with inconsistent links (β0 ≠ β1⁻¹,
+  // a βi not an involution) can take.
+  template <int I, class F>
+  bool walk_chain_cell(std::uint32_t x, F&& f) const;
+  // True if x is the smallest dart of its I-cell (a chain cell).
   template <int I>
   [[nodiscard]] bool is_chain_root(std::uint32_t x) const;
   // Calls f(x, darts) for the smallest dart x of each I-cell (I < 0: each connected component)
@@ -532,7 +537,7 @@ class CMap {
   template <int I>
   bool plan_contraction(const DartList& c, std::vector<Relink>& links) const;
 
-  std::vector<std::array<std::uint32_t, D + 1>> beta_;
+  detail::PodArray<std::array<std::uint32_t, D + 1>> beta_;
   std::uint32_t free_head_ = detail::null_index;  // free list threaded through β1 of dead darts
   std::uint32_t alive_ = 0;
   Stores stores_;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "sewn/cmap/detail/pod_array.hpp"
 #include "sewn/cmap/errors.hpp"
 
 namespace sewn {
@@ -165,7 +166,7 @@ class MarkPlanes {
   }
 
  private:
-  std::array<std::vector<std::uint64_t>, max_marks> planes_{};
+  std::array<PodArray<std::uint64_t>, max_marks> planes_{};
   std::array<std::uint64_t, max_marks> polarity_{};
   std::array<std::uint32_t, max_marks> count_{};
   std::uint32_t reserved_ = 0;

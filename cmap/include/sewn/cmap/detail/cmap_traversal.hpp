@@ -189,33 +189,38 @@ void CMap<D, A...>::collect_unmarked(std::uint32_t root, Out& out) const {
 template <int D, class... A>
 template <int I, class Out>
 void CMap<D, A...>::collect_cell_unmarked(std::uint32_t root, Out& out) const {
-  const std::size_t first = out.size();
-  const Mark m = marks_.reserve();
-  const MarkView mk = marks_.view(m);
-  walk_cell<I>(root, mk, out);
-  for (std::size_t i = first; i < out.size(); ++i) mk.clear(detail::raw(out[i]));
-  marks_.release(m);
+  if constexpr (chain_cell<I>) {  // a chain needs no mark to be walked once
+    out.push_back(typename Out::value_type(root));
+    walk_chain_cell<I>(root, [&](std::uint32_t y) {
+      out.push_back(typename Out::value_type(y));
+      return true;
+    });
+  } else {
+    const std::size_t first = out.size();
+    const Mark m = marks_.reserve();
+    const MarkView mk = marks_.view(m);
+    walk_cell<I>(root, mk, out);
+    for (std::size_t i = first; i < out.size(); ++i) mk.clear(detail::raw(out[i]));
+    marks_.release(m);
+  }
 }
 
 template <int D, class... A>
-template <int I>
-bool CMap<D, A...>::is_chain_root(std::uint32_t x) const {
+template <int I, class F>
+bool CMap<D, A...>::walk_chain_cell(std::uint32_t x, F&& f) const {
   constexpr std::uint32_t null = detail::null_index;
-  auto smaller = [x](std::uint32_t y) { return y != null && y < x; };
   std::uint32_t budget = dart_capacity();
-  // The chain through x by `next` (and its inverse `prev`). Both neighbours of x are looked at
-  // first, as two independent loads: most darts are not the smallest and stop there.
+  // The darts after x by `next` until x comes back or the chain ends; if it ended, the darts
+  // before x by `prev` (the inverse of next).
   auto chain = [&](auto next, auto prev) {
-    const std::uint32_t n1 = next(x), p1 = prev(x);
-    if (smaller(n1) || smaller(p1)) return false;
-    std::uint32_t y = n1;
+    std::uint32_t y = next(x);
     for (; y != null && y != x; y = next(y)) {
-      if (y < x) return false;
+      if (!f(y)) return false;
       if (--budget == 0) return true;
     }
     if (y == x) return true;
-    for (y = p1; y != null && y != x; y = prev(y)) {
-      if (y < x) return false;
+    for (y = prev(x); y != null && y != x; y = prev(y)) {
+      if (!f(y)) return false;
       if (--budget == 0) return true;
     }
     return true;
@@ -223,7 +228,8 @@ bool CMap<D, A...>::is_chain_root(std::uint32_t x) const {
   if constexpr (D == 1) {
     return true;  // no generator: every cell is one dart
   } else if constexpr (D == 2 && I == 1) {
-    return !smaller(b(x, 2));
+    const std::uint32_t y = b(x, 2);
+    return y == null || y == x || f(y);
   } else if constexpr (D == 2 && I == 2) {
     return chain([&](std::uint32_t y) { return b(y, 1); }, [&](std::uint32_t y) { return b(y, 0); });
   } else if constexpr (D == 2 && I == 0) {
@@ -240,19 +246,36 @@ bool CMap<D, A...>::is_chain_root(std::uint32_t x) const {
   } else {
     static_assert(D == 3 && I == 1);
     // β2 and β3 alternately from x, then, if that path ends, alternately from x's β3
-    if (smaller(b(x, 2)) || smaller(b(x, 3))) return false;
     for (int first = 2; first <= 3; ++first) {
       std::uint32_t y = x;
       for (int j = first;; j = 5 - j) {
         y = b(y, j);
         if (y == null) break;
         if (y == x) return true;
-        if (y < x) return false;
+        if (!f(y)) return false;
         if (--budget == 0) return true;
       }
     }
     return true;
   }
+}
+
+template <int D, class... A>
+template <int I>
+bool CMap<D, A...>::is_chain_root(std::uint32_t x) const {
+  constexpr std::uint32_t null = detail::null_index;
+  auto smaller = [x](std::uint32_t y) { return y != null && y < x; };
+  // Both chain neighbours of x first, as independent loads: most darts are not the smallest
+  // and stop there. (D = 2 vertices: β1∘β2 and β2∘β0; faces: β1, β0; edges: β2 (and β3).)
+  if constexpr (D == 2 && I == 0) {
+    const std::uint32_t s2 = b(x, 2), s0 = b(x, 0);
+    if (smaller(s2 == null ? null : b(s2, 1)) || smaller(s0 == null ? null : b(s0, 2))) return false;
+  } else if constexpr (D == 2 && I == 2) {
+    if (smaller(b(x, 1)) || smaller(b(x, 0))) return false;
+  } else if constexpr (D == 3 && I == 1) {
+    if (smaller(b(x, 2)) || smaller(b(x, 3))) return false;
+  }
+  return walk_chain_cell<I>(x, [x](std::uint32_t y) { return y > x; });
 }
 
 template <int D, class... A>
