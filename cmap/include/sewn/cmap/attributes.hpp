@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sewn/cmap/dart.hpp"
+#include "sewn/cmap/detail/pod_array.hpp"
 
 namespace sewn {
 
@@ -96,8 +97,8 @@ class AttributeContainer {
 
  private:
   std::vector<T> values_;
-  std::vector<std::uint32_t> dart_;   // one dart of the cell, `dead` for a free slot
-  std::vector<std::uint32_t> count_;  // darts referring to the slot
+  detail::PodArray<std::uint32_t> dart_;   // one dart of the cell, `dead` for a free slot
+  detail::PodArray<std::uint32_t> count_;  // darts referring to the slot
   std::vector<std::uint32_t> free_;
   std::uint32_t alive_ = 0;
 };

@@ -30,6 +30,7 @@
 //
 // Not thread-safe, not even for const traversals: they use the map's marks.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -44,6 +45,8 @@
 #include <boost/container/small_vector.hpp>
 
 #include "sewn/cmap/attributes.hpp"
+#include "sewn/cmap/detail/dart_buffer.hpp"
+#include "sewn/cmap/detail/pod_array.hpp"
 #include "sewn/cmap/dart.hpp"
 #include "sewn/cmap/errors.hpp"
 #include "sewn/cmap/marks.hpp"
@@ -72,7 +75,7 @@ struct nth_or_void<I, H, T...> {
 
 template <int I, class T>
 struct AttrStore {
-  std::vector<std::uint32_t> of_dart;  // attribute index of each dart's I-cell
+  PodArray<std::uint32_t> of_dart;  // attribute index of each dart's I-cell
   AttributeContainer<T> values;
   std::function<void(AttrId<I>, AttrId<I>)> on_split, on_merge;
   std::function<void(AttrId<I>)> on_erase;
@@ -271,9 +274,10 @@ class CMap {
   [[nodiscard]] DartList cell(Dart d) const;
   /// Darts of the connected component of d. O(component).
   [[nodiscard]] std::vector<Dart> component(Dart d) const;
-  /// Range yielding one dart per I-cell, in increasing order of the cell's smallest dart.
-  /// Holds a mark while alive (released on destruction, early break included). Do not modify
-  /// the map while iterating.
+  /// Range yielding the smallest dart of each I-cell, in increasing order. Holds a mark while
+  /// alive (released on destruction, early break included), except for cells that are single
+  /// chains of darts (every cell of a 1- or 2-map, edges of a 3-map), found without one. Do not
+  /// modify the map while iterating.
   template <int I>
   [[nodiscard]] auto cells() const;
   /// One dart per J-cell incident to the I-cell of d (J < I: its faces; J > I: the cells it
@@ -430,66 +434,104 @@ class CMap {
     }(std::make_integer_sequence<int, D + 1>{});
   }
 
-  // Orbit descriptions: a bit per β index (bit 1 stands for β1 and β0), or the vertex orbit.
-  struct Orbit {
-    unsigned mask;
-    bool vertex;
-  };
+  // Orbits, as a compile-time mask: a bit per β index (bit 1 stands for β1 and β0), or
+  // vertex_orbit (bit 0, which no β mask uses) for the darts starting at one vertex.
+  static constexpr unsigned vertex_orbit = 1u;
   static constexpr unsigned all_betas = ((1u << (D + 1)) - 1u) & ~1u;
-  static constexpr Orbit cell_orbit(int i) {
-    return i == 0 ? Orbit{0, true} : Orbit{all_betas & ~(1u << i), false};
-  }
-  static constexpr Orbit component_orbit() { return Orbit{all_betas, false}; }
+  template <int I>
+  static constexpr unsigned cell_mask = I == 0 ? vertex_orbit : all_betas & ~(1u << I);
+  static constexpr unsigned component_mask = all_betas;
+  using MarkView = detail::MarkPlanes::View;
 
   void set_b(std::uint32_t x, int i, std::uint32_t y) { beta_[x][static_cast<std::size_t>(i)] = y; }
   // Links x -> y for βi, with the inverse (β0/β1 pair or involution). Null y makes x i-free.
   void raw_link(std::uint32_t x, int i, std::uint32_t y);
-  void check_alive(Dart d, const char* where) const;
+  void check_alive(Dart d, const char* where) const {
+    if (!is_alive(d)) [[unlikely]]
+      throw_dead(d, where);
+  }
+  [[noreturn]] void throw_dead(Dart d, const char* where) const;
   template <int I>
   void check_attr(AttrId<I> a) const;
   [[nodiscard]] std::vector<std::uint32_t> dead_darts() const;
 
-  template <class F>
-  void for_each_neighbor(std::uint32_t x, Orbit o, F&& f) const;
-  // Breadth-first collection of an orbit; marks visited darts with m and appends them to out.
+  // Calls f(y) for each neighbour y of x in the orbit (the generators, not the closure).
+  template <unsigned Mask, class F>
+  void for_each_neighbor(std::uint32_t x, F&& f) const;
+  // Walks mark the darts they visit through a view and append exactly those darts to `out`,
+  // which is how callers know how many to add to the mark's count (see MarkPlanes::View).
+  // Breadth-first walk of an orbit from root.
+  template <unsigned Mask, class Out>
+  void walk(std::uint32_t root, MarkView mk, Out& out) const;
+  // Continues a breadth-first walk: expands out[head..] (already marked) until closed.
+  template <unsigned Mask, class Out>
+  void expand(std::size_t head, MarkView mk, Out& out) const;
+  // The I-cell of root, with walks specialised per dimension (β1 chains for faces and volumes,
+  // alternating involutions for edges, generator maps around vertices) that fall back to the
+  // generic search where the map is open.
+  template <int I, class Out>
+  void walk_cell(std::uint32_t root, MarkView mk, Out& out) const;
   template <class Out>
-  void collect(std::uint32_t root, Orbit o, Mark m, Out& out) const;
-  // Continues a breadth-first collection: expands out[head..] (already marked) until closed.
-  template <class Out>
-  void expand(std::size_t head, Orbit o, Mark m, Out& out) const;
-  // As collect() for the I-cell of root, with walks specialised per dimension (β1 chains for
-  // faces and volumes, alternating involutions for edges, forward generators around interior
-  // vertices) that fall back to the generic search where the map is open.
+  void walk_chain(std::uint32_t x, MarkView mk, Out& out) const;
+  // walk_cell with the mark's count kept.
   template <int I, class Out>
   void collect_cell(std::uint32_t root, Mark m, Out& out) const;
-  template <class Out>
-  void collect_chain(std::uint32_t x, Mark m, Out& out) const;
-  template <int I>
-  [[nodiscard]] std::uint32_t count_cells() const;
+  // As collect_cell / walk with a mark of their own, left clear on return.
   template <int I, class Out>
   void collect_cell_unmarked(std::uint32_t root, Out& out) const;
-  template <class Out>
-  void collect_unmarked(std::uint32_t root, Orbit o, Out& out) const;
-  [[nodiscard]] std::uint32_t count_orbits(Orbit o) const;
+  template <unsigned Mask, class Out>
+  void collect_unmarked(std::uint32_t root, Out& out) const;
+  [[nodiscard]] bool is_live_index(std::uint32_t x) const { return beta_[x][0] != detail::dead_marker; }
+  // I-cells whose orbit is a single path or cycle of darts: every cell of a 1- or 2-map, and
+  // the edges of a 3-map. Whether a dart is the smallest of such a cell is found by walking
+  // the chain until a smaller dart comes up, without marks: no stores, so the walks from
+  // successive darts overlap in the processor instead of queueing behind each mark update.
+  template <int I>
+  static constexpr bool chain_cell = D <= 2 || (D == 3 && I == 1);
+  // Calls f(y) for each dart of x's chain cell after x, in walk order (one way along the chain
+  // and, if it is open, the other way), until f returns false; returns false if f stopped it.
+  // Gives up after dart_capacity() steps, which only a map with inconsistent links (β0 ≠ β1⁻¹,
+  // a βi not an involution) can take.
+  template <int I, class F>
+  bool walk_chain_cell(std::uint32_t x, F&& f) const;
+  // True if x is the smallest dart of its I-cell (a chain cell).
+  template <int I>
+  [[nodiscard]] bool is_chain_root(std::uint32_t x) const;
+  // Calls f(x, darts) for the smallest dart x of each I-cell (I < 0: each connected component)
+  // in increasing order, with the darts of the cell (x first), found by marking: each dart is
+  // walked once (chain walks revisit darts, which only pays when the darts are not wanted).
+  // f must not change the map.
+  template <int I, class F>
+  void for_each_cell_root(F&& f) const;
+  // Number of I-cells (I < 0: connected components).
+  template <int I>
+  [[nodiscard]] std::uint32_t count_cells() const;
 
+  // Dart pairs an operation links or unlinks; a sew or unsew of a face has a handful.
+  using DartPairs = boost::container::small_vector<std::pair<std::uint32_t, std::uint32_t>, 16>;
   template <int I>
   bool sew_pairs(std::uint32_t a, std::uint32_t b, std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) const;
   template <int I>
-  void unsew_pairs(std::uint32_t d, std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) const;
+  void unsew_pairs(std::uint32_t d, DartPairs& out) const;
 
   std::uint32_t new_dart();
   void erase_dart_raw(std::uint32_t x);
+  // A bit per dimension whose attributes are enabled: work that only serves attributes is
+  // skipped at compile time when an operation's dimensions have none.
+  static constexpr unsigned attribute_dims = []<int... I>(std::integer_sequence<int, I...>) {
+    return (0u | ... | (has_attribute<I> ? 1u << I : 0u));
+  }(std::make_integer_sequence<int, D + 1>{});
   // Re-derives attributes after a topological change: `touched` holds the darts whose β links
   // changed (first the operation's first dart); `dims` a bit per dimension to update.
-  void update_attributes(const std::vector<std::uint32_t>& touched, unsigned dims);
+  void update_attributes(std::span<const std::uint32_t> touched, unsigned dims);
   template <int I>
-  void update_attributes_of(const std::vector<std::uint32_t>& touched);
-  template <int I>
-  void process_new_cell(const std::vector<std::uint32_t>& cell, std::vector<std::uint32_t>& claimed);
+  void update_attributes_of(std::span<const std::uint32_t> touched);
+  template <int I, class Claimed>
+  void process_new_cell(std::span<const std::uint32_t> cell, Claimed& claimed);
   template <int I>
   std::uint32_t copy_attribute(std::uint32_t a);
   template <int I>
-  void relabel(const std::vector<std::uint32_t>& cell, std::uint32_t from, std::uint32_t to);
+  void relabel(std::span<const std::uint32_t> cell, std::uint32_t from, std::uint32_t to);
   void flush_erased();
 
   // Gives `to` the attributes of `from` for every dimension whose bit is set in dims.
@@ -512,7 +554,7 @@ class CMap {
   template <int I>
   bool plan_contraction(const DartList& c, std::vector<Relink>& links) const;
 
-  std::vector<std::array<std::uint32_t, D + 1>> beta_;
+  detail::PodArray<std::array<std::uint32_t, D + 1>> beta_;
   std::uint32_t free_head_ = detail::null_index;  // free list threaded through β1 of dead darts
   std::uint32_t alive_ = 0;
   Stores stores_;

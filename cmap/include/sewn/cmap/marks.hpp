@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "sewn/cmap/detail/pod_array.hpp"
 #include "sewn/cmap/errors.hpp"
 
 namespace sewn {
@@ -32,6 +33,56 @@ namespace detail {
 class MarkPlanes {
  public:
   static constexpr int max_marks = 32;
+
+  /// One reserved mark seen through its plane's raw words, for traversal loops: passed by
+  /// value, the word pointer and polarity stay in registers and test / set compile to a few
+  /// instructions. A view does not keep the marked count: code that marks or unmarks through
+  /// one adds the difference with add_count() before the count is read or the mark cleared.
+  /// Valid while the mark stays reserved and no dart is created (that may grow the plane).
+  struct View {
+    std::uint64_t* words;
+    std::uint64_t polarity;
+
+    [[nodiscard]] bool test(std::uint32_t d) const { return (((words[d >> 6] ^ polarity) >> (d & 63)) & 1u) != 0; }
+    /// Sets the bit; returns true if it was not set before.
+    bool set(std::uint32_t d) const {
+      const std::uint64_t bit = std::uint64_t{1} << (d & 63);
+      std::uint64_t& w = words[d >> 6];
+      if (((w ^ polarity) & bit) != 0) return false;
+      w ^= bit;
+      return true;
+    }
+    /// Clears the bit; returns true if it was set before.
+    bool clear(std::uint32_t d) const {
+      const std::uint64_t bit = std::uint64_t{1} << (d & 63);
+      std::uint64_t& w = words[d >> 6];
+      if (((w ^ polarity) & bit) == 0) return false;
+      w ^= bit;
+      return true;
+    }
+    /// The first unmarked index in [d, end), or end: a word at a time over marked runs.
+    [[nodiscard]] std::uint32_t next_unmarked(std::uint32_t d, std::uint32_t end) const {
+      if (d >= end) return end;
+      std::size_t w = d >> 6;
+      std::uint64_t free = ~(words[w] ^ polarity) & (~std::uint64_t{0} << (d & 63));
+      const std::size_t last = (static_cast<std::size_t>(end) + 63) >> 6;
+      while (free == 0) {
+        if (++w >= last) return end;
+        free = ~(words[w] ^ polarity);
+      }
+      const auto found = static_cast<std::uint32_t>((w << 6) + static_cast<std::size_t>(std::countr_zero(free)));
+      return found < end ? found : end;
+    }
+  };
+  [[nodiscard]] View view(Mark m) {
+    const auto i = static_cast<std::size_t>(m.id());
+    return View{planes_[i].data(), polarity_[i]};
+  }
+  /// Adds delta to the marked count of m (after marking or unmarking through a View).
+  void add_count(Mark m, std::int64_t delta) {
+    auto& c = count_[static_cast<std::size_t>(m.id())];
+    c = static_cast<std::uint32_t>(static_cast<std::int64_t>(c) + delta);
+  }
 
   Mark reserve() {
     if (reserved_ == ~std::uint32_t{0})
@@ -115,7 +166,7 @@ class MarkPlanes {
   }
 
  private:
-  std::array<std::vector<std::uint64_t>, max_marks> planes_{};
+  std::array<PodArray<std::uint64_t>, max_marks> planes_{};
   std::array<std::uint64_t, max_marks> polarity_{};
   std::array<std::uint32_t, max_marks> count_{};
   std::uint32_t reserved_ = 0;

@@ -11,7 +11,7 @@ AttrId<I> CMap<D, A...>::set_attribute(Dart d, attribute_type<I> v) {
   check_alive(d, "set_attribute");
   auto& st = store<I>();
   const std::uint32_t a = st.values.create(std::move(v));
-  std::vector<std::uint32_t> darts;
+  detail::DartBuffer<64> darts;
   collect_cell_unmarked<I>(d.index(), darts);
   for (std::uint32_t x : darts) {
     const std::uint32_t old = st.of_dart[x];
@@ -94,7 +94,7 @@ void CMap<D, A...>::inherit_attributes(std::uint32_t from, std::uint32_t to, uns
 }
 
 template <int D, class... A>
-void CMap<D, A...>::update_attributes(const std::vector<std::uint32_t>& touched, unsigned dims) {
+void CMap<D, A...>::update_attributes(std::span<const std::uint32_t> touched, unsigned dims) {
   for_each_dim([&](auto k) {
     constexpr int K = k();
     if constexpr (has_attribute<K>)
@@ -105,11 +105,10 @@ void CMap<D, A...>::update_attributes(const std::vector<std::uint32_t>& touched,
 
 template <int D, class... A>
 template <int I>
-void CMap<D, A...>::update_attributes_of(const std::vector<std::uint32_t>& touched) {
+void CMap<D, A...>::update_attributes_of(std::span<const std::uint32_t> touched) {
   // Every new I-cell that differs from an old one contains a dart whose links changed (for
   // I = 0: such a dart or a β-neighbour of one, since vertex generators are two links long).
-  std::vector<std::uint32_t> candidates;
-  candidates.reserve(touched.size() * (I == 0 ? D + 2 : 1));
+  detail::DartBuffer<128> candidates;
   for (std::uint32_t t : touched) {
     if (!is_alive(Dart(t))) continue;
     candidates.push_back(t);
@@ -117,16 +116,22 @@ void CMap<D, A...>::update_attributes_of(const std::vector<std::uint32_t>& touch
       for (int j = 0; j <= D; ++j)
         if (const std::uint32_t y = b(t, j); y != detail::null_index) candidates.push_back(y);
   }
+  // The cells are walked into `visited`, one after the other; each is processed (hooks run
+  // there, and may create or erase darts: the mark's view is taken again for each walk, and its
+  // count kept exact) and all are unmarked at the end.
   const Mark seen = marks_.reserve();
-  std::vector<std::uint32_t> visited, cell_darts, claimed;
+  detail::DartBuffer<256> visited;
+  boost::container::small_vector<std::uint32_t, 8> claimed;
   for (std::uint32_t c : candidates) {
     if (marks_.test(c, seen)) continue;
-    cell_darts.clear();
-    collect_cell<I>(c, seen, cell_darts);
-    visited.insert(visited.end(), cell_darts.begin(), cell_darts.end());
-    process_new_cell<I>(cell_darts, claimed);
+    const std::size_t first = visited.size();
+    collect_cell<I>(c, seen, visited);
+    process_new_cell<I>(std::span<const std::uint32_t>(visited.begin() + first, visited.end()), claimed);
   }
-  for (std::uint32_t x : visited) marks_.clear(x, seen);
+  const MarkView mk = marks_.view(seen);
+  std::int64_t cleared = 0;
+  for (std::uint32_t x : visited) cleared += mk.clear(x) ? 1 : 0;
+  marks_.add_count(seen, -cleared);
   marks_.release(seen);
 }
 
@@ -140,7 +145,7 @@ std::uint32_t CMap<D, A...>::copy_attribute(std::uint32_t a) {
 
 template <int D, class... A>
 template <int I>
-void CMap<D, A...>::relabel(const std::vector<std::uint32_t>& cell_darts, std::uint32_t from, std::uint32_t to) {
+void CMap<D, A...>::relabel(std::span<const std::uint32_t> cell_darts, std::uint32_t from, std::uint32_t to) {
   auto& st = store<I>();
   std::int64_t moved = 0;
   for (std::uint32_t x : cell_darts)
@@ -153,8 +158,8 @@ void CMap<D, A...>::relabel(const std::vector<std::uint32_t>& cell_darts, std::u
 }
 
 template <int D, class... A>
-template <int I>
-void CMap<D, A...>::process_new_cell(const std::vector<std::uint32_t>& cell_darts, std::vector<std::uint32_t>& claimed) {
+template <int I, class Claimed>
+void CMap<D, A...>::process_new_cell(std::span<const std::uint32_t> cell_darts, Claimed& claimed) {
   auto& st = store<I>();
   // Distinct attributes of the cell in BFS order, with how many of its darts carry each.
   boost::container::small_vector<std::pair<std::uint32_t, std::uint32_t>, 4> attrs;

@@ -4,13 +4,11 @@
 namespace sewn {
 
 template <int D, class... A>
-void CMap<D, A...>::check_alive(Dart d, const char* where) const {
-  if (!is_alive(d)) [[unlikely]] {
-    if (d.is_null()) throw TopologyError(std::string("cmap::") + where + ": null dart");
-    throw TopologyError(std::string("cmap::") + where + ": dart " + std::to_string(d.index()) +
-                        (d.index() < beta_.size() ? " has been erased" : " is out of range (capacity " +
-                                                                            std::to_string(beta_.size()) + ")"));
-  }
+void CMap<D, A...>::throw_dead(Dart d, const char* where) const {
+  if (d.is_null()) throw TopologyError(std::string("cmap::") + where + ": null dart");
+  throw TopologyError(std::string("cmap::") + where + ": dart " + std::to_string(d.index()) +
+                      (d.index() < beta_.size() ? " has been erased" : " is out of range (capacity " +
+                                                                          std::to_string(beta_.size()) + ")"));
 }
 
 template <int D, class... A>
@@ -23,24 +21,26 @@ void CMap<D, A...>::check_attr(AttrId<I> a) const {
 
 template <int D, class... A>
 std::uint32_t CMap<D, A...>::new_dart() {
+  std::array<std::uint32_t, D + 1> unlinked;
+  unlinked.fill(detail::null_index);
   std::uint32_t x;
   if (free_head_ != detail::null_index) {
     x = free_head_;
     free_head_ = beta_[x][1];
+    beta_[x] = unlinked;
+    for_each_dim([&](auto k) {
+      if constexpr (has_attribute<k()>) store<k()>().of_dart[x] = detail::null_index;
+    });
   } else {
     if (beta_.size() >= detail::dead_marker - 1)
       throw CapacityError("cmap: the map cannot hold more than 2^32 - 3 darts");
     x = static_cast<std::uint32_t>(beta_.size());
-    beta_.emplace_back();
+    beta_.push_back(unlinked);
     for_each_dim([&](auto k) {
       if constexpr (has_attribute<k()>) store<k()>().of_dart.push_back(detail::null_index);
     });
     if ((x & 63u) == 0) marks_.resize(x + 64);
   }
-  beta_[x].fill(detail::null_index);
-  for_each_dim([&](auto k) {
-    if constexpr (has_attribute<k()>) store<k()>().of_dart[x] = detail::null_index;
-  });
   ++alive_;
   return x;
 }
@@ -93,6 +93,7 @@ void CMap<D, A...>::erase_dart(Dart d) {
 
 template <int D, class... A>
 void CMap<D, A...>::flush_erased() {
+  if (pending_erase_.empty()) return;
   auto pending = std::move(pending_erase_);
   pending_erase_.clear();
   for (auto [k, a] : pending) {

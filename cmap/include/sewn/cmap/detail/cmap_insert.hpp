@@ -9,36 +9,35 @@ Dart CMap<D, A...>::insert_vertex_in_edge(Dart d) {
   check_alive(d, "insert_vertex_in_edge");
   constexpr std::uint32_t null = detail::null_index;
   // 1) the darts of the edge (every dart on it, in every face and volume)
-  std::vector<std::uint32_t> edge;
-  collect_unmarked(d.index(), cell_orbit(1), edge);
+  detail::DartBuffer<32> edge;
+  collect_cell_unmarked<1>(d.index(), edge);
   // 2) a new dart after each of them, in its face: x -> x' -> old β1(x)
-  std::vector<std::uint32_t> split(edge.size());
-  std::vector<std::uint32_t> touched;
-  touched.reserve(4 * edge.size());
-  for (std::size_t k = 0; k < edge.size(); ++k) {
-    const std::uint32_t x = edge[k], nx = new_dart(), next = b(x, 1);
+  for (std::uint32_t x : edge) {
+    const std::uint32_t nx = new_dart(), next = b(x, 1);
     inherit_attributes(x, nx, ~1u);  // same edge (for now), face, volume...; a new vertex
-    split[k] = nx;
     raw_link(nx, 1, next);
     raw_link(x, 1, nx);
-    touched.push_back(x);
-    touched.push_back(nx);
-    if (next != null) touched.push_back(next);
   }
-  // 3) βj partners cross over: if βj(x) = y then βj(x) = y' and βj(x') = y
-  auto index_of = [&](std::uint32_t y) {
-    return static_cast<std::size_t>(std::find(edge.begin(), edge.end(), y) - edge.begin());
-  };
-  for (std::size_t k = 0; k < edge.size(); ++k)
+  // 3) βj partners cross over: if βj(x) = y then βj(x) = y' and βj(x') = y, where y' = β1(y)
+  //    is y's new dart (step 2)
+  for (std::uint32_t x : edge)
     for (int j = 2; j <= D; ++j) {
-      const std::uint32_t y = b(edge[k], j);
-      if (y == null || b(split[k], j) != null) continue;
-      const std::size_t l = index_of(y);
-      raw_link(edge[k], j, split[l]);
-      raw_link(split[k], j, y);
+      const std::uint32_t y = b(x, j), nx = b(x, 1);
+      if (y == null || b(nx, j) != null) continue;
+      raw_link(x, j, b(y, 1));
+      raw_link(nx, j, y);
     }
-  update_attributes(touched, 1u << 1);  // only the edge splits; the rest was inherited
-  return Dart(split[0]);
+  // 4) only the edge splits; the rest was inherited
+  if constexpr (has_attribute<1>) {
+    detail::DartBuffer<64> touched;
+    for (std::uint32_t x : edge) {
+      touched.push_back(x);
+      touched.push_back(b(x, 1));
+      if (const std::uint32_t next = b(b(x, 1), 1); next != null) touched.push_back(next);
+    }
+    update_attributes(touched, 1u << 1);
+  }
+  return Dart(b(d.index(), 1));
 }
 
 template <int D, class... A>
@@ -74,36 +73,32 @@ Dart CMap<D, A...>::insert_edge_in_face(Dart a, Dart b2) {
   struct Copy {
     std::uint32_t a, b;      // images of a and b under the βj path (for the BFS)
     std::uint32_t c1, c2;    // darts of this copy starting at the vertices of a and b
+    bool flipped;
     std::uint32_t n1 = null, n2 = null;
+    std::array<std::uint32_t, D + 1> next{};  // copy index reached by βj (j ≥ 3), or null
   };
-  std::vector<Copy> copies;
-  std::vector<std::array<std::uint32_t, D + 1>> next_copy;  // copy index reached by βj
-  const Mark seen = marks_.reserve();
-  std::vector<std::uint32_t> marked;
+  boost::container::small_vector<Copy, 2> copies;
   auto add_copy = [&](std::uint32_t ca, std::uint32_t cb, bool flipped) {
-    marks_.set(ca, seen);
-    marked.push_back(ca);
-    copies.push_back({ca, cb, flipped ? b(ca, 1) : ca, flipped ? b(cb, 1) : cb});
-    next_copy.emplace_back();
-    next_copy.back().fill(null);
+    copies.push_back({ca, cb, flipped ? b(ca, 1) : ca, flipped ? b(cb, 1) : cb, flipped});
+    copies.back().next.fill(null);
   };
-  std::vector<bool> flip{false};
   add_copy(a.index(), b2.index(), false);
-  for (std::size_t k = 0; k < copies.size(); ++k)
-    for (int j = 3; j <= D; ++j) {
-      const std::uint32_t ja = b(copies[k].a, j), jb = b(copies[k].b, j);
-      if (ja == null || jb == null) continue;
-      if (!marks_.test(ja, seen)) {
-        flip.push_back(!flip[k]);
-        add_copy(ja, jb, flip.back());
+  if constexpr (D >= 3) {
+    const Mark seen = marks_.reserve();
+    const MarkView mk = marks_.view(seen);
+    mk.set(a.index());
+    for (std::size_t k = 0; k < copies.size(); ++k)
+      for (int j = 3; j <= D; ++j) {
+        const std::uint32_t ja = b(copies[k].a, j), jb = b(copies[k].b, j);
+        if (ja == null || jb == null) continue;
+        if (mk.set(ja)) add_copy(ja, jb, !copies[k].flipped);
+        copies[k].next[static_cast<std::size_t>(j)] = static_cast<std::uint32_t>(
+            std::find_if(copies.begin(), copies.end(), [&](const Copy& c) { return c.a == ja; }) - copies.begin());
       }
-      next_copy[k][static_cast<std::size_t>(j)] = static_cast<std::uint32_t>(
-          std::find_if(copies.begin(), copies.end(), [&](const Copy& c) { return c.a == ja; }) - copies.begin());
-    }
-  for (std::uint32_t x : marked) marks_.clear(x, seen);
-  marks_.release(seen);
+    for (const Copy& c : copies) mk.clear(c.a);
+    marks_.release(seen);
+  }
   // 2) in each copy, n1 (c1 -> c2 vertices) closes the face holding c2, n2 the one holding c1
-  std::vector<std::uint32_t> touched;
   for (auto& c : copies) {
     const std::uint32_t p1 = b(c.c1, 0), p2 = b(c.c2, 0);
     c.n1 = new_dart();
@@ -116,17 +111,22 @@ Dart CMap<D, A...>::insert_edge_in_face(Dart a, Dart b2) {
     raw_link(p2, 1, c.n2);
     raw_link(c.n2, 1, c.c1);
     raw_link(c.n1, 2, c.n2);
-    touched.insert(touched.end(), {c.c1, c.n1, c.n2, c.c2, p1, p2});
   }
   // 3) βj between copies: n1 of one copy faces n2 of the next (opposite orientation)
-  for (std::size_t k = 0; k < copies.size(); ++k)
+  for (const Copy& c : copies)
     for (int j = 3; j <= D; ++j) {
-      const std::uint32_t l = next_copy[k][static_cast<std::size_t>(j)];
+      const std::uint32_t l = c.next[static_cast<std::size_t>(j)];
       if (l == null) continue;
-      raw_link(copies[k].n1, j, copies[l].n2);
-      raw_link(copies[k].n2, j, copies[l].n1);
+      raw_link(c.n1, j, copies[l].n2);
+      raw_link(c.n2, j, copies[l].n1);
     }
-  update_attributes(touched, 1u << 2);  // only the face splits; the rest was inherited
+  // 4) only the face splits; the rest was inherited
+  if constexpr (has_attribute<2>) {
+    detail::DartBuffer<64> touched;
+    for (const Copy& c : copies)
+      for (std::uint32_t x : {c.c1, c.n1, c.n2, c.c2, b(c.n1, 0), b(c.n2, 0)}) touched.push_back(x);
+    update_attributes(touched, 1u << 2);
+  }
   return Dart(copies[0].n1);
 }
 
@@ -166,7 +166,8 @@ Dart CMap<D, A...>::insert_face_in_volume(std::span<const Dart> path) {
   const std::size_t k = path.size();
   // Path dart d_i goes v_i -> v_{i+1}. New face: p_i (v_{i+1} -> v_i) on d's side and
   // q_i (v_i -> v_{i+1}) on the side of e_i = old β2(d_i), with β3(p_i) = q_i.
-  std::vector<std::uint32_t> p(k), q(k), e(k), touched;
+  std::vector<std::uint32_t> p(k), q(k), e(k);
+  detail::DartBuffer<64> touched;
   for (std::size_t i = 0; i < k; ++i) {
     p[i] = new_dart();
     q[i] = new_dart();
@@ -184,7 +185,7 @@ Dart CMap<D, A...>::insert_face_in_volume(std::span<const Dart> path) {
     raw_link(p[i], 3, q[i]);
     raw_link(path[i].index(), 2, p[i]);
     if (e[i] != null) raw_link(e[i], 2, q[i]);
-    touched.insert(touched.end(), {path[i].index(), p[i], q[i]});
+    for (std::uint32_t x : {path[i].index(), p[i], q[i]}) touched.push_back(x);
     if (e[i] != null) touched.push_back(e[i]);
   }
   update_attributes(touched, 1u << 3);  // only the volume may split; the rest was inherited

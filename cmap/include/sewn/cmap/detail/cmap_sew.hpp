@@ -63,21 +63,17 @@ bool CMap<D, A...>::sew_pairs(std::uint32_t a, std::uint32_t b0, std::vector<std
 
 template <int D, class... A>
 template <int I>
-void CMap<D, A...>::unsew_pairs(std::uint32_t d, std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs) const {
+void CMap<D, A...>::unsew_pairs(std::uint32_t d, DartPairs& pairs) const {
   constexpr std::uint32_t null = detail::null_index;
   pairs.clear();
   const Mark m = marks_.reserve();
-  std::vector<std::uint32_t> marked;
+  const MarkView mk = marks_.view(m);
   // A partial map may hold an I-sewn dart whose β1-neighbour is I-free (its partner's face is
   // open there); only sewn darts belong to the orbit being unsewn.
   auto visit = [&](std::uint32_t x) {
-    if (x == null || b(x, I) == null || !marks_.set(x, m)) return;
-    marked.push_back(x);
+    if (x == null || b(x, I) == null || !mk.set(x)) return;
     const std::uint32_t y = b(x, I);
-    if constexpr (I >= 2) {
-      marks_.set(y, m);
-      marked.push_back(y);
-    }
+    if constexpr (I >= 2) mk.set(y);
     pairs.emplace_back(x, y);
   };
   visit(d);
@@ -96,7 +92,10 @@ void CMap<D, A...>::unsew_pairs(std::uint32_t d, std::vector<std::pair<std::uint
     }
     for (int j = 2; j <= I - 2; ++j) visit(b(x, j));
   }
-  for (std::uint32_t x : marked) marks_.clear(x, m);
+  for (auto [x, y] : pairs) {  // the marked darts: the pairs' first darts, and for I ≥ 2 their partners
+    mk.clear(x);
+    if constexpr (I >= 2) mk.clear(y);
+  }
   marks_.release(m);
 }
 
@@ -132,14 +131,17 @@ void CMap<D, A...>::sew(Dart a, Dart b2) {
     throw TopologyError("cmap::sew<" + std::to_string(I) + ">: darts " + std::to_string(a.index()) + " and " +
                         std::to_string(b2.index()) +
                         " are not sewable (not free, or their orbits differ in shape; see is_sewable)");
-  std::vector<std::uint32_t> touched;
-  touched.reserve(2 * pairs.size());
-  for (auto [x, y] : pairs) {
-    raw_link(x, I, y);
-    touched.push_back(x);
-    touched.push_back(y);
+  for (auto [x, y] : pairs) raw_link(x, I, y);
+  // I-cells keep their darts (βI is not among their generators); the others may merge.
+  constexpr unsigned dims = ~(1u << I);
+  if constexpr ((attribute_dims & dims) != 0) {
+    detail::DartBuffer<64> touched;
+    for (auto [x, y] : pairs) {
+      touched.push_back(x);
+      touched.push_back(y);
+    }
+    update_attributes(touched, dims);
   }
-  update_attributes(touched, ~(1u << I));
 }
 
 template <int D, class... A>
@@ -150,7 +152,7 @@ void CMap<D, A...>::unlink(Dart d) {
   if (b(d.index(), I) == detail::null_index)
     throw TopologyError("cmap::unsew<" + std::to_string(I) + ">: dart " + std::to_string(d.index()) + " is " +
                         std::to_string(I) + "-free");
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  DartPairs pairs;
   unsew_pairs<I>(d.index(), pairs);
   constexpr int inv = I == 1 ? 0 : I;
   for (auto [x, y] : pairs) {
@@ -167,18 +169,23 @@ void CMap<D, A...>::unsew(Dart d) {
   if (b(d.index(), I) == detail::null_index)
     throw TopologyError("cmap::unsew<" + std::to_string(I) + ">: dart " + std::to_string(d.index()) + " is " +
                         std::to_string(I) + "-free");
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  DartPairs pairs;
   unsew_pairs<I>(d.index(), pairs);
-  std::vector<std::uint32_t> touched;
-  touched.reserve(2 * pairs.size());
   constexpr int inv = I == 1 ? 0 : I;
   for (auto [x, y] : pairs) {
     set_b(x, I, detail::null_index);
     set_b(y, inv, detail::null_index);
-    touched.push_back(x);
-    touched.push_back(y);
   }
-  update_attributes(touched, ~(1u << I));
+  // I-cells keep their darts (βI is not among their generators); the others may split.
+  constexpr unsigned dims = ~(1u << I);
+  if constexpr ((attribute_dims & dims) != 0) {
+    detail::DartBuffer<64> touched;
+    for (auto [x, y] : pairs) {
+      touched.push_back(x);
+      touched.push_back(y);
+    }
+    update_attributes(touched, dims);
+  }
 }
 
 }  // namespace sewn

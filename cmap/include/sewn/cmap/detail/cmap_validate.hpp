@@ -31,36 +31,37 @@ ValidationReport CMap<D, A...>::validate() const {
   // 2) links: live targets, β0 = β1⁻¹, involutions, commuting pairs
   for (std::uint32_t x = 0; x < cap; ++x) {
     if (!live(x)) continue;
+    const std::array<std::uint32_t, D + 1> row = beta_[x];
     bool links_ok = true;
     for (int i = 0; i <= D; ++i) {
-      const std::uint32_t y = b(x, i);
-      if (y != null && !live(y)) {
+      const std::uint32_t y = row[static_cast<std::size_t>(i)];
+      if (y != null && !live(y)) [[unlikely]] {
         r.add(K::dangling_link, x, i, "beta" + std::to_string(i) + "(" + s(x) + ") = " + s(y) + " is not a live dart");
         links_ok = false;
       }
     }
     if (!links_ok) continue;
-    if (const std::uint32_t y = b(x, 1); y != null && b(y, 0) != x)
+    if (const std::uint32_t y = row[1]; y != null && b(y, 0) != x) [[unlikely]]
       r.add(K::beta0_beta1, x, 1, "beta0(beta1(" + s(x) + ")) = " + s(b(y, 0)) + ", expected " + s(x));
-    if (const std::uint32_t y = b(x, 0); y != null && b(y, 1) != x)
+    if (const std::uint32_t y = row[0]; y != null && b(y, 1) != x) [[unlikely]]
       r.add(K::beta0_beta1, x, 0, "beta1(beta0(" + s(x) + ")) = " + s(b(y, 1)) + ", expected " + s(x));
     for (int i = 2; i <= D; ++i) {
-      const std::uint32_t y = b(x, i);
-      if (y == x)
+      const std::uint32_t y = row[static_cast<std::size_t>(i)];
+      if (y == x) [[unlikely]]
         r.add(K::not_involution, x, i, "beta" + std::to_string(i) + "(" + s(x) + ") = " + s(x) + " (a fixed point)");
-      else if (y != null && b(y, i) != x)
+      else if (y != null && b(y, i) != x) [[unlikely]]
         r.add(K::not_involution, x, i,
               "beta" + std::to_string(i) + " is not an involution at dart " + s(x) + ": beta" + std::to_string(i) +
                   "(" + s(y) + ") = " + s(b(y, i)));
     }
     // β1∘βj (j ≥ 3): βj(β1(x)) = β0(βj(x)), both null or both equal
     for (int j = 3; j <= D; ++j) {
-      const std::uint32_t xj = b(x, j);
+      const std::uint32_t xj = row[static_cast<std::size_t>(j)];
       if (xj == null) continue;
-      const std::uint32_t x1 = b(x, 1);
+      const std::uint32_t x1 = row[1];
       const std::uint32_t lhs = x1 == null ? null : b(x1, j);
       const std::uint32_t rhs = b(xj, 0);
-      if (lhs != rhs)
+      if (lhs != rhs) [[unlikely]]
         r.add(K::composition, x, j,
               "beta1 o beta" + std::to_string(j) + " is not an involution at dart " + s(x) + ": beta" +
                   std::to_string(j) + "(beta1(" + s(x) + ")) = " + s(lhs) + " but beta0(beta" + std::to_string(j) +
@@ -69,10 +70,10 @@ ValidationReport CMap<D, A...>::validate() const {
     // βi∘βj for 2 ≤ i, i+2 ≤ j: they commute
     for (int i = 2; i <= D; ++i)
       for (int j = i + 2; j <= D; ++j) {
-        const std::uint32_t xi = b(x, i), xj = b(x, j);
+        const std::uint32_t xi = row[static_cast<std::size_t>(i)], xj = row[static_cast<std::size_t>(j)];
         const std::uint32_t ij = xi == null ? null : b(xi, j);
         const std::uint32_t ji = xj == null ? null : b(xj, i);
-        if (ij != ji)
+        if (ij != ji) [[unlikely]]
           r.add(K::composition, x, j,
                 "beta" + std::to_string(i) + " o beta" + std::to_string(j) + " is not an involution at dart " + s(x) +
                     ": beta" + std::to_string(j) + "(beta" + std::to_string(i) + ") = " + s(ij) + ", beta" +
@@ -81,56 +82,63 @@ ValidationReport CMap<D, A...>::validate() const {
   }
   if (!r.ok()) return r;  // attribute checks traverse orbits and need sound links
 
-  // 3) attributes: one per cell, counts, orphans, one cell per attribute, recorded dart
+  // 3) attributes, walking each cell once: every dart carries the attribute of the cell's
+  //    smallest dart, each attribute lies in one cell, reference counts match, no orphan, and
+  //    the recorded dart carries its attribute.
   for_each_dim([&](auto k) {
     constexpr int I = k();
     if constexpr (has_attribute<I>) {
       const auto& st = store<I>();
       const auto& vals = st.values;
-      std::vector<std::uint32_t> counted(vals.capacity(), 0);
       const std::string dim = std::to_string(I) + "-attribute";
-      for (std::uint32_t x = 0; x < cap; ++x) {
-        if (!live(x)) continue;
-        const std::uint32_t a = st.of_dart[x];
-        if (a != null) {
-          if (!vals.is_alive(a)) {
-            r.add(K::attribute_dead, x, I, "dart " + s(x) + " refers to " + dim + " " + s(a) + ", which is not live");
+      std::vector<std::uint32_t> counted(vals.capacity(), 0);
+      // The smallest dart of the first cell seen carrying each attribute; `reported` once a
+      // second cell has been reported.
+      constexpr std::uint32_t reported = detail::dead_marker;
+      std::vector<std::uint32_t> cell_of(vals.capacity(), null);
+      // Whether the dart each attribute records was met carrying it: checked during the walks
+      // (every live dart is met once) rather than by looking each recorded dart up afterwards.
+      std::vector<std::uint8_t> recorded_ok(vals.capacity(), 0);
+      for_each_cell_root<I>([&](std::uint32_t root, const auto& darts) {
+        const std::uint32_t a0 = st.of_dart[root];
+        for (std::uint32_t y : darts) {
+          const std::uint32_t a = st.of_dart[y];
+          if (a != a0) [[unlikely]]
+            r.add(K::attribute_mismatch, y, I,
+                  "darts " + s(root) + " and " + s(y) + " are in one " + std::to_string(I) + "-cell but carry " + dim +
+                      "s " + s(a0) + " and " + s(a));
+          if (a == null) continue;
+          if (!vals.is_alive(a)) [[unlikely]] {
+            r.add(K::attribute_dead, y, I, "dart " + s(y) + " refers to " + dim + " " + s(a) + ", which is not live");
             continue;
           }
           ++counted[a];
+          if (vals.dart(a) == y) recorded_ok[a] = 1;
+          std::uint32_t& c = cell_of[a];
+          if (c == null) {
+            c = root;
+          } else if (c != root && c != reported) [[unlikely]] {
+            r.add(K::attribute_two_cells, y, I,
+                  dim + " " + s(a) + " is carried by darts of two " + std::to_string(I) + "-cells: those of darts " +
+                      s(c) + " and " + s(root));
+            c = reported;
+          }
         }
-        for_each_neighbor(x, cell_orbit(I), [&](std::uint32_t y) {
-          if (st.of_dart[y] != a)
-            r.add(K::attribute_mismatch, x, I,
-                  "darts " + s(x) + " and " + s(y) + " are in one " + std::to_string(I) + "-cell but carry " + dim +
-                      "s " + s(a) + " and " + s(st.of_dart[y]));
-        });
-      }
-      const Mark m = marks_.reserve();
-      std::vector<std::uint32_t> queue;
+      });
       for (std::uint32_t a = 0; a < vals.capacity(); ++a) {
         if (!vals.is_alive(a)) continue;
-        if (vals.count(a) != counted[a])
+        if (vals.count(a) != counted[a]) [[unlikely]]
           r.add(K::attribute_count, null, I,
                 dim + " " + s(a) + " has reference count " + std::to_string(vals.count(a)) + " but " +
                     std::to_string(counted[a]) + " darts refer to it");
-        if (counted[a] == 0) {
+        if (counted[a] == 0) [[unlikely]] {
           r.add(K::attribute_orphan, null, I, dim + " " + s(a) + " is live but no dart refers to it");
           continue;
         }
-        const std::uint32_t rep = vals.dart(a);
-        if (!live(rep) || st.of_dart[rep] != a) {
-          r.add(K::attribute_dart, rep, I, dim + " " + s(a) + " records dart " + s(rep) + ", which is not in its cell");
-          continue;
-        }
-        queue.clear();
-        collect_cell<I>(rep, m, queue);
-        if (queue.size() != counted[a])
-          r.add(K::attribute_two_cells, rep, I,
-                dim + " " + s(a) + " is carried by " + std::to_string(counted[a]) + " darts but the cell of dart " +
-                    s(rep) + " has " + std::to_string(queue.size()));
+        if (!recorded_ok[a]) [[unlikely]]
+          r.add(K::attribute_dart, vals.dart(a), I,
+                dim + " " + s(a) + " records dart " + s(vals.dart(a)) + ", which is not in its cell");
       }
-      free_mark(m);
     }
   });
 
