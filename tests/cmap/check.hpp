@@ -6,6 +6,8 @@
 #include <array>
 #include <cstdint>
 #include <deque>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "sewn/cmap/cmap.hpp"
@@ -67,8 +69,49 @@ std::array<std::uint32_t, Map::dimension + 1> recount(const Map& m) {
   return n;
 }
 
-// validate() is clean, the map's own counts agree with the independent recount, and no mark is
-// left reserved. Returns the counts.
+// What cells<i>() yields, against the independent search: one dart per cell, each the smallest
+// of its cell, as many as `ref` counts. Empty if so, else the first problem found.
+template <class Map>
+std::string check_iteration(const Map& m, const std::array<std::uint32_t, Map::dimension + 1>& ref) {
+  constexpr int D = Map::dimension;
+  std::string problem;
+  auto one = [&](auto k) {
+    constexpr int I = decltype(k)::value;
+    if (!problem.empty()) return;
+    std::vector<char> seen(m.dart_capacity(), 0);
+    std::uint32_t n = 0;
+    for (Dart d : m.template cells<I>()) {
+      ++n;
+      if (seen[d.index()]) {
+        problem = "cells<" + std::to_string(I) + ">() yields two darts of one cell";
+        return;
+      }
+      std::deque<Dart> queue{d};
+      seen[d.index()] = 1;
+      while (!queue.empty()) {
+        const Dart x = queue.front();
+        queue.pop_front();
+        if (x < d) {
+          problem = "cells<" + std::to_string(I) + ">() yields a dart that is not the smallest of its cell";
+          return;
+        }
+        for (Dart y : orbit_neighbours(m, x, I))
+          if (!seen[y.index()]) {
+            seen[y.index()] = 1;
+            queue.push_back(y);
+          }
+      }
+    }
+    if (n != ref[I]) problem = "cells<" + std::to_string(I) + ">() yields " + std::to_string(n) + " cells, not " + std::to_string(ref[I]);
+  };
+  [&]<int... I>(std::integer_sequence<int, I...>) {
+    (one(std::integral_constant<int, I>{}), ...);
+  }(std::make_integer_sequence<int, D + 1>{});
+  return problem;
+}
+
+// validate() is clean, the map's own counts agree with the independent recount, cells<i>()
+// yields the smallest dart of each cell, and no mark is left reserved. Returns the counts.
 template <class Map>
 std::array<std::uint32_t, Map::dimension + 1> check_map(const Map& m) {
   const auto report = m.validate();
@@ -80,6 +123,9 @@ std::array<std::uint32_t, Map::dimension + 1> check_map(const Map& m) {
     INFO("dimension " << i);
     CHECK(own[static_cast<std::size_t>(i)] == ref[static_cast<std::size_t>(i)]);
   }
+  const std::string iteration = check_iteration(m, ref);
+  INFO(iteration);
+  CHECK(iteration.empty());
   CHECK(m.num_reserved_marks() == 0);
   return own;
 }

@@ -79,6 +79,7 @@ struct Fuzzer {
     const auto own = m.count_all();
     const auto ref = sewn::test::recount(m);
     if (own != ref) return "count_all() differs from the independent recount";
+    if (std::string e = sewn::test::check_iteration(m, ref); !e.empty()) return e;
     if (m.num_reserved_marks() != 0) return "a mark is still reserved";
     label_new_cells();
     bool ok = true;

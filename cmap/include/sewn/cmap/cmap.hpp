@@ -275,9 +275,9 @@ class CMap {
   /// Darts of the connected component of d. O(component).
   [[nodiscard]] std::vector<Dart> component(Dart d) const;
   /// Range yielding the smallest dart of each I-cell, in increasing order. Holds a mark while
-  /// alive (released on destruction, early break included), except for cells that are single
-  /// chains of darts (every cell of a 1- or 2-map, edges of a 3-map), found without one. Do not
-  /// modify the map while iterating.
+  /// alive (released on destruction, early break included), except for the cells it recognises
+  /// without one (every cell of a 1- or 2-map, edges and faces of a 3-map). Do not modify the
+  /// map while iterating.
   template <int I>
   [[nodiscard]] auto cells() const;
   /// One dart per J-cell incident to the I-cell of d (J < I: its faces; J > I: the cells it
@@ -497,6 +497,26 @@ class CMap {
   // True if x is the smallest dart of its I-cell (a chain cell).
   template <int I>
   [[nodiscard]] bool is_chain_root(std::uint32_t x) const;
+  // Cells whose smallest dart is recognised without marks: chain cells, and the faces of a
+  // 3-map (a β1 cycle and its β3 partner's, checked to have that shape).
+  template <int I>
+  static constexpr bool rooted_without_marks = chain_cell<I> || (D == 3 && I == 2);
+  // True if x is the smallest dart of its face (D = 3). Inlined: most darts have a smaller
+  // neighbour in their own row and stop there; the others walk the face (face_root_walk).
+  [[nodiscard]] bool is_face_root(std::uint32_t x) const {
+    const auto& r = beta_[x];
+    auto smaller = [x](std::uint32_t y) { return y != detail::null_index && y < x; };
+    return !(smaller(r[0]) || smaller(r[1]) || smaller(r[3])) && face_root_walk(x);
+  }
+  [[nodiscard]] bool face_root_walk(std::uint32_t x) const;
+  template <int I>
+  [[nodiscard]] bool is_cell_root(std::uint32_t x) const {
+    static_assert(rooted_without_marks<I>);
+    if constexpr (chain_cell<I>)
+      return is_chain_root<I>(x);
+    else
+      return is_face_root(x);
+  }
   // Calls f(x, darts) for the smallest dart x of each I-cell (I < 0: each connected component)
   // in increasing order, with the darts of the cell (x first), found by marking: each dart is
   // walked once (chain walks revisit darts, which only pays when the darts are not wanted).

@@ -279,6 +279,38 @@ bool CMap<D, A...>::is_chain_root(std::uint32_t x) const {
 }
 
 template <int D, class... A>
+bool CMap<D, A...>::face_root_walk(std::uint32_t x) const {
+  static_assert(D == 3);
+  constexpr std::uint32_t null = detail::null_index;
+  auto by_mark = [&] {
+    DartList face;
+    collect_cell_unmarked<2>(x, face);
+    return std::all_of(face.begin(), face.end(), [x](Dart d) { return d.index() >= x; });
+  };
+  // A face is x's β1 cycle z and, if x is 3-sewn, its partner's cycle w, run the other way
+  // (β3∘β1 = β0∘β3). Both are walked together, each dart checked to be larger than x and its
+  // links to have this shape, which proves the two cycles are the whole orbit (closed under β0,
+  // β1, β3). Any other shape (an open or partly sewn face, inconsistent links) is settled by
+  // collecting the orbit with a mark.
+  const std::uint32_t w0 = b(x, 3);
+  std::uint32_t z = x, w = w0;
+  for (std::uint32_t budget = dart_capacity(); budget != 0; --budget) {
+    const std::uint32_t z1 = b(z, 1);
+    if (z1 == null || b(z1, 0) != z || b(z, 3) != w) return by_mark();
+    if (z1 < x) return false;
+    if (w != null) {
+      const std::uint32_t w1 = b(w, 0);
+      if (w < x) return false;
+      if (b(w, 3) != z || w1 == null || b(w1, 1) != w) return by_mark();
+      w = w1;
+    }
+    z = z1;
+    if (z == x) return w == w0 || by_mark();
+  }
+  return by_mark();
+}
+
+template <int D, class... A>
 template <int... B>
 DartList CMap<D, A...>::orbit(Dart d) const {
   static_assert(((B >= 0 && B <= D) && ...), "beta index outside [0, D]");
@@ -334,8 +366,8 @@ auto CMap<D, A...>::cells() const {
     Dart operator*() const { return Dart(x); }
     bool operator==(const Iter& o) const { return x == o.x; }
   };
-  if constexpr (chain_cell<I>) {
-    // Each live dart that is the smallest of its cell, found by walking the cell's chain.
+  if constexpr (rooted_without_marks<I>) {
+    // Each live dart that is the smallest of its cell.
     class Range {
      public:
       explicit Range(const CMap* m) : map_(m) {}
@@ -352,7 +384,7 @@ auto CMap<D, A...>::cells() const {
      private:
       static std::uint32_t next(const CMap* map, std::uint32_t x) {
         const std::uint32_t n = map->dart_capacity();
-        while (x < n && !(map->is_live_index(x) && map->template is_chain_root<I>(x))) ++x;
+        while (x < n && !(map->is_live_index(x) && map->template is_cell_root<I>(x))) ++x;
         return x;
       }
       const CMap* map_;
@@ -484,9 +516,9 @@ template <int D, class... A>
 template <int I>
 std::uint32_t CMap<D, A...>::count_cells() const {
   std::uint32_t n = 0;
-  if constexpr (I >= 0 && chain_cell<I>) {
+  if constexpr (I >= 0 && rooted_without_marks<I>) {
     const std::uint32_t cap = dart_capacity();
-    for (std::uint32_t x = 0; x < cap; ++x) n += is_live_index(x) && is_chain_root<I>(x) ? 1u : 0u;
+    for (std::uint32_t x = 0; x < cap; ++x) n += is_live_index(x) && is_cell_root<I>(x) ? 1u : 0u;
   } else {
     for_each_cell_root<I>([&](std::uint32_t, const auto&) { ++n; });
   }
