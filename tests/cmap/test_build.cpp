@@ -186,6 +186,73 @@ TEST_CASE("building into a map that already has darts") {
   CHECK(check_map(m)[3] == 3);
 }
 
+TEST_CASE("sew_coincident_faces glues free facets through the same points, and only those") {
+  auto point_of = [](auto& m) { return [&m](Dart d) { return m.value(m.template attribute<0>(d)); }; };
+  SUBCASE("the cells of a hexahedral grid made apart, then glued: the same map as build() makes") {
+    const IndexedMesh mesh = hex_grid(3, 2, 2);
+    Map3 apart, together;
+    build_with_points(apart, mesh, BuildOptions{.sew = false});
+    build_with_points(together, mesh);
+    CHECK(check_map(apart)[3] == 12);
+    const auto rep = sew_coincident_faces(apart, point_of(apart), mesh.num_points());
+    CHECK(rep.sewn == hex_grid_faces(3, 2, 2) - 2 * (3 * 2 + 2 * 2 + 3 * 2));
+    CHECK(rep.nonmanifold == 0);
+    CHECK(rep.mismatched == 0);
+    CHECK(check_map(apart) == check_map(together));  // the vertex attributes merged as the cells were sewn
+    CHECK(apart.count_components() == 1);
+    CHECK(sew_coincident_faces(apart, point_of(apart), mesh.num_points()).sewn == 0);  // nothing left to glue
+  }
+  SUBCASE("a grid cut through its middle plane is put back together") {
+    Map3 m;
+    build_with_points(m, hex_grid(4, 2, 2));
+    const auto before = check_map(m);
+    auto on_plane = [&](Dart d) { return m.value(m.attribute<0>(d)) % 5 == 2; };  // x = 2: point i + 5(j + 3k), i = 2
+    std::vector<Dart> plane;
+    for (Dart d : m.cells<2>())
+      if (!m.is_free(d, 3) && on_plane(d) && on_plane(m.beta(d, 1)) && on_plane(m.beta(d, 1, 1))) plane.push_back(d);
+    REQUIRE(plane.size() == 4);
+    for (Dart d : plane) m.unsew<3>(d);
+    CHECK(m.count_components() == 2);
+    const auto rep = sew_coincident_faces(m, point_of(m), 45);
+    CHECK(rep.sewn == 4);
+    CHECK(check_map(m) == before);
+  }
+  SUBCASE("three faces through the same points are left free; so is a pair with the same orientation") {
+    IndexedMesh mesh;
+    for (std::uint32_t p = 0; p < 8; ++p) mesh.points.push_back({double(p & 1), double((p >> 1) & 1), double(p >> 2)});
+    for (int c = 0; c < 3; ++c) mesh.add_cell(CellType::hexahedron, {0, 1, 3, 2, 4, 5, 7, 6});  // three times the same cube
+    Map3 m;
+    build_with_points(m, mesh, BuildOptions{.sew = false});
+    const auto rep = sew_coincident_faces(m, point_of(m), 8);
+    CHECK(rep == SewCoincidentReport{0, 6, 0});
+    CHECK(check_map(m)[3] == 3);
+    Map3 twice;
+    mesh.conn.resize(16);
+    mesh.offsets.resize(3);
+    mesh.types.resize(2);
+    mesh.tags.resize(2);
+    build_with_points(twice, mesh, BuildOptions{.sew = false});  // two copies of one cube: each face twice, same orientation
+    CHECK(sew_coincident_faces(twice, point_of(twice), 8) == SewCoincidentReport{0, 0, 6});
+    check_map(twice);
+  }
+  SUBCASE("quads of a 2-map glued along their edges") {
+    const IndexedMesh mesh = quad_grid(3, 2);
+    Map2 apart, together;
+    build_with_points(apart, mesh, BuildOptions{.sew = false});
+    build_with_points(together, mesh);
+    const auto rep = sew_coincident_faces(apart, point_of(apart), mesh.num_points());
+    CHECK(rep.sewn == 3 * 1 + 2 * 2);  // inner edges of a 3x2 grid
+    CHECK(check_map(apart) == check_map(together));
+  }
+  SUBCASE("a point out of range is refused, the map unchanged") {
+    Map3 m;
+    build_with_points(m, hex_grid(2, 1, 1), BuildOptions{.sew = false});
+    const auto before = check_map(m);
+    CHECK_THROWS_WITH_AS(sew_coincident_faces(m, point_of(m), 5), doctest::Contains("outside [0, 5)"), TopologyError);
+    CHECK(check_map(m) == before);
+  }
+}
+
 TEST_CASE("bad meshes are refused with the cell named") {
   auto message_of = [](auto&& f) {
     try {

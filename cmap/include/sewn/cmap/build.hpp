@@ -12,9 +12,14 @@
 // β2 across shared edges, segments by β1 at vertices with exactly two segments. A facet shared
 // by three or more cells stays unsewn (its cells share mesh points only), which is how
 // non-manifold junctions of mixed meshes are represented.
+//
+// sew_coincident_faces() does the gluing step alone on a map that already exists (cells made
+// one by one, or pieces cut apart and to be put back): it sews the free facets that run through
+// the same points.
 
 #include <algorithm>
 #include <array>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -314,6 +319,103 @@ BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOption
     ++res.sewn_facets;
   });
   return res;
+}
+
+struct SewCoincidentReport {
+  std::uint32_t sewn = 0;         ///< facet pairs sewn
+  std::uint32_t nonmanifold = 0;  ///< groups of 3+ free facets through the same points, left free
+  std::uint32_t mismatched = 0;   ///< pairs left free: same orientation, or shapes sew<D> refuses
+  friend bool operator==(const SewCoincidentReport&, const SewCoincidentReport&) = default;
+};
+
+/// Sews, by sew<D>, every two D-free facets of `map` (faces of a 3-map, edges of a 2-map) that
+/// run through the same points in opposite directions; point_of(d) names the point dart d
+/// starts at, in [0, num_points) (say, the value of its 0-attribute). Open facets (a β1 chain
+/// that does not close) are skipped. Attributes merge as sew<D> merges them, on_merge included.
+/// Throws TopologyError, the map unchanged, if point_of gives a point out of range.
+/// O(free darts + num_points).
+template <int D, class... A, class PointOf>
+SewCoincidentReport sew_coincident_faces(CMap<D, A...>& map, PointOf&& point_of, std::uint32_t num_points) {
+  static_assert(D == 2 || D == 3, "facets are glued by beta2 in a 2-map and by beta3 in a 3-map");
+  constexpr std::uint32_t null = Dart::null_index;
+  // 1) each free facet once (from its smallest dart): its darts' points, kept sorted in `pts`
+  struct Facet {
+    std::uint32_t dart, first, n;
+  };
+  std::vector<Facet> facets;
+  std::vector<std::uint32_t> pts;
+  auto start_of = [&](std::uint32_t x) {
+    const std::uint32_t p = static_cast<std::uint32_t>(point_of(Dart(x)));
+    if (p >= num_points)
+      throw TopologyError("sew_coincident_faces: dart " + std::to_string(x) + " starts at point " + std::to_string(p) +
+                          ", outside [0, " + std::to_string(num_points) + ")");
+    return p;
+  };
+  for (Dart d : map.darts()) {
+    const std::uint32_t x = d.index();
+    if (map.b(x, D) != null) continue;
+    const auto first = static_cast<std::uint32_t>(pts.size());
+    if constexpr (D == 2) {
+      const std::uint32_t y = map.b(x, 1);
+      if (y == null) continue;
+      const std::uint32_t p = start_of(x), q = start_of(y);
+      pts.push_back(std::min(p, q));
+      pts.push_back(std::max(p, q));
+    } else {
+      std::uint32_t y = x;
+      bool smallest = true;
+      do {
+        smallest = smallest && y >= x;
+        pts.push_back(start_of(y));
+        y = map.b(y, 1);
+      } while (y != null && y != x);
+      if (y == null || !smallest) {  // open, or met from its smallest dart
+        pts.resize(first);
+        continue;
+      }
+      std::sort(pts.begin() + first, pts.end());
+    }
+    facets.push_back({x, first, static_cast<std::uint32_t>(pts.size()) - first});
+  }
+  // 2) group by smallest point (counting sort), then by the whole point list within a group
+  std::vector<std::uint32_t> start(std::size_t{num_points} + 1, 0);
+  for (const Facet& f : facets) ++start[pts[f.first] + 1];
+  for (std::uint32_t p = 0; p < num_points; ++p) start[p + 1] += start[p];
+  std::vector<Facet> sorted(facets.size());
+  {
+    std::vector<std::uint32_t> pos(start.begin(), start.end() - 1);
+    for (const Facet& f : facets) sorted[pos[pts[f.first]]++] = f;
+  }
+  auto key = [&](const Facet& f) { return std::span<const std::uint32_t>(pts.data() + f.first, f.n); };
+  auto less = [&](const Facet& a, const Facet& b) {
+    return a.n != b.n ? a.n < b.n : std::ranges::lexicographical_compare(key(a), key(b));
+  };
+  SewCoincidentReport rep;
+  for (std::uint32_t p = 0; p < num_points; ++p) {
+    const auto first = sorted.begin() + start[p], last = sorted.begin() + start[p + 1];
+    std::sort(first, last, less);
+    for (auto it = first; it != last;) {
+      auto run = it + 1;
+      while (run != last && !less(*it, *run)) ++run;
+      if (run - it > 2) {
+        ++rep.nonmanifold;
+      } else if (run - it == 2) {
+        // pair dart a (u -> v) with the dart of the other facet that runs v -> u
+        const std::uint32_t a = it->dart, want = start_of(map.b(a, 1));
+        std::uint32_t y = (it + 1)->dart;
+        if constexpr (D == 3)  // a face: find that dart on its cycle (an edge is its own dart)
+          for (std::uint32_t k = 0; k < it->n && start_of(y) != want; ++k) y = map.b(y, 1);
+        if (start_of(y) == want && start_of(map.b(y, 1)) == start_of(a) && map.template is_sewable<D>(Dart(a), Dart(y))) {
+          map.template sew<D>(Dart(a), Dart(y));
+          ++rep.sewn;
+        } else {
+          ++rep.mismatched;
+        }
+      }
+      it = run;
+    }
+  }
+  return rep;
 }
 
 }  // namespace sewn
