@@ -533,6 +533,15 @@ class CMap {
   bool sew_pairs(std::uint32_t a, std::uint32_t b, std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) const;
   template <int I>
   void unsew_pairs(std::uint32_t d, DartPairs& out) const;
+  // The β links of sew/link and unsew/unlink (`who` names the caller in errors); the pairs
+  // they changed are returned for the attribute update of sew and unsew.
+  template <int I>
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> link_orbits(Dart a, Dart b, const char* who);
+  template <int I>
+  void unlink_orbits(Dart d, const char* who, DartPairs& pairs);
+  // Merges or splits the attributes of every dimension but I around the darts of `pairs`.
+  template <int I, class Pairs>
+  void update_attributes_around(const Pairs& pairs);
 
   std::uint32_t new_dart();
   void erase_dart_raw(std::uint32_t x);

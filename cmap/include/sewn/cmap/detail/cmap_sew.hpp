@@ -109,83 +109,75 @@ bool CMap<D, A...>::is_sewable(Dart a, Dart b2) const {
 
 template <int D, class... A>
 template <int I>
-void CMap<D, A...>::link(Dart a, Dart b2) {
+std::vector<std::pair<std::uint32_t, std::uint32_t>> CMap<D, A...>::link_orbits(Dart a, Dart b2, const char* who) {
   static_assert(I >= 1 && I <= D, "sew index must be in [1, D]");
-  check_alive(a, "link");
-  check_alive(b2, "link");
+  check_alive(a, who);
+  check_alive(b2, who);
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
   if (!sew_pairs<I>(a.index(), b2.index(), &pairs))
-    throw TopologyError("cmap::sew<" + std::to_string(I) + ">: darts " + std::to_string(a.index()) + " and " +
-                        std::to_string(b2.index()) +
+    throw TopologyError("cmap::" + std::string(who) + "<" + std::to_string(I) + ">: darts " + std::to_string(a.index()) +
+                        " and " + std::to_string(b2.index()) +
                         " are not sewable (not free, or their orbits differ in shape; see is_sewable)");
   for (auto [x, y] : pairs) raw_link(x, I, y);
+  return pairs;
+}
+
+template <int D, class... A>
+template <int I>
+void CMap<D, A...>::unlink_orbits(Dart d, const char* who, DartPairs& pairs) {
+  static_assert(I >= 1 && I <= D, "unsew index must be in [1, D]");
+  check_alive(d, who);
+  if (b(d.index(), I) == detail::null_index)
+    throw TopologyError("cmap::" + std::string(who) + "<" + std::to_string(I) + ">: dart " + std::to_string(d.index()) +
+                        " is " + std::to_string(I) + "-free");
+  unsew_pairs<I>(d.index(), pairs);
+  constexpr int inv = I == 1 ? 0 : I;
+  for (auto [x, y] : pairs) {
+    set_b(x, I, detail::null_index);
+    set_b(y, inv, detail::null_index);
+  }
+}
+
+template <int D, class... A>
+template <int I, class Pairs>
+void CMap<D, A...>::update_attributes_around(const Pairs& pairs) {
+  // I-cells keep their darts (βI is not among their generators); the others may merge or split.
+  constexpr unsigned dims = ~(1u << I);
+  if constexpr ((attribute_dims & dims) != 0) {
+    detail::DartBuffer<64> touched;
+    for (auto [x, y] : pairs) {
+      touched.push_back(x);
+      touched.push_back(y);
+    }
+    update_attributes(touched, dims);
+  }
+}
+
+template <int D, class... A>
+template <int I>
+void CMap<D, A...>::link(Dart a, Dart b2) {
+  (void)link_orbits<I>(a, b2, "link");
 }
 
 template <int D, class... A>
 template <int I>
 void CMap<D, A...>::sew(Dart a, Dart b2) {
-  check_alive(a, "sew");
-  check_alive(b2, "sew");
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
-  if (!sew_pairs<I>(a.index(), b2.index(), &pairs))
-    throw TopologyError("cmap::sew<" + std::to_string(I) + ">: darts " + std::to_string(a.index()) + " and " +
-                        std::to_string(b2.index()) +
-                        " are not sewable (not free, or their orbits differ in shape; see is_sewable)");
-  for (auto [x, y] : pairs) raw_link(x, I, y);
-  // I-cells keep their darts (βI is not among their generators); the others may merge.
-  constexpr unsigned dims = ~(1u << I);
-  if constexpr ((attribute_dims & dims) != 0) {
-    detail::DartBuffer<64> touched;
-    for (auto [x, y] : pairs) {
-      touched.push_back(x);
-      touched.push_back(y);
-    }
-    update_attributes(touched, dims);
-  }
+  update_attributes_around<I>(link_orbits<I>(a, b2, "sew"));
 }
 
 template <int D, class... A>
 template <int I>
 void CMap<D, A...>::unlink(Dart d) {
-  static_assert(I >= 1 && I <= D, "unsew index must be in [1, D]");
-  check_alive(d, "unlink");
-  if (b(d.index(), I) == detail::null_index)
-    throw TopologyError("cmap::unsew<" + std::to_string(I) + ">: dart " + std::to_string(d.index()) + " is " +
-                        std::to_string(I) + "-free");
   DartPairs pairs;
-  unsew_pairs<I>(d.index(), pairs);
-  constexpr int inv = I == 1 ? 0 : I;
-  for (auto [x, y] : pairs) {
-    set_b(x, I, detail::null_index);
-    set_b(y, inv, detail::null_index);
-  }
+  unlink_orbits<I>(d, "unlink", pairs);
 }
 
 template <int D, class... A>
 template <int I>
 void CMap<D, A...>::unsew(Dart d) {
-  static_assert(I >= 1 && I <= D, "unsew index must be in [1, D]");
-  check_alive(d, "unsew");
-  if (b(d.index(), I) == detail::null_index)
-    throw TopologyError("cmap::unsew<" + std::to_string(I) + ">: dart " + std::to_string(d.index()) + " is " +
-                        std::to_string(I) + "-free");
   DartPairs pairs;
-  unsew_pairs<I>(d.index(), pairs);
-  constexpr int inv = I == 1 ? 0 : I;
-  for (auto [x, y] : pairs) {
-    set_b(x, I, detail::null_index);
-    set_b(y, inv, detail::null_index);
-  }
-  // I-cells keep their darts (βI is not among their generators); the others may split.
-  constexpr unsigned dims = ~(1u << I);
-  if constexpr ((attribute_dims & dims) != 0) {
-    detail::DartBuffer<64> touched;
-    for (auto [x, y] : pairs) {
-      touched.push_back(x);
-      touched.push_back(y);
-    }
-    update_attributes(touched, dims);
-  }
+  unlink_orbits<I>(d, "unsew", pairs);
+  update_attributes_around<I>(pairs);
 }
 
 }  // namespace sewn
