@@ -310,6 +310,29 @@ TEST_CASE("bad meshes are refused with the cell named") {
     CHECK(r.sewn_facets == 0);
     check_map(lax);
   }
+  SUBCASE("three quads on one edge (a book of three pages), and a fourth glued to one page") {
+    IndexedMesh book;
+    book.points = {{0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {1, 0, 1}, {0, 1, 0}, {0, 1, 1}, {-1, 0, 0}, {-1, 0, 1}, {2, 0, 0}, {2, 0, 1}};
+    book.add_cell(CellType::quad, {0, 2, 3, 1});
+    book.add_cell(CellType::quad, {0, 4, 5, 1});
+    book.add_cell(CellType::quad, {0, 6, 7, 1});
+    book.add_cell(CellType::quad, {3, 9, 8, 2});  // runs 2 -> 3 as page 0 does: reversed to be glued
+    Map3 m;
+    BuildOptions strict;
+    strict.allow_nonmanifold = false;
+    strict.source = "book.msh";
+    const auto msg = message_of([&] { build(m, book, strict); });
+    CHECK(msg.find("book.msh") != std::string::npos);
+    CHECK(msg.find("non-manifold edge") != std::string::npos);
+    CHECK(msg.find("cell 0 (quad)") != std::string::npos);
+    Map3 lax;
+    const auto r = build_with_points(lax, book);
+    CHECK(r.nonmanifold_facets == 1);
+    CHECK(r.sewn_facets == 1);  // the fourth page to the first
+    CHECK(r.flipped[3]);
+    CHECK(check_map(lax)[2] == 4);
+    CHECK(lax.count_components() == 3);
+  }
 }
 
 TEST_CASE("discs, cylinders and polylines through points") {

@@ -92,6 +92,39 @@ void for_each_facet_group(std::vector<FacetKey>& facets, std::uint32_t num_point
   }
 }
 
+// Edge k of a 2D cell runs from its point k to point k+1.
+struct CellEdge {
+  std::uint32_t cell, k;
+};
+// The edges shared by 2D cells of a mesh, found once and used both to orient the cells and to
+// sew them: pairs of cell edges through the same two points, and how many edges 3+ cells share.
+struct SharedEdges {
+  std::vector<std::pair<CellEdge, CellEdge>> pairs;
+  std::uint32_t nonmanifold = 0;
+  std::pair<std::uint32_t, std::uint32_t> first_nonmanifold{};  // two of its cells
+};
+
+inline SharedEdges shared_edges(const IndexedMesh& mesh) {
+  std::vector<FacetKey> edges;
+  for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
+    if (cell_dimension(mesh.types[c]) != 2) continue;
+    const auto v = mesh.cell(c);
+    for (std::uint32_t k = 0; k < v.size(); ++k) {
+      const std::uint32_t a = v[k], b = v[(k + 1) % v.size()];
+      edges.push_back({{std::min(a, b), std::max(a, b), 0, 0}, 2, k, c});
+    }
+  }
+  SharedEdges out;
+  for_each_facet_group(edges, mesh.num_points(), [&](auto first, auto last) {
+    if (last - first == 2) {
+      out.pairs.push_back({{first->cell, first->dart}, {(first + 1)->cell, (first + 1)->dart}});
+    } else if (last - first > 2) {
+      if (out.nonmanifold++ == 0) out.first_nonmanifold = {first->cell, (first + 1)->cell};
+    }
+  });
+  return out;
+}
+
 }  // namespace detail
 
 /// Creates the cells of `mesh` in `map` (which may already hold darts) and glues them as
@@ -137,27 +170,32 @@ BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOption
 
   // 2) orient 2D cells: breadth-first over cells sharing a manifold edge, reversing a
   //    neighbour that runs along the shared edge in the same direction.
-  if (opt.orient_surfaces) {
-    std::vector<detail::FacetKey> edges;
-    for (std::uint32_t c = 0; c < nc; ++c) {
-      if (cell_dimension(mesh.types[c]) != 2) continue;
-      const auto v = mesh.cell(c);
-      for (std::uint32_t k = 0; k < v.size(); ++k) {
-        const std::uint32_t a = v[k], b = v[(k + 1) % v.size()];
-        edges.push_back({{std::min(a, b), std::max(a, b), 0, 0}, 2, k, c});
+  auto describe = [&](std::uint32_t cell) { return "cell " + std::to_string(cell) + " (" + to_string(mesh.types[cell]) + ")"; };
+  const bool any_2d = std::any_of(mesh.types.begin(), mesh.types.end(), [](CellType t) { return cell_dimension(t) == 2; });
+  const detail::SharedEdges shared = any_2d && (opt.orient_surfaces || (opt.sew && D >= 2)) ? detail::shared_edges(mesh) : detail::SharedEdges{};
+  if (opt.sew && D >= 2 && shared.nonmanifold != 0 && !opt.allow_nonmanifold)
+    throw MeshError(opt.source + ": 3 or more cells share one edge, among them " + describe(shared.first_nonmanifold.first) +
+                    " and " + describe(shared.first_nonmanifold.second) + " (a non-manifold edge where a manifold is required)");
+  auto same_direction = [&](const detail::CellEdge& e0, const detail::CellEdge& e1) {
+    return mesh.cell(e0.cell)[e0.k] == mesh.cell(e1.cell)[e1.k];  // both start at the same point
+  };
+  if (opt.orient_surfaces && !shared.pairs.empty()) {
+    // the pairs as adjacency lists (CSR), then a breadth-first walk per connected surface
+    std::vector<std::uint32_t> first_nbr(std::size_t{nc} + 1, 0);
+    for (const auto& [e0, e1] : shared.pairs) {
+      ++first_nbr[e0.cell + 1];
+      ++first_nbr[e1.cell + 1];
+    }
+    for (std::uint32_t c = 0; c < nc; ++c) first_nbr[c + 1] += first_nbr[c];
+    std::vector<std::pair<std::uint32_t, bool>> nbr(first_nbr[nc]);  // (cell, same direction)
+    {
+      std::vector<std::uint32_t> pos(first_nbr.begin(), first_nbr.end() - 1);
+      for (const auto& [e0, e1] : shared.pairs) {
+        const bool same = same_direction(e0, e1);
+        nbr[pos[e0.cell]++] = {e1.cell, same};
+        nbr[pos[e1.cell]++] = {e0.cell, same};
       }
     }
-    std::vector<std::vector<std::pair<std::uint32_t, bool>>> nbr(nc);  // (cell, same direction)
-    detail::for_each_facet_group(edges, mesh.num_points(), [&](auto first, auto last) {
-      if (last - first != 2) return;
-      const auto& e0 = *first;
-      const auto& e1 = *(first + 1);
-      const auto v0 = mesh.cell(e0.cell);
-      const auto v1 = mesh.cell(e1.cell);
-      const bool same = v0[e0.dart] == v1[e1.dart];  // both start at the same point
-      nbr[e0.cell].emplace_back(e1.cell, same);
-      nbr[e1.cell].emplace_back(e0.cell, same);
-    });
     std::vector<std::uint8_t> seen(nc, 0);
     std::vector<std::uint32_t> queue;
     for (std::uint32_t c0 = 0; c0 < nc; ++c0) {
@@ -166,11 +204,11 @@ BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOption
       queue.assign(1, c0);
       for (std::size_t h = 0; h < queue.size(); ++h) {
         const std::uint32_t c = queue[h];
-        for (auto [o, same] : nbr[c]) {
-          const bool want_flip = res.flipped[c] ^ same;
+        for (std::uint32_t i = first_nbr[c]; i < first_nbr[c + 1]; ++i) {
+          const auto [o, same] = nbr[i];
           if (!seen[o]) {
             seen[o] = 1;
-            res.flipped[o] = want_flip;
+            res.flipped[o] = res.flipped[c] ^ same;
             queue.push_back(o);
           }
         }
@@ -182,7 +220,7 @@ BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOption
   std::array<CellTemplate, 7> templates;
   std::array<bool, 7> have_template{};
   std::vector<Dart> made;
-  std::vector<detail::FacetKey> facets;      // faces of volumes, edges of 2D cells
+  std::vector<detail::FacetKey> facets;      // faces of volumes
   std::vector<detail::FacetKey> segment_at;  // (point, dart ending there / starting there)
   for (std::uint32_t c = 0; c < nc; ++c) {
     const CellType t = mesh.types[c];
@@ -220,13 +258,6 @@ BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOption
           const std::uint32_t p = res.flipped[c] ? v[(n - k) % n] : v[k];
           record(Dart(x), p, c);
         }
-        if constexpr (D >= 2) {
-          x = first.index();
-          for (std::uint32_t k = 0; k < n; ++k, x = map.b(x, 1)) {
-            const std::uint32_t p = res.vertex_of_dart[x], q = res.vertex_of_dart[map.b(x, 1)];
-            facets.push_back({{std::min(p, q), std::max(p, q), null, null}, 2, x, c});
-          }
-        }
         break;
       }
       default: {
@@ -250,35 +281,42 @@ BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOption
   }
   if (!opt.sew) return res;
 
-  // 4) glue facets shared by exactly two cells of the same dimension
+  // 4) glue facets shared by exactly two cells of the same dimension: 2D cells along edges
+  //    (β2) if they run along them in opposite directions, volumes across faces (β3)
   auto start_of = [&](std::uint32_t x) { return res.vertex_of_dart[x]; };
-  auto describe = [&](std::uint32_t cell) { return "cell " + std::to_string(cell) + " (" + to_string(mesh.types[cell]) + ")"; };
+  if constexpr (D >= 2) {
+    res.nonmanifold_facets += shared.nonmanifold;
+    // the dart of a 2D cell along its edge k: dart k, or dart n-1-k of a reversed cell
+    auto dart_of = [&](const detail::CellEdge& e) {
+      const auto n = static_cast<std::uint32_t>(mesh.cell(e.cell).size());
+      std::uint32_t x = res.cell_dart[e.cell].index();
+      for (std::uint32_t j = res.flipped[e.cell] ? n - 1 - e.k : e.k; j != 0; --j) x = map.b(x, 1);
+      return x;
+    };
+    for (const auto& [e0, e1] : shared.pairs) {
+      const std::uint32_t a = dart_of(e0), bb = dart_of(e1);
+      if (start_of(a) == start_of(bb)) {
+        ++res.unorientable_edges;
+        continue;
+      }
+      map.template link_beta<2>(Dart(a), Dart(bb));
+      ++res.sewn_facets;
+    }
+  }
   detail::for_each_facet_group(facets, mesh.num_points(), [&](auto first, auto last) {
     const auto count = last - first;
     if (count == 1) return;
-    const bool volume = first->n != 2;
     if (count > 2) {
-      if (!opt.allow_nonmanifold || (volume && opt.manifold_volumes))
-        throw MeshError(opt.source + ": " + std::to_string(count) + " cells share one " + (volume ? "face" : "edge") +
-                        ", among them " + describe(first->cell) + " and " + describe((first + 1)->cell) +
-                        " (a non-manifold " + (volume ? "face" : "edge") + " where a manifold is required)");
+      if (!opt.allow_nonmanifold || opt.manifold_volumes)
+        throw MeshError(opt.source + ": " + std::to_string(count) + " cells share one face, among them " +
+                        describe(first->cell) + " and " + describe((first + 1)->cell) +
+                        " (a non-manifold face where a manifold is required)");
       ++res.nonmanifold_facets;
-      return;
-    }
-    const std::uint32_t a = first->dart, bb = (first + 1)->dart;
-    if (!volume) {  // two 2D cells along an edge: 2-sew if they run along it in opposite directions
-      if constexpr (D >= 2) {
-        if (start_of(a) == start_of(bb)) {
-          ++res.unorientable_edges;
-          return;
-        }
-        map.template link_beta<2>(Dart(a), Dart(bb));
-        ++res.sewn_facets;
-      }
       return;
     }
     if constexpr (D >= 3) {
       // two faces: pair each dart u->v of one with the dart v->u of the other
+      const std::uint32_t a = first->dart, bb = (first + 1)->dart;
       std::uint32_t y = bb;
       const std::uint32_t want = start_of(map.b(a, 1));
       std::uint32_t guard = 0;
