@@ -114,9 +114,9 @@ class Springs final : public ForceTerm {
   std::vector<Index> slot_ij_, slot_ji_, slot_ii_, slot_jj_;
   std::uint64_t bound_pattern_ = 0;
   std::uint64_t bound_topology_ = ~std::uint64_t{0};
-  // Force accumulator with 4 doubles per node, so each spring end is one aligned 256-bit
-  // read-modify-write that store forwarding handles (see springs.cpp).
-  mutable AlignedVector<double> acc_;
+  // Positions, velocities and the force accumulator as rows of 4 doubles per node, so each
+  // spring end is one aligned 256-bit access (see springs.cpp). acc_ is zero between calls.
+  mutable AlignedVector<double> x_rows_, v_rows_, acc_;
 };
 
 }  // namespace sewn::physics
