@@ -42,7 +42,8 @@ void apply_precond(std::span<const double> P, std::span<const double> r, std::sp
 
 #ifdef SEWN_CG_AVX512
 // Copies A's upper block triangle into ws (pattern rebuilt only when A's changes). Returns
-// false, leaving the caller to use A itself, if a block is not exactly symmetric.
+// false, leaving the caller to use A itself, if a block is not exactly symmetric. (The filter
+// cannot be folded into the blocks: S_i B S_j is not symmetric when i and j fix different axes.)
 bool pack_symmetric(const BlockMatrix& A, CgWorkspace& ws) {
   const Index n = A.size();
   if (ws.sym_pattern != A.pattern_version()) {
@@ -94,10 +95,10 @@ inline double hsum(__m256d a) {
   return _mm_cvtsd_f64(_mm_add_sd(s, _mm_unpackhi_pd(s, s)));
 }
 
-// y = S A p over rows of 4; returns p·y. Each block (i,j), j > i, serves both (i,j) and
+// y = S A p over rows of 4, for p zero on fixed axes; returns p·y. Each block (i,j), j > i, serves both (i,j) and
 // (j,i): it adds to row i from p_j and to row j from p_i. Row i is complete once its own
-// blocks are done (its other terms came from earlier rows), so the filter and the dot product
-// are applied as it is stored.
+// blocks are done (its other terms came from earlier rows), so the dot product is taken as it
+// is stored, and so is the filter.
 double sym_multiply(const CgWorkspace& ws, const double* __restrict p, double* __restrict y, const double* __restrict free4,
                     Index n) {
   const Index* __restrict row = ws.sym_row.data();
@@ -130,44 +131,47 @@ double sym_multiply(const CgWorkspace& ws, const double* __restrict p, double* _
   return hsum(pq);
 }
 
-// z_i = S_i P_i r_i for one node (pre: the preconditioner's padded columns).
-inline __m256d precond_row(const double* pre, __m256d r, __m256d s) {
+// z_i = S_i P_i S_i r_i for one node (pre: the filtered preconditioner's padded columns).
+inline __m256d precond_row(const double* pre, __m256d r) {
   const __m256d r0 = _mm256_permute4x64_pd(r, 0x00), r1 = _mm256_permute4x64_pd(r, 0x55),
                 r2 = _mm256_permute4x64_pd(r, 0xAA);
   const __m256d z = _mm256_fmadd_pd(_mm256_load_pd(pre + 8), r2,
                                     _mm256_fmadd_pd(_mm256_load_pd(pre + 4), r1, _mm256_mul_pd(_mm256_load_pd(pre), r0)));
-  return _mm256_mul_pd(z, s);
+  return z;
 }
 
 // The solve of filtered_pcg on the packed matrix, with the vector passes of an iteration
 // fused: the product with its filter and p·q, then x, r, the preconditioner, r·r and r·z in one
 // pass, then p.
-CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
+// The initial residual takes one product with A itself: x is not zero on fixed axes. The
+// filter is folded into the preconditioner (r and z vanish on fixed axes).
+CgResult pcg_packed(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
                     std::span<const double> P, double b_norm, double tolerance, int max_iterations, CgWorkspace& ws) {
   const std::size_t n = b.size() / 3, n4 = 4 * n;
-  for (auto* v : {&ws.r, &ws.z, &ws.p, &ws.q, &ws.x4, &ws.b4, &ws.free4}) v->assign(n4, 0.0);
+  ws.b4.resize(b.size());  // A x, before the rows of 4 take the work arrays
+  A.multiply(x, ws.b4);
+  for (auto* v : {&ws.r, &ws.z, &ws.p, &ws.q, &ws.x4, &ws.free4}) v->assign(n4, 0.0);
   ws.pre4.assign(12 * n, 0.0);
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t a = 0; a < 3; ++a) {
+      const double fa = free_dof[3 * i + a];
       ws.x4[4 * i + a] = x[3 * i + a];
-      ws.free4[4 * i + a] = free_dof[3 * i + a];
-      ws.b4[4 * i + a] = free_dof[3 * i + a] * b[3 * i + a];
-      for (std::size_t c = 0; c < 3; ++c) ws.pre4[12 * i + 4 * c + a] = P[9 * i + 3 * c + a];
+      ws.free4[4 * i + a] = fa;
+      ws.r[4 * i + a] = fa * (b[3 * i + a] - ws.b4[3 * i + a]);
+      for (std::size_t c = 0; c < 3; ++c) ws.pre4[12 * i + 4 * c + a] = fa * free_dof[3 * i + c] * P[9 * i + 3 * c + a];
     }
   double* __restrict xv = ws.x4.data();
   double* __restrict r = ws.r.data();
   double* __restrict z = ws.z.data();
   double* __restrict p = ws.p.data();
   double* __restrict q = ws.q.data();
-  const double* __restrict s = ws.free4.data();
   const double* __restrict pre = ws.pre4.data();
+  const double* __restrict s = ws.free4.data();
   const auto nodes = static_cast<Index>(n);
-  (void)sym_multiply(ws, xv, q, s, nodes);
   __m256d rr_acc = _mm256_setzero_pd(), rz_acc = _mm256_setzero_pd();
   for (std::size_t i = 0; i < n; ++i) {
-    const __m256d ri = _mm256_sub_pd(_mm256_load_pd(ws.b4.data() + 4 * i), _mm256_load_pd(q + 4 * i));
-    const __m256d zi = precond_row(pre + 12 * i, ri, _mm256_load_pd(s + 4 * i));
-    _mm256_store_pd(r + 4 * i, ri);
+    const __m256d ri = _mm256_load_pd(r + 4 * i);
+    const __m256d zi = precond_row(pre + 12 * i, ri);
     _mm256_store_pd(z + 4 * i, zi);
     _mm256_store_pd(p + 4 * i, zi);
     rr_acc = _mm256_fmadd_pd(ri, ri, rr_acc);
@@ -190,7 +194,7 @@ CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<co
       const std::size_t o = 4 * i;
       _mm256_store_pd(xv + o, _mm256_fmadd_pd(alpha, _mm256_load_pd(p + o), _mm256_load_pd(xv + o)));
       const __m256d ri = _mm256_fnmadd_pd(alpha, _mm256_load_pd(q + o), _mm256_load_pd(r + o));
-      const __m256d zi = precond_row(pre + 12 * i, ri, _mm256_load_pd(s + o));
+      const __m256d zi = precond_row(pre + 12 * i, ri);
       _mm256_store_pd(r + o, ri);
       _mm256_store_pd(z + o, zi);
       rr_acc = _mm256_fmadd_pd(ri, ri, rr_acc);
@@ -262,7 +266,7 @@ CgResult filtered_pcg(const BlockMatrix& A, std::span<const double> b, std::span
   }
   const double b_norm = std::sqrt(b_norm2);
 #ifdef SEWN_CG_AVX512
-  if (pack_symmetric(A, ws)) return pcg_packed(b, x, free_dof, P, b_norm, tolerance, max_iterations, ws);
+  if (pack_symmetric(A, ws)) return pcg_packed(A, b, x, free_dof, P, b_norm, tolerance, max_iterations, ws);
 #endif
   A.multiply(x, q);
   for (std::size_t k = 0; k < n3; ++k) r[k] = free_dof[k] * (b[k] - q[k]);

@@ -34,7 +34,7 @@ struct CgWorkspace {
   std::uint64_t sym_pattern = ~std::uint64_t{0};
   std::vector<Index> sym_row, sym_col, sym_src;  // row offsets (diagonal first), columns, slots in A
   AlignedVector<double> sym_val;                  // 6 per block: a00 a01 a02 a11 a12 a22
-  AlignedVector<double> x4, b4, free4, pre4;      // 4 per node; pre4: 12 per node (padded columns)
+  AlignedVector<double> x4, free4, b4, pre4;      // 4 per node; b4: A x (3n); pre4: 12 per node
 };
 
 /// Solves A x = b on the free axes with x fixed to its incoming values on the others (pass
