@@ -131,47 +131,55 @@ double sym_multiply(const CgWorkspace& ws, const double* __restrict p, double* _
   return hsum(pq);
 }
 
-// z_i = S_i P_i S_i r_i for one node (pre: the filtered preconditioner's padded columns).
+// z_i = S_i P_i S_i r_i for one node (pre: that block packed as a symmetric one).
 inline __m256d precond_row(const double* pre, __m256d r) {
-  const __m256d r0 = _mm256_permute4x64_pd(r, 0x00), r1 = _mm256_permute4x64_pd(r, 0x55),
-                r2 = _mm256_permute4x64_pd(r, 0xAA);
-  const __m256d z = _mm256_fmadd_pd(_mm256_load_pd(pre + 8), r2,
-                                    _mm256_fmadd_pd(_mm256_load_pd(pre + 4), r1, _mm256_mul_pd(_mm256_load_pd(pre), r0)));
-  return z;
+  __m256d c0, c1, c2;
+  columns(pre, c0, c1, c2);
+  return _mm256_fmadd_pd(c2, _mm256_permute4x64_pd(r, 0xAA),
+                         _mm256_fmadd_pd(c1, _mm256_permute4x64_pd(r, 0x55), _mm256_mul_pd(c0, _mm256_permute4x64_pd(r, 0x00))));
 }
 
 // The solve of filtered_pcg on the packed matrix, with the vector passes of an iteration
 // fused: the product with its filter and p·q, then x, r, the preconditioner, r·r and r·z in one
 // pass, then p.
-// The initial residual takes one product with A itself: x is not zero on fixed axes. The
-// filter is folded into the preconditioner (r and z vanish on fixed axes).
-CgResult pcg_packed(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
+// The filter is folded into the preconditioner, S P S, whose blocks are symmetric (P's upper
+// triangle is used: the inverse of a symmetric block is symmetric up to round-off), as r and z
+// vanish on fixed axes.
+CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
                     std::span<const double> P, double b_norm, double tolerance, int max_iterations, CgWorkspace& ws) {
   const std::size_t n = b.size() / 3, n4 = 4 * n;
-  ws.b4.resize(b.size());  // A x, before the rows of 4 take the work arrays
-  A.multiply(x, ws.b4);
   for (auto* v : {&ws.r, &ws.z, &ws.p, &ws.q, &ws.x4, &ws.free4}) v->assign(n4, 0.0);
-  ws.pre4.assign(12 * n, 0.0);
-  for (std::size_t i = 0; i < n; ++i)
+  ws.pre.resize(6 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* f = free_dof.data() + 3 * i;
+    const double* Pi = P.data() + 9 * i;  // column-major
+    double* o = ws.pre.data() + 6 * i;
+    o[0] = f[0] * Pi[0];
+    o[1] = f[0] * f[1] * Pi[3];
+    o[2] = f[0] * f[2] * Pi[6];
+    o[3] = f[1] * Pi[4];
+    o[4] = f[1] * f[2] * Pi[7];
+    o[5] = f[2] * Pi[8];
     for (std::size_t a = 0; a < 3; ++a) {
-      const double fa = free_dof[3 * i + a];
       ws.x4[4 * i + a] = x[3 * i + a];
-      ws.free4[4 * i + a] = fa;
-      ws.r[4 * i + a] = fa * (b[3 * i + a] - ws.b4[3 * i + a]);
-      for (std::size_t c = 0; c < 3; ++c) ws.pre4[12 * i + 4 * c + a] = fa * free_dof[3 * i + c] * P[9 * i + 3 * c + a];
+      ws.free4[4 * i + a] = f[a];
     }
+  }
   double* __restrict xv = ws.x4.data();
   double* __restrict r = ws.r.data();
   double* __restrict z = ws.z.data();
   double* __restrict p = ws.p.data();
   double* __restrict q = ws.q.data();
-  const double* __restrict pre = ws.pre4.data();
+  const double* __restrict pre = ws.pre.data();
   const double* __restrict s = ws.free4.data();
   const auto nodes = static_cast<Index>(n);
+  (void)sym_multiply(ws, xv, q, s, nodes);
   __m256d rr_acc = _mm256_setzero_pd(), rz_acc = _mm256_setzero_pd();
   for (std::size_t i = 0; i < n; ++i) {
-    const __m256d ri = _mm256_load_pd(r + 4 * i);
-    const __m256d zi = precond_row(pre + 12 * i, ri);
+    const __m256d ri = _mm256_sub_pd(_mm256_mul_pd(_mm256_maskz_loadu_pd(0x7, b.data() + 3 * i), _mm256_load_pd(s + 4 * i)),
+                                     _mm256_load_pd(q + 4 * i));
+    const __m256d zi = precond_row(pre + 6 * i, ri);
+    _mm256_store_pd(r + 4 * i, ri);
     _mm256_store_pd(z + 4 * i, zi);
     _mm256_store_pd(p + 4 * i, zi);
     rr_acc = _mm256_fmadd_pd(ri, ri, rr_acc);
@@ -194,7 +202,7 @@ CgResult pcg_packed(const BlockMatrix& A, std::span<const double> b, std::span<d
       const std::size_t o = 4 * i;
       _mm256_store_pd(xv + o, _mm256_fmadd_pd(alpha, _mm256_load_pd(p + o), _mm256_load_pd(xv + o)));
       const __m256d ri = _mm256_fnmadd_pd(alpha, _mm256_load_pd(q + o), _mm256_load_pd(r + o));
-      const __m256d zi = precond_row(pre + 12 * i, ri);
+      const __m256d zi = precond_row(pre + 6 * i, ri);
       _mm256_store_pd(r + o, ri);
       _mm256_store_pd(z + o, zi);
       rr_acc = _mm256_fmadd_pd(ri, ri, rr_acc);
@@ -266,7 +274,7 @@ CgResult filtered_pcg(const BlockMatrix& A, std::span<const double> b, std::span
   }
   const double b_norm = std::sqrt(b_norm2);
 #ifdef SEWN_CG_AVX512
-  if (pack_symmetric(A, ws)) return pcg_packed(A, b, x, free_dof, P, b_norm, tolerance, max_iterations, ws);
+  if (pack_symmetric(A, ws)) return pcg_packed(b, x, free_dof, P, b_norm, tolerance, max_iterations, ws);
 #endif
   A.multiply(x, q);
   for (std::size_t k = 0; k < n3; ++k) r[k] = free_dof[k] * (b[k] - q[k]);

@@ -34,7 +34,8 @@ struct CgWorkspace {
   std::uint64_t sym_pattern = ~std::uint64_t{0};
   std::vector<Index> sym_row, sym_col, sym_src;  // row offsets (diagonal first), columns, slots in A
   AlignedVector<double> sym_val;                  // 6 per block: a00 a01 a02 a11 a12 a22
-  AlignedVector<double> x4, free4, b4, pre4;      // 4 per node; b4: A x (3n); pre4: 12 per node
+  AlignedVector<double> x4, free4;                // 4 per node
+  AlignedVector<double> pre;                      // the filtered preconditioner, 6 per node
 };
 
 /// Solves A x = b on the free axes with x fixed to its incoming values on the others (pass
