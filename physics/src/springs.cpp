@@ -424,9 +424,16 @@ void Springs::remap_nodes(std::span<const Index> old_to_new) {
   touch_topology();
 }
 
-void Springs::add_forces(const StateView& st, std::span<double> f) const {
+void Springs::add_forces(const StateView& st, std::span<double> f) const { forces(st, f, true); }
+
+void Springs::set_forces(const StateView& st, std::span<double> f) const { forces(st, f, false); }
+
+void Springs::forces(const StateView& st, std::span<double> f, bool accumulate) const {
   const Index n = st.size();
-  if (size() == 0) return;
+  if (size() == 0) {
+    if (!accumulate) std::fill(f.begin(), f.end(), 0.0);
+    return;
+  }
   if (max_node_ >= n)
     throw InputError("springs: a spring refers to node " + std::to_string(max_node_) + " but the state has " +
                      std::to_string(n) + " nodes");
@@ -463,13 +470,19 @@ void Springs::add_forces(const StateView& st, std::span<double> f) const {
     _mm512_store_pd(ap, zero);
     _mm512_store_pd(ap + 8, zero);
     double* o = out + 3 * p;
-    _mm512_storeu_pd(o, _mm512_add_pd(_mm512_loadu_pd(o), _mm512_permutex2var_pd(lo, first8, hi)));
-    _mm256_storeu_pd(o + 8, _mm256_add_pd(_mm256_loadu_pd(o + 8), tail));
+    __m512d head = _mm512_permutex2var_pd(lo, first8, hi);
+    __m256d last = tail;
+    if (accumulate) {
+      head = _mm512_add_pd(_mm512_loadu_pd(o), head);
+      last = _mm256_add_pd(_mm256_loadu_pd(o + 8), last);
+    }
+    _mm512_storeu_pd(o, head);
+    _mm256_storeu_pd(o + 8, last);
   }
 #endif
   for (; p < n; ++p) {
     for (std::size_t c = 0; c < 3; ++c) {
-      out[3 * p + c] += a[4 * p + c];
+      out[3 * p + c] = accumulate ? out[3 * p + c] + a[4 * p + c] : a[4 * p + c];
       a[4 * p + c] = 0.0;
     }
   }

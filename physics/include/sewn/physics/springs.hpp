@@ -87,6 +87,7 @@ class Springs final : public ForceTerm {
 
   // ---- ForceTerm
   void add_forces(const StateView& s, std::span<double> f) const override;
+  void set_forces(const StateView& s, std::span<double> f) const override;
   [[nodiscard]] double potential_energy(const StateView& s) const override;
   [[nodiscard]] double energy_scale() const override;
   void collect_pairs(std::vector<NodePair>& out) const override;
@@ -99,6 +100,8 @@ class Springs final : public ForceTerm {
 
  private:
   void check_spring(Index s, const char* where) const;
+  // add_forces (accumulate) or set_forces (overwrite f).
+  void forces(const StateView& s, std::span<double> f, bool accumulate) const;
 
   // Structure of arrays: the force loop streams these in order.
   AlignedVector<Index> ni_, nj_;
