@@ -39,7 +39,6 @@ void apply_precond(std::span<const double> P, std::span<const double> r, std::sp
   }
 }
 
-
 #ifdef SEWN_CG_AVX512
 // Copies A's upper block triangle into ws (pattern rebuilt only when A's changes). Returns
 // false, leaving the caller to use A itself, if a block is not exactly symmetric. (The filter
@@ -95,10 +94,10 @@ inline double hsum(__m256d a) {
   return _mm_cvtsd_f64(_mm_add_sd(s, _mm_unpackhi_pd(s, s)));
 }
 
-// y = S A p over rows of 4, for p zero on fixed axes; returns p·y. Each block (i,j), j > i, serves both (i,j) and
-// (j,i): it adds to row i from p_j and to row j from p_i. Row i is complete once its own
-// blocks are done (its other terms came from earlier rows), so the dot product is taken as it
-// is stored, and so is the filter.
+// y = S A p over rows of 4; returns p·y. Each block (i,j), j > i, serves both (i,j) and (j,i):
+// it adds to row i from p_j and to row j from p_i. Row i is complete once its own blocks are
+// done (its other terms came from earlier rows), so the filter and the dot product are applied
+// as it is stored.
 double sym_multiply(const CgWorkspace& ws, const double* __restrict p, double* __restrict y, const double* __restrict free4,
                     Index n) {
   const Index* __restrict row = ws.sym_row.data();
@@ -141,10 +140,9 @@ inline __m256d precond_row(const double* pre, __m256d r) {
 
 // The solve of filtered_pcg on the packed matrix, with the vector passes of an iteration
 // fused: the product with its filter and p·q, then x, r, the preconditioner, r·r and r·z in one
-// pass, then p.
-// The filter is folded into the preconditioner, S P S, whose blocks are symmetric (P's upper
-// triangle is used: the inverse of a symmetric block is symmetric up to round-off), as r and z
-// vanish on fixed axes.
+// pass, then p. The filter is folded into the preconditioner, S P S, as r and z vanish on fixed
+// axes; its blocks are stored as symmetric ones (P's upper triangle: the inverse of a symmetric
+// block is symmetric up to round-off).
 CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
                     std::span<const double> P, double b_norm, double tolerance, int max_iterations, CgWorkspace& ws) {
   const std::size_t n = b.size() / 3, n4 = 4 * n;
