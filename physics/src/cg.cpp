@@ -4,6 +4,11 @@
 
 #include <Eigen/LU>
 
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+#include <immintrin.h>
+#define SEWN_CG_AVX512 1
+#endif
+
 namespace sewn::physics {
 
 namespace {
@@ -33,6 +38,190 @@ void apply_precond(std::span<const double> P, std::span<const double> r, std::sp
     z[3 * i + 2] = free_dof[3 * i + 2] * (B[2] * r0 + B[5] * r1 + B[8] * r2);
   }
 }
+
+#ifdef SEWN_CG_AVX512
+// Copies A's upper block triangle into ws (pattern rebuilt only when A's changes). Returns
+// false, leaving the caller to use A itself, if a block is not exactly symmetric. (The filter
+// cannot be folded into the blocks: S_i B S_j is not symmetric when i and j fix different axes.)
+bool pack_symmetric(const BlockMatrix& A, CgWorkspace& ws) {
+  const Index n = A.size();
+  if (ws.sym_pattern != A.pattern_version()) {
+    const auto rows = A.row_offsets();
+    const auto cols = A.columns();
+    ws.sym_row.assign(std::size_t{n} + 1, 0);
+    ws.sym_col.clear();
+    ws.sym_src.clear();
+    for (Index i = 0; i < n; ++i) {
+      ws.sym_col.push_back(i);
+      ws.sym_src.push_back(A.diagonal(i));
+      for (Index k = rows[i]; k < rows[i + 1]; ++k) {
+        if (cols[k] <= i) continue;
+        ws.sym_col.push_back(cols[k]);
+        ws.sym_src.push_back(k);
+      }
+      ws.sym_row[i + 1] = static_cast<Index>(ws.sym_col.size());
+    }
+    ws.sym_val.resize(6 * ws.sym_src.size());
+    ws.sym_pattern = A.pattern_version();
+  }
+  double* __restrict out = ws.sym_val.data();
+  bool symmetric = true;
+  for (std::size_t b = 0; b < ws.sym_src.size(); ++b) {
+    const double* a = A.block(ws.sym_src[b]).data();  // column-major
+    symmetric &= a[1] == a[3] && a[2] == a[6] && a[5] == a[7];
+    double* o = out + 6 * b;
+    o[0] = a[0];
+    o[1] = a[3];
+    o[2] = a[6];
+    o[3] = a[4];
+    o[4] = a[7];
+    o[5] = a[8];
+  }
+  return symmetric;
+}
+
+// The three columns of a packed symmetric block, as padded rows [c0 c1 c2 0].
+inline void columns(const double* v, __m256d& c0, __m256d& c1, __m256d& c2) {
+  const __m256d lo = _mm256_loadu_pd(v);      // a00 a01 a02 a11
+  const __m256d hi = _mm256_loadu_pd(v + 2);  // a02 a11 a12 a22
+  c0 = _mm256_maskz_mov_pd(0x7, lo);
+  c1 = _mm256_maskz_permutex2var_pd(0x7, lo, _mm256_setr_epi64x(1, 3, 6, 0), hi);
+  c2 = _mm256_maskz_permutex2var_pd(0x7, lo, _mm256_setr_epi64x(2, 6, 7, 0), hi);
+}
+
+inline double hsum(__m256d a) {
+  const __m128d s = _mm_add_pd(_mm256_castpd256_pd128(a), _mm256_extractf128_pd(a, 1));
+  return _mm_cvtsd_f64(_mm_add_sd(s, _mm_unpackhi_pd(s, s)));
+}
+
+// y = S A p over rows of 4; returns p·y. Each block (i,j), j > i, serves both (i,j) and (j,i):
+// it adds to row i from p_j and to row j from p_i. Row i is complete once its own blocks are
+// done (its other terms came from earlier rows), so the filter and the dot product are applied
+// as it is stored.
+double sym_multiply(const CgWorkspace& ws, const double* __restrict p, double* __restrict y, const double* __restrict free4,
+                    Index n) {
+  const Index* __restrict row = ws.sym_row.data();
+  const Index* __restrict col = ws.sym_col.data();
+  const double* __restrict val = ws.sym_val.data();
+  std::fill(y, y + 4 * std::size_t{n}, 0.0);
+  __m256d pq = _mm256_setzero_pd();
+  for (Index i = 0; i < n; ++i) {
+    const double* pi = p + 4 * std::size_t{i};
+    const __m256d b0 = _mm256_broadcast_sd(pi), b1 = _mm256_broadcast_sd(pi + 1), b2 = _mm256_broadcast_sd(pi + 2);
+    __m256d c0, c1, c2;
+    Index k = row[i];
+    columns(val + 6 * std::size_t{k}, c0, c1, c2);
+    __m256d a0 = _mm256_fmadd_pd(c0, b0, _mm256_load_pd(y + 4 * std::size_t{i}));
+    __m256d a1 = _mm256_mul_pd(c1, b1);
+    __m256d a2 = _mm256_mul_pd(c2, b2);
+    for (++k; k < row[i + 1]; ++k) {
+      columns(val + 6 * std::size_t{k}, c0, c1, c2);
+      const double* pj = p + 4 * std::size_t{col[k]};
+      a0 = _mm256_fmadd_pd(c0, _mm256_broadcast_sd(pj), a0);
+      a1 = _mm256_fmadd_pd(c1, _mm256_broadcast_sd(pj + 1), a1);
+      a2 = _mm256_fmadd_pd(c2, _mm256_broadcast_sd(pj + 2), a2);
+      double* yj = y + 4 * std::size_t{col[k]};
+      _mm256_store_pd(yj, _mm256_fmadd_pd(c2, b2, _mm256_fmadd_pd(c1, b1, _mm256_fmadd_pd(c0, b0, _mm256_load_pd(yj)))));
+    }
+    const __m256d yi = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(a0, a1), a2), _mm256_load_pd(free4 + 4 * std::size_t{i}));
+    _mm256_store_pd(y + 4 * std::size_t{i}, yi);
+    pq = _mm256_fmadd_pd(yi, _mm256_load_pd(pi), pq);
+  }
+  return hsum(pq);
+}
+
+// z_i = S_i P_i S_i r_i for one node (pre: that block packed as a symmetric one).
+inline __m256d precond_row(const double* pre, __m256d r) {
+  __m256d c0, c1, c2;
+  columns(pre, c0, c1, c2);
+  return _mm256_fmadd_pd(c2, _mm256_permute4x64_pd(r, 0xAA),
+                         _mm256_fmadd_pd(c1, _mm256_permute4x64_pd(r, 0x55), _mm256_mul_pd(c0, _mm256_permute4x64_pd(r, 0x00))));
+}
+
+// The solve of filtered_pcg on the packed matrix, with the vector passes of an iteration
+// fused: the product with its filter and p·q, then x, r, the preconditioner, r·r and r·z in one
+// pass, then p. The filter is folded into the preconditioner, S P S, as r and z vanish on fixed
+// axes; its blocks are stored as symmetric ones (P's upper triangle: the inverse of a symmetric
+// block is symmetric up to round-off).
+CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
+                    std::span<const double> P, double b_norm, double tolerance, int max_iterations, CgWorkspace& ws) {
+  const std::size_t n = b.size() / 3, n4 = 4 * n;
+  for (auto* v : {&ws.r, &ws.z, &ws.p, &ws.q, &ws.x4, &ws.free4}) v->assign(n4, 0.0);
+  ws.pre.resize(6 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* f = free_dof.data() + 3 * i;
+    const double* Pi = P.data() + 9 * i;  // column-major
+    double* o = ws.pre.data() + 6 * i;
+    o[0] = f[0] * Pi[0];
+    o[1] = f[0] * f[1] * Pi[3];
+    o[2] = f[0] * f[2] * Pi[6];
+    o[3] = f[1] * Pi[4];
+    o[4] = f[1] * f[2] * Pi[7];
+    o[5] = f[2] * Pi[8];
+    for (std::size_t a = 0; a < 3; ++a) {
+      ws.x4[4 * i + a] = x[3 * i + a];
+      ws.free4[4 * i + a] = f[a];
+    }
+  }
+  double* __restrict xv = ws.x4.data();
+  double* __restrict r = ws.r.data();
+  double* __restrict z = ws.z.data();
+  double* __restrict p = ws.p.data();
+  double* __restrict q = ws.q.data();
+  const double* __restrict pre = ws.pre.data();
+  const double* __restrict s = ws.free4.data();
+  const auto nodes = static_cast<Index>(n);
+  (void)sym_multiply(ws, xv, q, s, nodes);
+  __m256d rr_acc = _mm256_setzero_pd(), rz_acc = _mm256_setzero_pd();
+  for (std::size_t i = 0; i < n; ++i) {
+    const __m256d ri = _mm256_sub_pd(_mm256_mul_pd(_mm256_maskz_loadu_pd(0x7, b.data() + 3 * i), _mm256_load_pd(s + 4 * i)),
+                                     _mm256_load_pd(q + 4 * i));
+    const __m256d zi = precond_row(pre + 6 * i, ri);
+    _mm256_store_pd(r + 4 * i, ri);
+    _mm256_store_pd(z + 4 * i, zi);
+    _mm256_store_pd(p + 4 * i, zi);
+    rr_acc = _mm256_fmadd_pd(ri, ri, rr_acc);
+    rz_acc = _mm256_fmadd_pd(ri, zi, rz_acc);
+  }
+  double r_norm = std::sqrt(hsum(rr_acc));
+  double rz = hsum(rz_acc);
+  CgResult out;
+  int it = 0;
+  while (r_norm > tolerance * b_norm && it < max_iterations) {
+    const double pq = sym_multiply(ws, p, q, s, nodes);
+    if (!(pq > 0.0)) {
+      out.breakdown = true;
+      break;
+    }
+    const __m256d alpha = _mm256_set1_pd(rz / pq);
+    rr_acc = _mm256_setzero_pd();
+    rz_acc = _mm256_setzero_pd();
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t o = 4 * i;
+      _mm256_store_pd(xv + o, _mm256_fmadd_pd(alpha, _mm256_load_pd(p + o), _mm256_load_pd(xv + o)));
+      const __m256d ri = _mm256_fnmadd_pd(alpha, _mm256_load_pd(q + o), _mm256_load_pd(r + o));
+      const __m256d zi = precond_row(pre + 6 * i, ri);
+      _mm256_store_pd(r + o, ri);
+      _mm256_store_pd(z + o, zi);
+      rr_acc = _mm256_fmadd_pd(ri, ri, rr_acc);
+      rz_acc = _mm256_fmadd_pd(ri, zi, rz_acc);
+    }
+    ++it;
+    r_norm = std::sqrt(hsum(rr_acc));
+    const double rz_new = hsum(rz_acc);
+    const __m256d beta = _mm256_set1_pd(rz_new / rz);
+    rz = rz_new;
+    for (std::size_t o = 0; o < n4; o += 4)
+      _mm256_store_pd(p + o, _mm256_fmadd_pd(beta, _mm256_load_pd(p + o), _mm256_load_pd(z + o)));
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t a = 0; a < 3; ++a) x[3 * i + a] = xv[4 * i + a];
+  out.iterations = it;
+  out.relative_residual = r_norm / b_norm;
+  out.converged = !out.breakdown && std::isfinite(r_norm) && r_norm <= tolerance * b_norm;
+  return out;
+}
+#endif
 
 }  // namespace
 
@@ -82,6 +271,9 @@ CgResult filtered_pcg(const BlockMatrix& A, std::span<const double> b, std::span
     return out;
   }
   const double b_norm = std::sqrt(b_norm2);
+#ifdef SEWN_CG_AVX512
+  if (pack_symmetric(A, ws)) return pcg_packed(b, x, free_dof, P, b_norm, tolerance, max_iterations, ws);
+#endif
   A.multiply(x, q);
   for (std::size_t k = 0; k < n3; ++k) r[k] = free_dof[k] * (b[k] - q[k]);
   double r_norm = std::sqrt(dot(r, r));

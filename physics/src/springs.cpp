@@ -27,11 +27,13 @@ void check_param(double value, const char* what, const char* where, Index s) {
                      std::to_string(value));
 }
 
-// Everything the force loop reads, as raw pointers (no aliasing between them).
+// Everything the force loop reads, as raw pointers (no aliasing between them). Node rows are
+// 4 doubles, [x y z 0], so each spring end is one aligned 256-bit access that never splits a
+// cache line (masked 3-double reads of the 3n arrays did, and cost ~25% of the loop).
 struct Kernel {
-  const double* __restrict x;
-  const double* __restrict v;
-  double* __restrict acc;  // 4 doubles per node
+  const double* __restrict x;  // 4 per node
+  const double* __restrict v;  // 4 per node
+  double* __restrict acc;      // 4 per node
   const Index* __restrict ni;
   const Index* __restrict nj;
   const double* __restrict k;
@@ -44,8 +46,8 @@ struct Kernel {
 template <SpringDamping D>
 inline void spring_scalar(const Kernel& K, Index s) {
   const std::size_t i = K.ni[s], j = K.nj[s];
-  const double* xi = K.x + 3 * i;
-  const double* xj = K.x + 3 * j;
+  const double* xi = K.x + 4 * i;
+  const double* xj = K.x + 4 * j;
   const double dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
   const double d2 = dx * dx + dy * dy + dz * dz;
   const double l = K.l[s];
@@ -55,8 +57,8 @@ inline void spring_scalar(const Kernel& K, Index s) {
   double e = 0.0;  // coefficient of ΔV (Rayleigh only)
   double ux = 0, uy = 0, uz = 0;
   if constexpr (D != SpringDamping::none) {
-    const double* vi = K.v + 3 * i;
-    const double* vj = K.v + 3 * j;
+    const double* vi = K.v + 4 * i;
+    const double* vj = K.v + 4 * j;
     ux = vj[0] - vi[0];
     uy = vj[1] - vi[1];
     uz = vj[2] - vi[2];
@@ -82,27 +84,14 @@ inline void spring_scalar(const Kernel& K, Index s) {
 }
 
 #ifdef SEWN_SPRINGS_AVX512
-// Four springs at a time. Gathers are slow (about one element per cycle), so each node's
-// (x, y, z) is read as one masked 256-bit load ([x y z 0]) and four such rows are transposed
-// into x, y, z vectors in registers; the forces are transposed back into rows and added to
-// the 4-wide accumulator with one 256-bit read-modify-write per spring end. 1/d comes from
-// rsqrt14 plus two Newton steps (relative error ~1e-16, no division or square root).
-inline void to_soa(__m256d a0, __m256d a1, __m256d a2, __m256d a3, __m256d& X, __m256d& Y, __m256d& Z) {
-  const __m256d t0 = _mm256_unpacklo_pd(a0, a1), t1 = _mm256_unpackhi_pd(a0, a1);
-  const __m256d t2 = _mm256_unpacklo_pd(a2, a3), t3 = _mm256_unpackhi_pd(a2, a3);
-  X = _mm256_permute2f128_pd(t0, t2, 0x20);
-  Z = _mm256_permute2f128_pd(t0, t2, 0x31);
-  Y = _mm256_permute2f128_pd(t1, t3, 0x20);
-}
-
-inline void to_rows(__m256d X, __m256d Y, __m256d Z, __m256d r[4]) {
-  const __m256d zero = _mm256_setzero_pd();
-  const __m256d t0 = _mm256_unpacklo_pd(X, Y), t1 = _mm256_unpackhi_pd(X, Y);
-  const __m256d t2 = _mm256_unpacklo_pd(Z, zero), t3 = _mm256_unpackhi_pd(Z, zero);
-  r[0] = _mm256_permute2f128_pd(t0, t2, 0x20);
-  r[1] = _mm256_permute2f128_pd(t1, t3, 0x20);
-  r[2] = _mm256_permute2f128_pd(t0, t2, 0x31);
-  r[3] = _mm256_permute2f128_pd(t1, t3, 0x31);
+// Four springs at a time, each kept as its row [dx dy dz 0]. Gathers are slow (about one
+// element per cycle), hence one row load per spring end. The two dot products a spring needs
+// (d·d and Δv·d) are horizontal sums of rows, and its force is its row times its scalar
+// coefficient broadcast: fewer shuffles than transposing four rows to x/y/z vectors and back.
+// 1/d comes from rsqrt14 plus two Newton steps (relative error ~1e-16, no division or sqrt).
+inline __m256d hsum4(__m256d p0, __m256d p1, __m256d p2, __m256d p3) {
+  const __m256d t0 = _mm256_hadd_pd(p0, p1), t1 = _mm256_hadd_pd(p2, p3);
+  return _mm256_add_pd(_mm256_permute2f128_pd(t0, t1, 0x21), _mm256_blend_pd(t0, t1, 0b1100));
 }
 
 inline __m256d inv_sqrt(__m256d d2) {
@@ -114,63 +103,59 @@ inline __m256d inv_sqrt(__m256d d2) {
   return y;
 }
 
+inline __m256d lane(__m256d c, int q) {
+  switch (q) {
+    case 0: return _mm256_permute4x64_pd(c, 0x00);
+    case 1: return _mm256_permute4x64_pd(c, 0x55);
+    case 2: return _mm256_permute4x64_pd(c, 0xAA);
+    default: return _mm256_permute4x64_pd(c, 0xFF);
+  }
+}
+
 template <SpringDamping D>
 inline void springs_x4(const Kernel& K, Index s) {
-  constexpr __mmask8 xyz = 0x7;
   std::size_t i[4], j[4];
-  __m256d a[4], b[4];
+  __m256d d[4], u[4], dd[4], du[4];
   for (int q = 0; q < 4; ++q) {
     i[q] = K.ni[s + q];
     j[q] = K.nj[s + q];
-    a[q] = _mm256_sub_pd(_mm256_maskz_loadu_pd(xyz, K.x + 3 * j[q]), _mm256_maskz_loadu_pd(xyz, K.x + 3 * i[q]));
-    if constexpr (D != SpringDamping::none)
-      b[q] = _mm256_sub_pd(_mm256_maskz_loadu_pd(xyz, K.v + 3 * j[q]), _mm256_maskz_loadu_pd(xyz, K.v + 3 * i[q]));
+    d[q] = _mm256_sub_pd(_mm256_load_pd(K.x + 4 * j[q]), _mm256_load_pd(K.x + 4 * i[q]));
+    dd[q] = _mm256_mul_pd(d[q], d[q]);
+    if constexpr (D != SpringDamping::none) {
+      u[q] = _mm256_sub_pd(_mm256_load_pd(K.v + 4 * j[q]), _mm256_load_pd(K.v + 4 * i[q]));
+      du[q] = _mm256_mul_pd(d[q], u[q]);
+    }
   }
-  __m256d dx, dy, dz;
-  to_soa(a[0], a[1], a[2], a[3], dx, dy, dz);
-  const __m256d d2 = _mm256_fmadd_pd(dz, dz, _mm256_fmadd_pd(dy, dy, _mm256_mul_pd(dx, dx)));
+  const __m256d d2 = hsum4(dd[0], dd[1], dd[2], dd[3]);
   const __m256d l = _mm256_loadu_pd(K.l + s);
   const __m256d k = _mm256_loadu_pd(K.k + s);
   const __m256d one = _mm256_set1_pd(1.0);
-  // Ordered compare: a NaN length fails it, c becomes 0 but c·dx stays NaN.
+  // Ordered compare: a NaN length fails it, c becomes 0 but c·d stays NaN.
   const __mmask8 ok = _mm256_cmp_pd_mask(d2, _mm256_mul_pd(_mm256_set1_pd(degenerate_ratio_sq), _mm256_mul_pd(l, l)),
                                          _CMP_GT_OQ);
   const __m256d inv = inv_sqrt(d2);
   const __m256d linv = _mm256_mul_pd(l, inv);
   __m256d c = _mm256_mul_pd(k, _mm256_sub_pd(one, linv));
-  __m256d fx, fy, fz;
-  if constexpr (D == SpringDamping::none) {
-    c = _mm256_maskz_mov_pd(ok, c);
-    fx = _mm256_mul_pd(c, dx);
-    fy = _mm256_mul_pd(c, dy);
-    fz = _mm256_mul_pd(c, dz);
-  } else {
-    __m256d ux, uy, uz;
-    to_soa(b[0], b[1], b[2], b[3], ux, uy, uz);
-    const __m256d w = _mm256_mul_pd(_mm256_fmadd_pd(uz, dz, _mm256_fmadd_pd(uy, dy, _mm256_mul_pd(ux, dx))),
-                                    _mm256_mul_pd(inv, inv));
+  __m256d e = _mm256_setzero_pd();
+  if constexpr (D != SpringDamping::none) {
+    const __m256d w = _mm256_mul_pd(hsum4(du[0], du[1], du[2], du[3]), _mm256_mul_pd(inv, inv));
     if constexpr (D == SpringDamping::viscous) {
-      c = _mm256_maskz_mov_pd(ok, _mm256_fmadd_pd(_mm256_loadu_pd(K.g + s), w, c));
-      fx = _mm256_mul_pd(c, dx);
-      fy = _mm256_mul_pd(c, dy);
-      fz = _mm256_mul_pd(c, dz);
+      c = _mm256_fmadd_pd(_mm256_loadu_pd(K.g + s), w, c);
     } else {
       const __m256d cl = _mm256_max_pd(_mm256_sub_pd(one, linv), _mm256_setzero_pd());
       const __m256d bk = _mm256_mul_pd(_mm256_set1_pd(K.beta), k);
-      c = _mm256_maskz_mov_pd(ok, _mm256_fmadd_pd(_mm256_mul_pd(bk, _mm256_sub_pd(one, cl)), w, c));
-      const __m256d e = _mm256_maskz_mov_pd(ok, _mm256_mul_pd(bk, cl));
-      fx = _mm256_fmadd_pd(e, ux, _mm256_mul_pd(c, dx));
-      fy = _mm256_fmadd_pd(e, uy, _mm256_mul_pd(c, dy));
-      fz = _mm256_fmadd_pd(e, uz, _mm256_mul_pd(c, dz));
+      c = _mm256_fmadd_pd(_mm256_mul_pd(bk, _mm256_sub_pd(one, cl)), w, c);
+      e = _mm256_maskz_mov_pd(ok, _mm256_mul_pd(bk, cl));
     }
   }
-  __m256d r[4];
-  to_rows(fx, fy, fz, r);
+  c = _mm256_maskz_mov_pd(ok, c);
   for (int q = 0; q < 4; ++q) {
+    __m256d fq = _mm256_mul_pd(lane(c, q), d[q]);
+    if constexpr (D == SpringDamping::stiffness_proportional) fq = _mm256_fmadd_pd(lane(e, q), u[q], fq);
     double* ai = K.acc + 4 * i[q];
     double* aj = K.acc + 4 * j[q];
-    _mm256_store_pd(ai, _mm256_add_pd(_mm256_load_pd(ai), r[q]));
-    _mm256_store_pd(aj, _mm256_sub_pd(_mm256_load_pd(aj), r[q]));
+    _mm256_store_pd(ai, _mm256_add_pd(_mm256_load_pd(ai), fq));
+    _mm256_store_pd(aj, _mm256_sub_pd(_mm256_load_pd(aj), fq));
   }
 }
 #endif
@@ -182,6 +167,29 @@ void spring_loop(const Kernel& K, Index count) {
   for (; s + 4 <= count; s += 4) springs_x4<D>(K, s);
 #endif
   for (; s < count; ++s) spring_scalar<D>(K, s);
+}
+
+// 3n node-major values -> rows of 4 ([x y z 0] per node).
+void to_rows(std::span<const double> in, double* __restrict out, std::size_t n) {
+  const double* __restrict a = in.data();
+  std::size_t p = 0;
+#ifdef SEWN_SPRINGS_AVX512
+  // Four nodes: 12 values -> 16 by two permutes that zero the padding lanes.
+  const __m512i lo_idx = _mm512_setr_epi64(0, 1, 2, 0, 3, 4, 5, 0);
+  const __m512i hi_idx = _mm512_setr_epi64(6, 7, 8, 0, 9, 10, 11, 0);
+  for (; p + 4 <= n; p += 4) {
+    const __m512d a0 = _mm512_loadu_pd(a + 3 * p);
+    const __m512d a1 = _mm512_maskz_loadu_pd(0x0F, a + 3 * p + 8);
+    _mm512_store_pd(out + 4 * p, _mm512_maskz_permutex2var_pd(0x77, a0, lo_idx, a1));
+    _mm512_store_pd(out + 4 * p + 8, _mm512_maskz_permutex2var_pd(0x77, a0, hi_idx, a1));
+  }
+#endif
+  for (; p < n; ++p) {
+    out[4 * p] = a[3 * p];
+    out[4 * p + 1] = a[3 * p + 1];
+    out[4 * p + 2] = a[3 * p + 2];
+    out[4 * p + 3] = 0.0;
+  }
 }
 
 struct SpringFrame {
@@ -416,40 +424,67 @@ void Springs::remap_nodes(std::span<const Index> old_to_new) {
   touch_topology();
 }
 
-void Springs::add_forces(const StateView& st, std::span<double> f) const {
+void Springs::add_forces(const StateView& st, std::span<double> f) const { forces(st, f, true); }
+
+void Springs::set_forces(const StateView& st, std::span<double> f) const { forces(st, f, false); }
+
+void Springs::forces(const StateView& st, std::span<double> f, bool accumulate) const {
   const Index n = st.size();
-  if (size() == 0) return;
+  if (size() == 0) {
+    if (!accumulate) std::fill(f.begin(), f.end(), 0.0);
+    return;
+  }
   if (max_node_ >= n)
     throw InputError("springs: a spring refers to node " + std::to_string(max_node_) + " but the state has " +
                      std::to_string(n) + " nodes");
-  acc_.assign(4 * std::size_t{n}, 0.0);
-  const Kernel K{st.x.data(), st.v.data(), acc_.data(), ni_.data(), nj_.data(), k_.data(), l_.data(), gamma_.data(), beta_};
-  switch (damping_) {
-    case SpringDamping::none: spring_loop<SpringDamping::none>(K, size()); break;
-    case SpringDamping::viscous: spring_loop<SpringDamping::viscous>(K, size()); break;
-    case SpringDamping::stiffness_proportional: spring_loop<SpringDamping::stiffness_proportional>(K, size()); break;
+  const std::size_t n4 = 4 * std::size_t{n};
+  // acc_ is all zeros between calls (the scatter below clears what it reads).
+  if (acc_.size() != n4) {
+    acc_.assign(n4, 0.0);
+    x_rows_.resize(n4);
+    v_rows_.resize(n4);
   }
-  const double* __restrict a = acc_.data();
+  to_rows(st.x, x_rows_.data(), n);
+  if (damping_ != SpringDamping::none) to_rows(st.v, v_rows_.data(), n);
+  const Kernel K{x_rows_.data(), v_rows_.data(), acc_.data(), ni_.data(), nj_.data(), k_.data(), l_.data(), gamma_.data(), beta_};
+  const Index count = size();
+  switch (damping_) {
+    case SpringDamping::none: spring_loop<SpringDamping::none>(K, count); break;
+    case SpringDamping::viscous: spring_loop<SpringDamping::viscous>(K, count); break;
+    case SpringDamping::stiffness_proportional: spring_loop<SpringDamping::stiffness_proportional>(K, count); break;
+  }
+  double* __restrict a = acc_.data();
   double* __restrict out = f.data();
   std::size_t p = 0;
 #ifdef SEWN_SPRINGS_AVX512
-  // Four nodes: 16 padded accumulator values -> 12 consecutive forces, by two permutes.
+  // Four nodes: 16 padded accumulator values -> 12 consecutive forces, by two permutes. The
+  // last 4 are written by a 256-bit store: a masked 512-bit one would block the next
+  // iteration's load, which overlaps its footprint, until it retires.
   const __m512i first8 = _mm512_setr_epi64(0, 1, 2, 4, 5, 6, 8, 9);
-  const __m512i last4 = _mm512_setr_epi64(10, 12, 13, 14, 10, 12, 13, 14);  // upper half unused
+  const __m256i last4 = _mm256_setr_epi64x(2, 4, 5, 6);  // of acc lanes 8..15
+  const __m512d zero = _mm512_setzero_pd();
   for (; p + 4 <= n; p += 4) {
-    const __m512d lo = _mm512_load_pd(a + 4 * p), hi = _mm512_load_pd(a + 4 * p + 8);
+    double* ap = a + 4 * p;
+    const __m512d lo = _mm512_load_pd(ap), hi = _mm512_load_pd(ap + 8);
+    const __m256d tail = _mm256_permutex2var_pd(_mm256_load_pd(ap + 8), last4, _mm256_load_pd(ap + 12));
+    _mm512_store_pd(ap, zero);
+    _mm512_store_pd(ap + 8, zero);
     double* o = out + 3 * p;
-    _mm512_storeu_pd(o, _mm512_add_pd(_mm512_loadu_pd(o), _mm512_permutex2var_pd(lo, first8, hi)));
-    // Through memory rather than a 512->256 cast, which GCC 12 flags as uninitialised.
-    alignas(64) double tail[8];
-    _mm512_store_pd(tail, _mm512_permutex2var_pd(lo, last4, hi));
-    _mm256_storeu_pd(o + 8, _mm256_add_pd(_mm256_loadu_pd(o + 8), _mm256_load_pd(tail)));
+    __m512d head = _mm512_permutex2var_pd(lo, first8, hi);
+    __m256d last = tail;
+    if (accumulate) {
+      head = _mm512_add_pd(_mm512_loadu_pd(o), head);
+      last = _mm256_add_pd(_mm256_loadu_pd(o + 8), last);
+    }
+    _mm512_storeu_pd(o, head);
+    _mm256_storeu_pd(o + 8, last);
   }
 #endif
   for (; p < n; ++p) {
-    out[3 * p] += a[4 * p];
-    out[3 * p + 1] += a[4 * p + 1];
-    out[3 * p + 2] += a[4 * p + 2];
+    for (std::size_t c = 0; c < 3; ++c) {
+      out[3 * p + c] = accumulate ? out[3 * p + c] + a[4 * p + c] : a[4 * p + c];
+      a[4 * p + c] = 0.0;
+    }
   }
 }
 

@@ -91,8 +91,13 @@ BlockMatrix& System::matrix() {
 void System::compute_forces() {
   refresh();
   auto f = nodes_.f();
-  std::fill(f.begin(), f.end(), 0.0);
-  add_forces(nodes_.state(), f);
+  if (terms_.empty()) {
+    std::fill(f.begin(), f.end(), 0.0);
+    return;
+  }
+  const StateView s = nodes_.state();
+  terms_.front()->set_forces(s, f);
+  for (std::size_t t = 1; t < terms_.size(); ++t) terms_[t]->add_forces(s, f);
 }
 
 void System::add_forces(const StateView& s, std::span<double> f) const {

@@ -2,7 +2,9 @@
 // Preconditioned conjugate gradients with Baraff-Witkin filtering (PHYSICS_NOTES §1.5):
 // constrained axes keep their prescribed values and never enter the Krylov space.
 
+#include <cstdint>
 #include <span>
+#include <vector>
 
 #include "sewn/physics/aligned.hpp"
 #include "sewn/physics/block_matrix.hpp"
@@ -20,10 +22,20 @@ struct CgResult {
 /// (column-major), for block-Jacobi preconditioning. free_dof is 1 on free axes, 0 on fixed. O(n).
 void block_jacobi_inverse(const BlockMatrix& A, std::span<const double> free_dof, std::span<double> inverse);
 
-/// Work vectors reused between solves (no allocation once sized).
+/// Work arrays reused between solves (no allocation once sized).
 struct CgWorkspace {
   AlignedVector<double> r, z, p, q;
   void resize(std::size_t n3);
+
+  // The fast path (AVX-512 builds, every block of A symmetric, as the springs' are): the upper
+  // block triangle of A, 6 values per symmetric 3×3 block, less than half the bytes of A, so
+  // that a product streams from L2 for meshes whose full matrix does not fit there. Rows of
+  // vectors are padded to 4 doubles. The pattern is rebuilt when A's pattern_version() changes.
+  std::uint64_t sym_pattern = ~std::uint64_t{0};
+  std::vector<Index> sym_row, sym_col, sym_src;  // row offsets (diagonal first), columns, slots in A
+  AlignedVector<double> sym_val;                  // 6 per block: a00 a01 a02 a11 a12 a22
+  AlignedVector<double> x4, free4;                // 4 per node
+  AlignedVector<double> pre;                      // the filtered preconditioner, 6 per node
 };
 
 /// Solves A x = b on the free axes with x fixed to its incoming values on the others (pass

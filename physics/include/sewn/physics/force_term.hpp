@@ -12,6 +12,7 @@
 // A term that a scene does not instantiate costs nothing. Terms are not thread-safe: forces
 // may use scratch buffers owned by the term.
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <string_view>
@@ -89,6 +90,13 @@ class ForceTerm {
   [[nodiscard]] virtual std::string_view name() const = 0;
   /// Adds this term's forces at state s into f (3n). Cost: one pass over the elements.
   virtual void add_forces(const StateView& s, std::span<double> f) const = 0;
+  /// Sets f (3n) to this term's forces at state s. The default zeroes f and adds; a term that
+  /// can write its forces directly overrides it and saves that pass (System::compute_forces
+  /// calls it for its first term).
+  virtual void set_forces(const StateView& s, std::span<double> f) const {
+    std::fill(f.begin(), f.end(), 0.0);
+    add_forces(s, f);
+  }
   /// Potential energy at state s. Cost: one pass over the elements.
   [[nodiscard]] virtual double potential_energy(const StateView& s) const = 0;
   [[nodiscard]] virtual EnergyKind energy_kind() const { return EnergyKind::internal; }

@@ -87,6 +87,7 @@ class Springs final : public ForceTerm {
 
   // ---- ForceTerm
   void add_forces(const StateView& s, std::span<double> f) const override;
+  void set_forces(const StateView& s, std::span<double> f) const override;
   [[nodiscard]] double potential_energy(const StateView& s) const override;
   [[nodiscard]] double energy_scale() const override;
   void collect_pairs(std::vector<NodePair>& out) const override;
@@ -99,6 +100,8 @@ class Springs final : public ForceTerm {
 
  private:
   void check_spring(Index s, const char* where) const;
+  // add_forces (accumulate) or set_forces (overwrite f).
+  void forces(const StateView& s, std::span<double> f, bool accumulate) const;
 
   // Structure of arrays: the force loop streams these in order.
   AlignedVector<Index> ni_, nj_;
@@ -114,9 +117,9 @@ class Springs final : public ForceTerm {
   std::vector<Index> slot_ij_, slot_ji_, slot_ii_, slot_jj_;
   std::uint64_t bound_pattern_ = 0;
   std::uint64_t bound_topology_ = ~std::uint64_t{0};
-  // Force accumulator with 4 doubles per node, so each spring end is one aligned 256-bit
-  // read-modify-write that store forwarding handles (see springs.cpp).
-  mutable AlignedVector<double> acc_;
+  // Positions, velocities and the force accumulator as rows of 4 doubles per node, so each
+  // spring end is one aligned 256-bit access (see springs.cpp). acc_ is zero between calls.
+  mutable AlignedVector<double> x_rows_, v_rows_, acc_;
 };
 
 }  // namespace sewn::physics
