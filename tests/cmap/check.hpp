@@ -14,6 +14,19 @@
 
 namespace sewn::test {
 
+// Gives every cell of every dimension with attributes its own attribute, numbered 0, 1, 2, ...
+template <class M>
+void label_all_cells(M& m) {
+  int next = 0;
+  auto label = [&](auto k) {
+    constexpr int I = decltype(k)::value;
+    if constexpr (M::template has_attribute<I>) m.template create_attributes<I>([&](Dart) { return next++; });
+  };
+  [&]<int... I>(std::integer_sequence<int, I...>) {
+    (label(std::integral_constant<int, I>{}), ...);
+  }(std::make_integer_sequence<int, M::dimension + 1>{});
+}
+
 // Neighbours of dart x in the orbit of its i-cell, written out by hand from the definition of
 // cells in a combinatorial map (not shared with the library): for i ≥ 1 every βj (j ≠ i, β0
 // with β1), for i = 0 the compositions β1∘βj, βj∘β0 and βk∘βj (j ≠ k ≥ 2).

@@ -9,6 +9,7 @@
 using namespace sewn;
 using sewn::test::check_map;
 using sewn::test::counts;
+using sewn::test::label_all_cells;
 
 using Map1 = CMap<1, int, int>;
 using Map2 = CMap<2, int, int, int>;
@@ -16,18 +17,6 @@ using Map3 = CMap<3, int, int, int, int>;
 using Map4 = CMap<4, int, int, int, int, int>;
 
 namespace {
-
-template <class M>
-void label_all_cells(M& m) {
-  int next = 0;
-  auto label = [&](auto k) {
-    constexpr int I = decltype(k)::value;
-    if constexpr (M::template has_attribute<I>) m.template create_attributes<I>([&](Dart) { return next++; });
-  };
-  [&]<int... I>(std::integer_sequence<int, I...>) {
-    (label(std::integral_constant<int, I>{}), ...);
-  }(std::make_integer_sequence<int, M::dimension + 1>{});
-}
 
 template <class M>
 std::array<std::uint32_t, M::dimension + 1> plus(std::array<std::uint32_t, M::dimension + 1> a,

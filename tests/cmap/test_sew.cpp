@@ -13,23 +13,12 @@
 using namespace sewn;
 using sewn::test::check_map;
 using sewn::test::counts;
+using sewn::test::label_all_cells;
 
 using Map1 = CMap<1, int, int>;
 using Map2 = CMap<2, int, int, int>;
 using Map3 = CMap<3, int, int, int, int>;
 using Map4 = CMap<4, int, int, int, int, int>;
-
-template <class M>
-void label_all_cells(M& m) {
-  int next = 0;
-  auto label = [&](auto k) {
-    constexpr int I = decltype(k)::value;
-    if constexpr (M::template has_attribute<I>) m.template create_attributes<I>([&](Dart) { return next++; });
-  };
-  [&]<int... I>(std::integer_sequence<int, I...>) {
-    (label(std::integral_constant<int, I>{}), ...);
-  }(std::make_integer_sequence<int, M::dimension + 1>{});
-}
 
 TEST_CASE("1-sew in a 1-map joins two darts into a path and back") {
   Map1 m;
