@@ -63,33 +63,41 @@ struct FacetKey {
   friend bool operator<(const FacetKey& a, const FacetKey& b) {
     return a.n != b.n ? a.n < b.n : a.v < b.v;
   }
-  [[nodiscard]] bool same_points(const FacetKey& o) const { return n == o.n && v == o.v; }
 };
 
-// Groups facets by their smallest point with a counting sort, then by key within a group:
-// O(facets + points). Calls f(first, last) for each run of facets with the same points.
-template <class F>
-void for_each_facet_group(std::vector<FacetKey>& facets, std::uint32_t num_points, F&& f) {
-  std::vector<std::uint32_t> start(num_points + 1, 0);
-  for (const auto& k : facets) ++start[k.v[0] + 1];
+// Groups items by their smallest point with a counting sort, then by `less` within a group:
+// O(items + points). Calls f(first, last) for each run of items that `less` does not order
+// (the same points). smallest(item) must lie in [0, num_points).
+template <class T, class Smallest, class Less, class F>
+void for_each_point_group(const std::vector<T>& items, std::uint32_t num_points, Smallest&& smallest, Less&& less, F&& f) {
+  std::vector<std::uint32_t> start(std::size_t{num_points} + 1, 0);
+  for (const T& k : items) ++start[smallest(k) + 1];
   for (std::uint32_t p = 0; p < num_points; ++p) start[p + 1] += start[p];
-  std::vector<FacetKey> sorted(facets.size());
+  std::vector<T> sorted(items.size());
   {
     std::vector<std::uint32_t> pos(start.begin(), start.end() - 1);
-    for (const auto& k : facets) sorted[pos[k.v[0]]++] = k;
+    for (const T& k : items) sorted[pos[smallest(k)]++] = k;
   }
   for (std::uint32_t p = 0; p < num_points; ++p) {
     auto first = sorted.begin() + start[p], last = sorted.begin() + start[p + 1];
-    // groups hold the few facets around one point: insertion sort beats std::sort here
+    // groups hold the few items around one point: insertion sort beats std::sort here
     for (auto it = first + (first != last); it < last; ++it)
-      for (auto j = it; j != first && *j < *(j - 1); --j) std::iter_swap(j, j - 1);
+      for (auto j = it; j != first && less(*j, *(j - 1)); --j) std::iter_swap(j, j - 1);
     for (auto it = first; it != last;) {
       auto run = it + 1;
-      while (run != last && run->same_points(*it)) ++run;
+      while (run != last && !less(*it, *run)) ++run;
       f(it, run);
       it = run;
     }
   }
+}
+
+// for_each_point_group over facet keys, by their sorted points.
+template <class F>
+void for_each_facet_group(const std::vector<FacetKey>& facets, std::uint32_t num_points, F&& f) {
+  for_each_point_group(
+      facets, num_points, [](const FacetKey& k) { return k.v[0]; },
+      [](const FacetKey& a, const FacetKey& b) { return a < b; }, std::forward<F>(f));
 }
 
 // Edge k of a 2D cell runs from its point k to point k+1.
@@ -415,44 +423,29 @@ SewCoincidentReport sew_coincident_faces(CMap<D, A...>& map, PointOf&& point_of,
     }
     facets.push_back({x, first, static_cast<std::uint32_t>(pts.size()) - first});
   }
-  // 2) group by smallest point (counting sort), then by the whole point list within a group
-  std::vector<std::uint32_t> start(std::size_t{num_points} + 1, 0);
-  for (const Facet& f : facets) ++start[pts[f.first] + 1];
-  for (std::uint32_t p = 0; p < num_points; ++p) start[p + 1] += start[p];
-  std::vector<Facet> sorted(facets.size());
-  {
-    std::vector<std::uint32_t> pos(start.begin(), start.end() - 1);
-    for (const Facet& f : facets) sorted[pos[pts[f.first]]++] = f;
-  }
+  // 2) group by the whole sorted point list
   auto key = [&](const Facet& f) { return std::span<const std::uint32_t>(pts.data() + f.first, f.n); };
   auto less = [&](const Facet& a, const Facet& b) {
     return a.n != b.n ? a.n < b.n : std::ranges::lexicographical_compare(key(a), key(b));
   };
   SewCoincidentReport rep;
-  for (std::uint32_t p = 0; p < num_points; ++p) {
-    const auto first = sorted.begin() + start[p], last = sorted.begin() + start[p + 1];
-    std::sort(first, last, less);
-    for (auto it = first; it != last;) {
-      auto run = it + 1;
-      while (run != last && !less(*it, *run)) ++run;
-      if (run - it > 2) {
-        ++rep.nonmanifold;
-      } else if (run - it == 2) {
-        // pair dart a (u -> v) with the dart of the other facet that runs v -> u
-        const std::uint32_t a = it->dart, want = start_of(map.b(a, 1));
-        std::uint32_t y = (it + 1)->dart;
-        if constexpr (D == 3)  // a face: find that dart on its cycle (an edge is its own dart)
-          for (std::uint32_t k = 0; k < it->n && start_of(y) != want; ++k) y = map.b(y, 1);
-        if (start_of(y) == want && start_of(map.b(y, 1)) == start_of(a) && map.template is_sewable<D>(Dart(a), Dart(y))) {
-          map.template sew<D>(Dart(a), Dart(y));
-          ++rep.sewn;
-        } else {
-          ++rep.mismatched;
-        }
+  detail::for_each_point_group(facets, num_points, [&](const Facet& f) { return pts[f.first]; }, less, [&](auto it, auto run) {
+    if (run - it > 2) {
+      ++rep.nonmanifold;
+    } else if (run - it == 2) {
+      // pair dart a (u -> v) with the dart of the other facet that runs v -> u
+      const std::uint32_t a = it->dart, want = start_of(map.b(a, 1));
+      std::uint32_t y = (it + 1)->dart;
+      if constexpr (D == 3)  // a face: find that dart on its cycle (an edge is its own dart)
+        for (std::uint32_t k = 0; k < it->n && start_of(y) != want; ++k) y = map.b(y, 1);
+      if (start_of(y) == want && start_of(map.b(y, 1)) == start_of(a) && map.template is_sewable<D>(Dart(a), Dart(y))) {
+        map.template sew<D>(Dart(a), Dart(y));
+        ++rep.sewn;
+      } else {
+        ++rep.mismatched;
       }
-      it = run;
     }
-  }
+  });
   return rep;
 }
 
