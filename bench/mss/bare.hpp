@@ -5,11 +5,17 @@
 // measured cost of living on the map and of the library's generality. No map, no force-term
 // interface, no health checks.
 //
-// Layout, chosen by measurement (bench/mss/notes.md, "The bare loop"): positions, velocities
-// and the force accumulator hold 4 doubles per node (x, y, z, 0), so every node is one aligned
-// 256-bit load that never splits a cache line; springs are a structure of arrays in mesh-edge
-// order. Gravity enters as an acceleration g on free axes, and the update zeroes the
-// accumulator as it reads it, so a step is two passes: springs, then nodes.
+// Layout, chosen by measurement (bench/mss/notes.md, "The bare loop"): every node quantity is
+// one array per axis, and the springs are grouped into chunks of eight whose ends are
+// consecutive nodes (spring q of a chunk joins i0 + q and j0 + q), so a chunk reads and writes
+// contiguous lanes; springs in no such run are a short list done one at a time. Gravity enters
+// as an acceleration g on free axes, and the update zeroes the accumulators as it reads them,
+// so a step is two passes: springs, then nodes. It is written apart from the library's
+// spring_runs.cpp on purpose: the baseline must not inherit the library's choices.
+//
+// When fewer than half of the springs are in chunks (the one- and two-element cases), rows
+// of 4 doubles per node (x, y, z, 0) are faster: each spring end is one aligned 256-bit load,
+// four springs at a time. The constructor picks the layout.
 
 #include <array>
 #include <cstdint>
@@ -28,7 +34,7 @@ class Bare {
   /// One semi-implicit step: v += h (F/m), x += h v, F = springs + gravity; fixed axes stay.
   void step(double h);
 
-  [[nodiscard]] Counts counts() const { return {n_, k_.size()}; }
+  [[nodiscard]] Counts counts() const { return {n_, springs_}; }
   void set_state(const State& s);
   [[nodiscard]] State state() const;
   void save();
@@ -39,17 +45,31 @@ class Bare {
 
  private:
   void accumulate_springs();
+  void accumulate_rows();
+  void step_rows(double h);
 
   template <class T>
   using Vec = physics::AlignedVector<T>;
-  std::size_t n_ = 0;
-  Vec<double> x_, v_, acc_;    // 4 per node
-  Vec<double> inv_mass_, g_;   // 4 per node: 1/m and g on free axes, 0 on fixed axes and lane 3
-  Vec<double> mass_;           // per node, for forces()
+  struct Chunk {
+    std::uint32_t i0, j0;
+    std::uint8_t mask;
+  };
+  std::size_t n_ = 0, springs_ = 0;
+  // Per axis, padded past the last node so that an 8-lane access may start at any node:
+  // positions, velocities, the i-side and j-side force accumulators, 1/m and g (0 on fixed axes).
+  std::array<Vec<double>, 3> x_, v_, fi_, fj_, inv_mass_, g_;
+  Vec<double> mass_;  // per node, for forces()
   std::array<double, 3> gravity_{};
+  std::vector<Chunk> chunks_;        // in order of i0
+  Vec<double> ck_, cl_, cg_;         // 8 per chunk; unused lanes k = 0, l = 1, γ = 0
+  Vec<std::uint32_t> ri_, rj_;       // the springs in no chunk
+  Vec<double> rk_, rl_, rg_;
+  std::array<Vec<double>, 3> saved_x_, saved_v_;
+  // The row layout (used instead of all the above when rows_ is set): 4 per node.
+  bool rows_ = false;
+  Vec<double> x4_, v4_, acc4_, inv_mass4_, g4_, saved_x4_, saved_v4_;
   Vec<std::uint32_t> i_, j_;
   Vec<double> k_, l_, gamma_;
-  Vec<double> saved_x_, saved_v_;
 };
 
 }  // namespace sewn::bench::mss

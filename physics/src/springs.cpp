@@ -266,6 +266,7 @@ Index Springs::add(Index i, Index j, double k, double rest_length, SpringKind ki
   }
   ++alive_count_;
   max_node_ = std::max({max_node_, i, j});
+  runs_.on_added(s);
   touch_topology();
   return s;
 }
@@ -277,6 +278,7 @@ void Springs::remove(Index s) {
   k_[s] = l_[s] = gamma_[s] = 0.0;
   free_.push_back(s);
   --alive_count_;
+  runs_.on_removed(s);
   touch_topology();
 }
 
@@ -284,6 +286,7 @@ void Springs::set_stiffness(Index s, double k) {
   check_spring(s, "Springs::set_stiffness");
   check_param(k, "stiffness", "Springs::set_stiffness", s);
   k_[s] = k;
+  runs_.on_parameters_changed(s, k_[s], l_[s], gamma_[s]);
   touch_parameters();
 }
 
@@ -291,6 +294,7 @@ void Springs::set_rest_length(Index s, double l) {
   check_spring(s, "Springs::set_rest_length");
   check_param(l, "rest length", "Springs::set_rest_length", s);
   l_[s] = l;
+  runs_.on_parameters_changed(s, k_[s], l_[s], gamma_[s]);
   touch_parameters();
 }
 
@@ -298,6 +302,7 @@ void Springs::set_viscosity(Index s, double gamma) {
   check_spring(s, "Springs::set_viscosity");
   check_param(gamma, "viscosity", "Springs::set_viscosity", s);
   gamma_[s] = gamma;
+  runs_.on_parameters_changed(s, k_[s], l_[s], gamma_[s]);
   touch_parameters();
 }
 
@@ -308,6 +313,7 @@ void Springs::set_endpoints(Index s, Index i, Index j) {
   ni_[s] = i;
   nj_[s] = j;
   max_node_ = std::max({max_node_, i, j});
+  runs_.on_endpoints_changed(s);
   touch_topology();
 }
 
@@ -330,6 +336,7 @@ void Springs::set_paper_viscosity(std::span<const double> masses) {
                        std::to_string(masses.size()) + " masses given");
     gamma_[s] = paper_viscosity(k_[s], masses[ni_[s]], masses[nj_[s]]);
   }
+  runs_.refresh_parameters(arrays());
   touch_parameters();
 }
 
@@ -368,6 +375,7 @@ std::vector<Index> Springs::compact() {
   free_.clear();
   max_node_ = 0;
   for (Index s = 0; s < n; ++s) max_node_ = std::max({max_node_, ni_[s], nj_[s]});
+  runs_.invalidate();
   touch_topology();
   return old_to_new;
 }
@@ -421,6 +429,7 @@ void Springs::remap_nodes(std::span<const Index> old_to_new) {
   }
   max_node_ = 0;
   for (Index s = 0; s < size(); ++s) max_node_ = std::max({max_node_, ni_[s], nj_[s]});
+  runs_.invalidate();
   touch_topology();
 }
 
@@ -437,6 +446,23 @@ void Springs::forces(const StateView& st, std::span<double> f, bool accumulate) 
   if (max_node_ >= n)
     throw InputError("springs: a spring refers to node " + std::to_string(max_node_) + " but the state has " +
                      std::to_string(n) + " nodes");
+  if (runs_.needs_rebuild()) runs_.rebuild(arrays());
+  if (runs_.worthwhile()) {
+    static_assert(int(SpringDamping::none) == int(detail::RunDamping::none) &&
+                  int(SpringDamping::viscous) == int(detail::RunDamping::viscous) &&
+                  int(SpringDamping::stiffness_proportional) == int(detail::RunDamping::stiffness_proportional));
+    runs_.forces(arrays(), static_cast<detail::RunDamping>(damping_), beta_, st.x, st.v, f, accumulate, n);
+    return;
+  }
+  forces_by_rows(st, f, accumulate);
+}
+
+detail::SpringArrays Springs::arrays() const {
+  return {ni_.data(), nj_.data(), k_.data(), l_.data(), gamma_.data(), alive_.data(), size()};
+}
+
+void Springs::forces_by_rows(const StateView& st, std::span<double> f, bool accumulate) const {
+  const Index n = st.size();
   const std::size_t n4 = 4 * std::size_t{n};
   // acc_ is all zeros between calls (the scatter below clears what it reads).
   if (acc_.size() != n4) {

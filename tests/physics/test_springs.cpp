@@ -103,6 +103,124 @@ TEST_CASE("the vector force loop matches a plain per-spring reference for every 
   }
 }
 
+namespace {
+
+// Nodes of an nx×ny×nz lattice (jittered, random velocities) numbered x fastest, with the
+// springs a hexahedral grid has (edges and the 4 diagonals of each cell), so that most of them
+// come in runs of consecutive nodes. A third of the runs are reversed (j < i) and a few single
+// springs too, which breaks their runs.
+Springs& lattice_scene(System& sys, std::mt19937& rng, int nx, int ny, int nz, SpringDamping damping) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const auto id = [&](int x, int y, int z) { return static_cast<Index>(x + nx * (y + ny * z)); };
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x)
+        sys.nodes().add({x + 0.2 * u(rng), y + 0.2 * u(rng), z + 0.2 * u(rng)}, {u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5},
+                        0.5 + u(rng));
+  Springs& sp = sys.add<Springs>(damping, 0.03);
+  const auto spring = [&](Index i, Index j, bool reversed) {
+    const double d = (sys.nodes().position(j) - sys.nodes().position(i)).norm();
+    if (reversed != (u(rng) < 0.03)) std::swap(i, j);
+    sp.add(i, j, 10 + 90 * u(rng), d * (0.5 + u(rng)), SpringKind::edge, 0.5 + u(rng));
+  };
+  const int offsets[][2][3] = {{{0, 0, 0}, {1, 0, 0}}, {{0, 0, 0}, {0, 1, 0}}, {{0, 0, 0}, {0, 0, 1}},
+                               {{0, 0, 0}, {1, 1, 1}}, {{1, 0, 0}, {0, 1, 1}}, {{0, 1, 0}, {1, 0, 1}},
+                               {{0, 0, 1}, {1, 1, 0}}};
+  for (int f = 0; f < 7; ++f) {
+    const auto& o = offsets[f];
+    for (int z = 0; z + 1 < nz; ++z)
+      for (int y = 0; y + 1 < ny; ++y)
+        for (int x = 0; x + 1 < nx; ++x)
+          spring(id(x + o[0][0], y + o[0][1], z + o[0][2]), id(x + o[1][0], y + o[1][1], z + o[1][2]), (f + z) % 3 == 0);
+  }
+  return sp;
+}
+
+}  // namespace
+
+TEST_CASE("springs in runs take the chunked loop, which matches the reference through random edits") {
+  for (SpringDamping model : {SpringDamping::none, SpringDamping::viscous, SpringDamping::stiffness_proportional}) {
+    CAPTURE(int(model));
+    System sys;
+    std::mt19937 rng(11);
+    Springs& sp = lattice_scene(sys, rng, 11, 7, 5, model);  // 385 nodes: not a multiple of 8
+    Eigen::VectorXd f = forces(sys);
+    CHECK(sp.num_in_runs() >= sp.num_alive() / 2);
+    CHECK(max_abs(f - reference_forces(sys, sp)) <= 1e-13 * max_abs(f));
+    // set_forces (the system's first term) must agree with add_forces.
+    sys.compute_forces();
+    const auto fs = sys.nodes().f();
+    CHECK(max_abs(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(fs.data(), f.size())) - f) == 0.0);
+
+    const Index n = sys.nodes().size();
+    std::uniform_int_distribution<Index> node(0, n - 1);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const auto live_spring = [&] {
+      std::uniform_int_distribution<Index> pick(0, sp.size() - 1);
+      Index s = pick(rng);
+      while (!sp.is_alive(s)) s = pick(rng);
+      return s;
+    };
+    // Re-attaching springs to their own nodes sends them to the rest list one by one, until
+    // the list is long enough for a rebuild, which puts every one back in its chunk.
+    const Index initial = sp.num_in_runs();
+    bool came_back = false;
+    for (int step = 0; step < 400 && !came_back; ++step) {
+      const Index before = sp.num_in_runs();
+      const Index s = live_spring();
+      sp.set_endpoints(s, sp.node_i(s), sp.node_j(s));
+      f = forces(sys);
+      REQUIRE(max_abs(f - reference_forces(sys, sp)) <= 1e-13 * max_abs(f));
+      came_back = sp.num_in_runs() > before;
+    }
+    CHECK(came_back);
+    CHECK(sp.num_in_runs() == initial);
+    for (int step = 0; step < 600; ++step) {
+      switch (step % 6) {
+        case 0: sp.remove(live_spring()); break;
+        case 1: {
+          Index i = node(rng), j = node(rng);
+          while (j == i) j = node(rng);
+          sp.add(i, j, 50, 0.9 * (sys.nodes().position(j) - sys.nodes().position(i)).norm(), SpringKind::other, 2);
+          break;
+        }
+        case 2: {
+          const Index s = live_spring();
+          Index j = node(rng);
+          while (j == sp.node_i(s)) j = node(rng);
+          sp.set_endpoints(s, sp.node_i(s), j);
+          break;
+        }
+        case 3: sp.set_stiffness(live_spring(), 5 + 50 * u(rng)); break;
+        case 4: sp.set_rest_length(live_spring(), 0.5 + u(rng)); break;
+        default: sp.set_viscosity(live_spring(), u(rng)); break;
+      }
+      f = forces(sys);
+      REQUIRE(max_abs(f - reference_forces(sys, sp)) <= 1e-13 * max_abs(f));
+    }
+    sp.set_paper_viscosity(sys.nodes().masses());
+    f = forces(sys);
+    CHECK(max_abs(f - reference_forces(sys, sp)) <= 1e-13 * max_abs(f));
+    sp.compact();
+    f = forces(sys);
+    CHECK(sp.num_in_runs() > 0);
+    CHECK(max_abs(f - reference_forces(sys, sp)) <= 1e-13 * max_abs(f));
+  }
+}
+
+TEST_CASE("the chunked loop passes a NaN position on to the forces") {
+  System sys;
+  std::mt19937 rng(5);
+  Springs& sp = lattice_scene(sys, rng, 9, 4, 3, SpringDamping::viscous);
+  (void)forces(sys);
+  REQUIRE(sp.num_in_runs() > 0);
+  const Index bad = 13;  // an interior node
+  sys.nodes().x()[3 * bad + 1] = std::nan("");
+  const Eigen::VectorXd f = forces(sys);
+  CHECK(std::isnan(f[3 * bad + 1]));
+  CHECK_FALSE(std::isnan(f[3 * (bad + 2 * 9 + 6)]));  // a node sharing no spring with it
+}
+
 TEST_CASE("spring Jacobians match finite differences of the forces") {
   SUBCASE("random configurations, every damping model") {
     for (SpringDamping model : {SpringDamping::none, SpringDamping::viscous, SpringDamping::stiffness_proportional}) {

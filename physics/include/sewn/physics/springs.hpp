@@ -24,6 +24,7 @@
 
 #include "sewn/physics/aligned.hpp"
 #include "sewn/physics/force_term.hpp"
+#include "sewn/physics/spring_runs.hpp"
 
 namespace sewn::physics {
 
@@ -84,6 +85,9 @@ class Springs final : public ForceTerm {
   [[nodiscard]] SpringKind kind(Index s) const;
   [[nodiscard]] SpringDamping damping() const { return damping_; }
   [[nodiscard]] double rayleigh_beta() const { return beta_; }
+  /// Springs the force loop handled as chunks of runs in its last call (spring_runs.hpp); 0 if
+  /// it used the row path for all of them. For tests and benchmarks. O(1).
+  [[nodiscard]] Index num_in_runs() const { return runs_.worthwhile() ? runs_.num_chunked() : 0; }
 
   // ---- ForceTerm
   void add_forces(const StateView& s, std::span<double> f) const override;
@@ -102,6 +106,9 @@ class Springs final : public ForceTerm {
   void check_spring(Index s, const char* where) const;
   // add_forces (accumulate) or set_forces (overwrite f).
   void forces(const StateView& s, std::span<double> f, bool accumulate) const;
+  // The AoS path: every spring from rows of 4 doubles per node.
+  void forces_by_rows(const StateView& s, std::span<double> f, bool accumulate) const;
+  [[nodiscard]] detail::SpringArrays arrays() const;
 
   // Structure of arrays: the force loop streams these in order.
   AlignedVector<Index> ni_, nj_;
@@ -120,6 +127,8 @@ class Springs final : public ForceTerm {
   // Positions, velocities and the force accumulator as rows of 4 doubles per node, so each
   // spring end is one aligned 256-bit access (see springs.cpp). acc_ is zero between calls.
   mutable AlignedVector<double> x_rows_, v_rows_, acc_;
+  // The chunked path for springs numbered in runs (spring_runs.hpp), used when most are.
+  mutable detail::SpringRuns runs_;
 };
 
 }  // namespace sewn::physics

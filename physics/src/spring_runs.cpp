@@ -1,0 +1,399 @@
+#include "sewn/physics/spring_runs.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#define SEWN_RUNS_AVX512 1
+#endif
+
+namespace sewn::physics::detail {
+
+namespace {
+
+// The springs term's degenerate-spring guard (springs.cpp): no force below d² = 1e-18 l².
+constexpr double degenerate_ratio_sq = 1e-18;
+constexpr std::uint32_t no_lane = ~std::uint32_t{0};
+// A run shorter than this is cheaper one spring at a time than as a chunk.
+constexpr int min_chunk_lanes = 4;
+
+// The per-axis arrays inside soa_, each `stride` long.
+enum Axis : int { X, Y, Z, VX, VY, VZ, FX, FY, FZ, GX, GY, GZ, num_arrays };
+
+struct Soa {
+  double* a[num_arrays];
+};
+
+Soa soa_view(double* base, std::size_t stride) {
+  Soa s{};
+  for (int k = 0; k < num_arrays; ++k) s.a[k] = base + static_cast<std::size_t>(k) * stride;
+  return s;
+}
+
+// 3n node-major values -> three per-axis arrays.
+void split_axes(const double* __restrict in, double* __restrict x, double* __restrict y, double* __restrict z, std::size_t n) {
+  std::size_t p = 0;
+#ifdef SEWN_RUNS_AVX512
+  // Eight nodes are 24 values in three registers; each axis is two two-source permutes.
+  const __m512i x01 = _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0), x2 = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13);
+  const __m512i y01 = _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0), y2 = _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14);
+  const __m512i z01 = _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0), z2 = _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15);
+  for (; p + 8 <= n; p += 8) {
+    const __m512d a0 = _mm512_loadu_pd(in + 3 * p), a1 = _mm512_loadu_pd(in + 3 * p + 8),
+                  a2 = _mm512_loadu_pd(in + 3 * p + 16);
+    _mm512_store_pd(x + p, _mm512_permutex2var_pd(_mm512_permutex2var_pd(a0, x01, a1), x2, a2));
+    _mm512_store_pd(y + p, _mm512_permutex2var_pd(_mm512_permutex2var_pd(a0, y01, a1), y2, a2));
+    _mm512_store_pd(z + p, _mm512_permutex2var_pd(_mm512_permutex2var_pd(a0, z01, a1), z2, a2));
+  }
+#endif
+  for (; p < n; ++p) {
+    x[p] = in[3 * p];
+    y[p] = in[3 * p + 1];
+    z[p] = in[3 * p + 2];
+  }
+}
+
+// f (3n) = or += fi + gj per axis, and the accumulators back to zero.
+void join_axes(const Soa& s, double* __restrict out, std::size_t n, bool accumulate) {
+  double *fx = s.a[FX], *fy = s.a[FY], *fz = s.a[FZ], *gx = s.a[GX], *gy = s.a[GY], *gz = s.a[GZ];
+  std::size_t p = 0;
+#ifdef SEWN_RUNS_AVX512
+  // The inverse of split_axes: three registers of 8 interleaved nodes, two permutes each.
+  const __m512i o0a = _mm512_setr_epi64(0, 8, 0, 1, 9, 0, 2, 10), o0b = _mm512_setr_epi64(0, 1, 8, 3, 4, 9, 6, 7);
+  const __m512i o1a = _mm512_setr_epi64(0, 3, 11, 0, 4, 12, 0, 5), o1b = _mm512_setr_epi64(10, 1, 2, 11, 4, 5, 12, 7);
+  const __m512i o2a = _mm512_setr_epi64(13, 0, 6, 14, 0, 7, 15, 0), o2b = _mm512_setr_epi64(0, 13, 2, 3, 14, 5, 6, 15);
+  const __m512d zero = _mm512_setzero_pd();
+  for (; p + 8 <= n; p += 8) {
+    const __m512d X = _mm512_add_pd(_mm512_load_pd(fx + p), _mm512_load_pd(gx + p));
+    const __m512d Y = _mm512_add_pd(_mm512_load_pd(fy + p), _mm512_load_pd(gy + p));
+    const __m512d Z = _mm512_add_pd(_mm512_load_pd(fz + p), _mm512_load_pd(gz + p));
+    for (double* a : {fx, fy, fz, gx, gy, gz}) _mm512_store_pd(a + p, zero);
+    __m512d r0 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(X, o0a, Y), o0b, Z);
+    __m512d r1 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(X, o1a, Y), o1b, Z);
+    __m512d r2 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(X, o2a, Y), o2b, Z);
+    double* o = out + 3 * p;
+    if (accumulate) {
+      r0 = _mm512_add_pd(r0, _mm512_loadu_pd(o));
+      r1 = _mm512_add_pd(r1, _mm512_loadu_pd(o + 8));
+      r2 = _mm512_add_pd(r2, _mm512_loadu_pd(o + 16));
+    }
+    _mm512_storeu_pd(o, r0);
+    _mm512_storeu_pd(o + 8, r1);
+    _mm512_storeu_pd(o + 16, r2);
+  }
+#endif
+  for (; p < n; ++p) {
+    const double v[3] = {fx[p] + gx[p], fy[p] + gy[p], fz[p] + gz[p]};
+    for (int c = 0; c < 3; ++c) out[3 * p + c] = accumulate ? out[3 * p + c] + v[c] : v[c];
+    fx[p] = fy[p] = fz[p] = gx[p] = gy[p] = gz[p] = 0.0;
+  }
+}
+
+// The force of one spring from the per-axis arrays: the reference arithmetic of the chunk
+// kernel (springs.cpp's spring_scalar, on another layout).
+template <RunDamping D>
+inline void one_spring(const Soa& s, std::size_t i, std::size_t j, double k, double l, double g, double beta) {
+  const double dx = s.a[X][j] - s.a[X][i], dy = s.a[Y][j] - s.a[Y][i], dz = s.a[Z][j] - s.a[Z][i];
+  const double d2 = dx * dx + dy * dy + dz * dz;
+  if (d2 <= degenerate_ratio_sq * l * l) return;  // NaN goes on, to be caught downstream
+  const double inv = 1.0 / std::sqrt(d2);
+  double c = k * (1.0 - l * inv);
+  double e = 0.0, ux = 0, uy = 0, uz = 0;
+  if constexpr (D != RunDamping::none) {
+    ux = s.a[VX][j] - s.a[VX][i];
+    uy = s.a[VY][j] - s.a[VY][i];
+    uz = s.a[VZ][j] - s.a[VZ][i];
+    const double w = (ux * dx + uy * dy + uz * dz) * inv * inv;
+    if constexpr (D == RunDamping::viscous) {
+      c += g * w;
+    } else {
+      const double cl = std::max(0.0, 1.0 - l * inv);
+      const double bk = beta * k;
+      c += bk * (1.0 - cl) * w;
+      e = bk * cl;
+    }
+  }
+  const double fx = c * dx + e * ux, fy = c * dy + e * uy, fz = c * dz + e * uz;
+  s.a[FX][i] += fx;
+  s.a[FY][i] += fy;
+  s.a[FZ][i] += fz;
+  s.a[GX][j] -= fx;
+  s.a[GY][j] -= fy;
+  s.a[GZ][j] -= fz;
+}
+
+#ifdef SEWN_RUNS_AVX512
+inline __m512d inv_sqrt(__m512d d2) {
+  // rsqrt14 and two Newton steps: relative error ~1e-16, as the AoS path's.
+  const __m512d half = _mm512_set1_pd(0.5), three_halves = _mm512_set1_pd(1.5);
+  const __m512d hd = _mm512_mul_pd(half, d2);
+  // (The zero-masked forms: GCC 12 warns that the plain ones read an undefined register.)
+  __m512d y = _mm512_maskz_rsqrt14_pd(0xFF, d2);
+  y = _mm512_mul_pd(y, _mm512_fnmadd_pd(hd, _mm512_mul_pd(y, y), three_halves));
+  y = _mm512_mul_pd(y, _mm512_fnmadd_pd(hd, _mm512_mul_pd(y, y), three_halves));
+  return y;
+}
+
+// The node arrays as the chunk loop reads them, as separate restrict pointers so that the
+// compiler keeps them in registers across the masked stores.
+struct Arrays {
+  const double* __restrict x;
+  const double* __restrict y;
+  const double* __restrict z;
+  const double* __restrict vx;
+  const double* __restrict vy;
+  const double* __restrict vz;
+  double* __restrict f[3];
+  double* __restrict g[3];
+};
+
+// Chunks of eight springs (i0 + q, j0 + q). Loads are unmasked (the arrays are padded past
+// the last node, and lanes outside the mask compute values nobody stores); stores are masked.
+template <RunDamping D, class Chunk>
+void chunk_loop(const Arrays& A, const Chunk* __restrict chunks, const std::uint8_t* __restrict masks, std::size_t count,
+                const double* __restrict k8, const double* __restrict l8, const double* __restrict g8, double beta) {
+  const double* __restrict x = A.x;
+  const double* __restrict y = A.y;
+  const double* __restrict z = A.z;
+  const double* __restrict vx = A.vx;
+  const double* __restrict vy = A.vy;
+  const double* __restrict vz = A.vz;
+  double* __restrict fo[3] = {A.f[0], A.f[1], A.f[2]};
+  double* __restrict go[3] = {A.g[0], A.g[1], A.g[2]};
+  const __m512d one = _mm512_set1_pd(1.0), tiny = _mm512_set1_pd(degenerate_ratio_sq);
+  // Chunks are sorted by i0, and the i-side forces of chunks with the same i0 are summed in
+  // registers and stored once: a load of the accumulator right after a masked store to it
+  // cannot be forwarded and would wait for the store to reach the cache.
+  __m512d fi[3] = {_mm512_setzero_pd(), _mm512_setzero_pd(), _mm512_setzero_pd()};
+  __mmask8 fi_mask = 0;
+  std::size_t fi_node = count > 0 ? chunks[0].i0 : 0;
+  const auto flush = [&] {
+    for (int a = 0; a < 3; ++a) {
+      _mm512_mask_storeu_pd(fo[a] + fi_node, fi_mask, _mm512_add_pd(_mm512_loadu_pd(fo[a] + fi_node), fi[a]));
+      fi[a] = _mm512_setzero_pd();
+    }
+    fi_mask = 0;
+  };
+  for (std::size_t c = 0; c < count; ++c) {
+    const std::size_t i = chunks[c].i0, j = chunks[c].j0;
+    const __mmask8 mk = masks[c];
+    if (i != fi_node) {
+      flush();
+      fi_node = i;
+    }
+    fi_mask |= mk;
+    const auto diff = [&](const double* a) { return _mm512_sub_pd(_mm512_loadu_pd(a + j), _mm512_loadu_pd(a + i)); };
+    const __m512d dx = diff(x), dy = diff(y), dz = diff(z);
+    const __m512d d2 = _mm512_fmadd_pd(dz, dz, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dx, dx)));
+    const __m512d l = _mm512_load_pd(l8 + 8 * c), k = _mm512_load_pd(k8 + 8 * c);
+    // Ordered compare: a NaN length fails it, c becomes 0 but c·d stays NaN.
+    const __mmask8 ok = _mm512_cmp_pd_mask(d2, _mm512_mul_pd(tiny, _mm512_mul_pd(l, l)), _CMP_GT_OQ);
+    const __m512d inv = inv_sqrt(d2);
+    const __m512d linv = _mm512_mul_pd(l, inv);
+    __m512d cf = _mm512_mul_pd(k, _mm512_sub_pd(one, linv));
+    __m512d e = _mm512_setzero_pd(), u[3] = {e, e, e};
+    if constexpr (D != RunDamping::none) {
+      u[0] = diff(vx);
+      u[1] = diff(vy);
+      u[2] = diff(vz);
+      const __m512d du = _mm512_fmadd_pd(dz, u[2], _mm512_fmadd_pd(dy, u[1], _mm512_mul_pd(dx, u[0])));
+      const __m512d w = _mm512_mul_pd(du, _mm512_mul_pd(inv, inv));
+      if constexpr (D == RunDamping::viscous) {
+        cf = _mm512_fmadd_pd(_mm512_load_pd(g8 + 8 * c), w, cf);
+      } else {
+        const __m512d cl = _mm512_maskz_max_pd(0xFF, _mm512_sub_pd(one, linv), _mm512_setzero_pd());
+        const __m512d bk = _mm512_mul_pd(_mm512_set1_pd(beta), k);
+        cf = _mm512_fmadd_pd(_mm512_mul_pd(bk, _mm512_sub_pd(one, cl)), w, cf);
+        e = _mm512_maskz_mov_pd(ok, _mm512_mul_pd(bk, cl));
+      }
+    }
+    cf = _mm512_maskz_mov_pd(ok, cf);
+    const __m512d d[3] = {dx, dy, dz};
+    for (int a = 0; a < 3; ++a) {
+      __m512d f = _mm512_mul_pd(cf, d[a]);
+      if constexpr (D == RunDamping::stiffness_proportional) f = _mm512_fmadd_pd(e, u[a], f);
+      fi[a] = _mm512_mask_add_pd(fi[a], mk, fi[a], f);
+      _mm512_mask_storeu_pd(go[a] + j, mk, _mm512_sub_pd(_mm512_loadu_pd(go[a] + j), f));
+    }
+  }
+  if (count > 0) flush();
+}
+#endif
+
+}  // namespace
+
+void SpringRuns::ensure_lane_index(Index count) {
+  if (lane_of_.size() < count) {
+    lane_of_.resize(count, no_lane);
+    in_rest_.resize(count, 0);
+  }
+}
+
+void SpringRuns::to_rest(Index s) {
+  if (in_rest_[s] != 0) return;
+  in_rest_[s] = 1;
+  rest_.push_back(s);
+}
+
+void SpringRuns::rebuild(const SpringArrays& a) {
+  chunks_.clear();
+  mask_.clear();
+  k_.clear();
+  l_.clear();
+  g_.clear();
+  spring_.clear();
+  rest_.clear();
+  lane_of_.assign(a.count, no_lane);
+  in_rest_.assign(a.count, 0);
+  std::vector<Index> order;
+  order.reserve(a.count);
+  for (Index s = 0; s < a.count; ++s)
+    if (a.alive[s] != 0) order.push_back(s);
+  live_ = static_cast<Index>(order.size());
+  const auto offset = [&](Index s) { return std::int64_t{a.nj[s]} - std::int64_t{a.ni[s]}; };
+  // Same offset j - i, then increasing i: each run is a stretch of consecutive entries.
+  std::sort(order.begin(), order.end(), [&](Index p, Index q) {
+    const std::int64_t op = offset(p), oq = offset(q);
+    return op != oq ? op < oq : a.ni[p] < a.ni[q];
+  });
+  chunked_ = 0;
+  for (std::size_t t = 0; t < order.size();) {
+    const Index first = order[t];
+    std::size_t len = 1;
+    while (t + len < order.size() && len < lanes && offset(order[t + len]) == offset(first) &&
+           a.ni[order[t + len]] == a.ni[first] + len)
+      ++len;
+    if (len < min_chunk_lanes) {
+      for (std::size_t q = 0; q < len; ++q) to_rest(order[t + q]);
+    } else {
+      const auto c = static_cast<std::uint32_t>(chunks_.size());
+      chunks_.push_back({a.ni[first], a.nj[first]});
+      mask_.push_back(static_cast<std::uint8_t>((1u << len) - 1u));
+      for (std::size_t q = 0; q < lanes; ++q) {
+        const bool used = q < len;
+        const Index s = used ? order[t + q] : invalid_index;
+        spring_.push_back(s);
+        k_.push_back(used ? a.k[s] : 0.0);
+        l_.push_back(used ? a.l[s] : 1.0);
+        g_.push_back(used ? a.g[s] : 0.0);
+        if (used) lane_of_[s] = c * lanes + static_cast<std::uint32_t>(q);
+      }
+      chunked_ += static_cast<Index>(len);
+    }
+    t += len;
+  }
+  // Chunks in order of their first node, so that consecutive chunks touch nearby memory.
+  std::vector<std::uint32_t> by_node(chunks_.size());
+  for (std::uint32_t c = 0; c < by_node.size(); ++c) by_node[c] = c;
+  std::stable_sort(by_node.begin(), by_node.end(), [&](std::uint32_t p, std::uint32_t q) { return chunks_[p].i0 < chunks_[q].i0; });
+  const auto chunks = chunks_;
+  const auto mask = mask_;
+  const auto k = k_, l = l_, g = g_;
+  const auto spring = spring_;
+  for (std::uint32_t c = 0; c < by_node.size(); ++c) {
+    const std::uint32_t from = by_node[c];
+    chunks_[c] = chunks[from];
+    mask_[c] = mask[from];
+    for (std::uint32_t q = 0; q < lanes; ++q) {
+      const std::size_t to = c * lanes + q, src = from * lanes + q;
+      k_[to] = k[src];
+      l_[to] = l[src];
+      g_[to] = g[src];
+      spring_[to] = spring[src];
+      if (spring[src] != invalid_index) lane_of_[spring[src]] = static_cast<std::uint32_t>(to);
+    }
+  }
+  rest_at_build_ = rest_.size();
+  built_ = true;
+}
+
+bool SpringRuns::needs_rebuild() const {
+  return !built_ || rest_.size() - rest_at_build_ > std::max<std::size_t>(64, live_ / 8);
+}
+
+void SpringRuns::on_added(Index s) {
+  if (!built_) return;
+  ensure_lane_index(s + 1);
+  lane_of_[s] = no_lane;
+  to_rest(s);
+  ++live_;
+}
+
+void SpringRuns::on_removed(Index s) {
+  if (!built_) return;
+  const std::uint32_t lane = lane_of_[s];
+  if (lane != no_lane) {
+    mask_[lane / lanes] &= static_cast<std::uint8_t>(~(1u << (lane % lanes)));
+    spring_[lane] = invalid_index;
+    lane_of_[s] = no_lane;
+    --chunked_;
+  }
+  --live_;
+}
+
+void SpringRuns::on_endpoints_changed(Index s) {
+  if (!built_) return;
+  const std::uint32_t lane = lane_of_[s];
+  if (lane != no_lane) {
+    mask_[lane / lanes] &= static_cast<std::uint8_t>(~(1u << (lane % lanes)));
+    spring_[lane] = invalid_index;
+    lane_of_[s] = no_lane;
+    --chunked_;
+  }
+  to_rest(s);
+}
+
+void SpringRuns::on_parameters_changed(Index s, double k, double l, double g) {
+  if (!built_) return;
+  const std::uint32_t lane = lane_of_[s];
+  if (lane == no_lane) return;  // the rest list reads the spring arrays
+  k_[lane] = k;
+  l_[lane] = l;
+  g_[lane] = g;
+}
+
+void SpringRuns::refresh_parameters(const SpringArrays& a) {
+  if (!built_) return;
+  for (std::size_t lane = 0; lane < spring_.size(); ++lane) {
+    const Index s = spring_[lane];
+    if (s == invalid_index) continue;
+    k_[lane] = a.k[s];
+    l_[lane] = a.l[s];
+    g_[lane] = a.g[s];
+  }
+}
+
+void SpringRuns::forces(const SpringArrays& a, RunDamping damping, double beta, std::span<const double> x,
+                        std::span<const double> v, std::span<double> f, bool accumulate, Index n) const {
+  // Room for an unmasked 8-lane access starting at the last node.
+  const std::size_t stride = (std::size_t{n} + 2 * lanes - 1) / lanes * lanes;
+  if (stride != stride_) {
+    soa_.assign(num_arrays * stride, 0.0);
+    stride_ = stride;
+  }
+  const Soa s = soa_view(soa_.data(), stride);
+  split_axes(x.data(), s.a[X], s.a[Y], s.a[Z], n);
+  if (damping != RunDamping::none) split_axes(v.data(), s.a[VX], s.a[VY], s.a[VZ], n);
+  const auto run = [&]<RunDamping D>() {
+#ifdef SEWN_RUNS_AVX512
+    const Arrays A{s.a[X], s.a[Y], s.a[Z], s.a[VX], s.a[VY], s.a[VZ], {s.a[FX], s.a[FY], s.a[FZ]}, {s.a[GX], s.a[GY], s.a[GZ]}};
+    chunk_loop<D>(A, chunks_.data(), mask_.data(), chunks_.size(), k_.data(), l_.data(), g_.data(), beta);
+#else
+    for (std::size_t c = 0; c < chunks_.size(); ++c)
+      for (int q = 0; q < lanes; ++q)
+        if ((mask_[c] >> q) & 1u)
+          one_spring<D>(s, chunks_[c].i0 + q, chunks_[c].j0 + q, k_[c * lanes + q], l_[c * lanes + q], g_[c * lanes + q], beta);
+#endif
+    for (const Index r : rest_)
+      if (a.alive[r] != 0) one_spring<D>(s, a.ni[r], a.nj[r], a.k[r], a.l[r], a.g[r], beta);
+  };
+  switch (damping) {
+    case RunDamping::none: run.template operator()<RunDamping::none>(); break;
+    case RunDamping::viscous: run.template operator()<RunDamping::viscous>(); break;
+    case RunDamping::stiffness_proportional: run.template operator()<RunDamping::stiffness_proportional>(); break;
+  }
+  join_axes(s, f.data(), n, accumulate);
+}
+
+}  // namespace sewn::physics::detail
