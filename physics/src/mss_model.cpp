@@ -107,11 +107,6 @@ CornerPaths corner_paths(const CellTemplate& t) {
   return out;
 }
 
-template <class V, class T>
-void erase_value(V& v, T x) {
-  v.erase(std::remove(v.begin(), v.end(), x), v.end());
-}
-
 int local_edge_index(ElementKind k, std::uint8_t a, std::uint8_t b, std::span<const Edge> edges) {
   for (std::size_t e = 0; e < edges.size(); ++e)
     if ((edges[e][0] == a && edges[e][1] == b) || (edges[e][0] == b && edges[e][1] == a)) return static_cast<int>(e);
@@ -273,10 +268,11 @@ void MssModel<D>::build_elements(const IndexedMesh& mesh, const BuildResult& bui
     rest_.push_back(x);
     point_of_node_.push_back(q);
   }
-  vertices_of_node_.assign(nodes.size(), {});
+  first_vertex_.assign(nodes.size(), Dart::null_index);
   map_.template create_attributes<0>(
       [&](Dart d) { return NodeRef{node_of_point_[built.vertex_of_dart[d.index()]]}; });
-  for (AttrId<0> a : map_.template attributes<0>()) vertices_of_node_[map_.value(a).node].push_back(a.index());
+  next_vertex_.assign(map_.template attribute_container<0>().capacity(), Dart::null_index);
+  for (AttrId<0> a : map_.template attributes<0>()) link_vertex(map_.value(a).node, a.index());
 
   // 2) elements on their cells: volumes by 3-attributes, 2D cells by 2-attributes
   live_elements_ = nc;
@@ -317,11 +313,15 @@ void MssModel<D>::build_elements(const IndexedMesh& mesh, const BuildResult& bui
   if (options_.damping == DampingModel::viscous) springs_->set_paper_viscosity(nodes.masses());
   // Cuts add particles and springs: headroom now spares a cut the reallocation of every array
   // (and its page faults), and the stamp vectors are sized once.
-  nodes.reserve(nodes.size() + nodes.size() / 4 + 16);
+  const Index node_room = nodes.size() + nodes.size() / 4 + 16;
+  nodes.reserve(node_room);
+  rest_.reserve(node_room);
+  point_of_node_.reserve(node_room);
+  first_vertex_.reserve(node_room);
+  next_vertex_.reserve(next_vertex_.size() + node_room - nodes.size());
   springs_->reserve(springs_->size() + springs_->size() / 4 + 16);
   for (auto* v : {&seen_node_, &seen_spring_}) v->assign(nodes.size() + springs_->size(), 0u);
   seen_element_.assign(elements_.size(), 0u);
-  seen_vertex_.assign(map_.template attribute_container<0>().capacity() + 16, 0u);
   seen_edge_.assign(map_.template attribute_container<1>().capacity() + 16, 0u);
 
   // 4) fields
@@ -391,14 +391,18 @@ Index MssModel<D>::end_node(Dart d) const {
 }
 
 template <int D>
-std::vector<std::uint32_t> MssModel<D>::edges_at(Dart v) const {
-  std::vector<std::uint32_t> out;
-  for (Dart x : map_.template cell<0>(v)) {
-    if (const AttrId<1> a = map_.template attribute<1>(x)) out.push_back(a.index());
-    if (const Dart p = map_.beta(x, 0))
-      if (const AttrId<1> a = map_.template attribute<1>(p)) out.push_back(a.index());
-  }
-  return out;
+void MssModel<D>::link_vertex(Index node, std::uint32_t vertex) {
+  if (vertex >= next_vertex_.size()) next_vertex_.resize(vertex + 1 + vertex / 4, Dart::null_index);
+  next_vertex_[vertex] = first_vertex_[node];
+  first_vertex_[node] = vertex;
+}
+
+template <int D>
+bool MssModel<D>::unlink_vertex(Index node, std::uint32_t vertex) {
+  std::uint32_t* link = &first_vertex_[node];
+  while (*link != Dart::null_index && *link != vertex) link = &next_vertex_[*link];
+  if (*link == vertex) *link = next_vertex_[vertex];
+  return first_vertex_[node] == Dart::null_index;
 }
 
 template <int D>
@@ -460,25 +464,22 @@ double MssModel<D>::edge_stiffness(Dart edge_dart) const {
 }
 
 template <int D>
-double MssModel<D>::vertex_mass(Dart v, std::vector<Index>* springs) {
+double MssModel<D>::walk_vertex(std::uint32_t v, std::vector<std::uint32_t>& edges, std::vector<Index>& elems) {
   constexpr std::uint32_t null = Dart::null_index;
-  const auto& edges = map_.template attribute_container<1>();
+  const auto& edge_refs = map_.template attribute_container<1>();
   double m = 0;
-  for (Dart y : map_.template cell<0>(v)) {
+  for (Dart y : map_.template cell<0>(map_.dart_of(AttrId<0>(v)))) {
     Index e = element_of(y);
     const std::uint32_t edge = map_.template attribute_index<1>(y.index());
-    if (e == invalid_index && edge != null) e = edges.value(edge).segment;
+    if (e == invalid_index && edge != null) e = edge_refs.value(edge).segment;
     if (e != invalid_index && elements_[e].alive) {
       const Element& el = elements_[e];
       m += materials_[el.material].density * el.measure / (corners(el.kind) * darts_per_corner(el.kind));
-      if (springs && first_visit(seen_element_, e, generation_))
-        for (Index s : el.diagonal)
-          if (s != invalid_index) springs->push_back(s);
+      if (first_visit(seen_element_, e, generation_)) elems.push_back(e);
     }
-    if (!springs) continue;
-    if (edge != null) springs->push_back(edges.value(edge).spring);
+    if (edge != null) edges.push_back(edge);
     if (const std::uint32_t p = map_.b(y.index(), 0); p != null)  // a surface's boundary edge may have only this dart
-      if (const std::uint32_t a = map_.template attribute_index<1>(p); a != null) springs->push_back(edges.value(a).spring);
+      if (const std::uint32_t a = map_.template attribute_index<1>(p); a != null) edges.push_back(a);
   }
   return m;
 }
@@ -555,16 +556,15 @@ void MssModel<D>::install_hooks() {
     const Index copy = system_.nodes().duplicate(n);
     rest_.push_back(rest_[n]);
     point_of_node_.push_back(point_of_node_[n]);
-    vertices_of_node_.emplace_back();
+    first_vertex_.push_back(Dart::null_index);
     map_.value(b).node = copy;
-    vertices_of_node_[copy].push_back(b.index());
+    link_vertex(copy, b.index());
     dirty_vertices_.insert(dirty_vertices_.end(), {a.index(), b.index()});
   });
   map_.template on_merge<0>([this](AttrId<0> kept, AttrId<0> gone) {
     // two vertices sewn into one: the gone particle's momentum joins the kept one
     const Index nk = map_.value(kept).node, ng = map_.value(gone).node;
-    erase_value(vertices_of_node_[ng], gone.index());
-    if (nk != ng && vertices_of_node_[ng].empty()) {
+    if (unlink_vertex(ng, gone.index()) && nk != ng) {
       NodeTable& nodes = system_.nodes();
       const double mk = nodes.mass(nk), mg = nodes.mass(ng);
       nodes.set_velocity(nk, (mk * nodes.velocity(nk) + mg * nodes.velocity(ng)) / (mk + mg));
@@ -574,8 +574,7 @@ void MssModel<D>::install_hooks() {
   });
   map_.template on_erase<0>([this](AttrId<0> gone) {
     const Index n = map_.value(gone).node;
-    erase_value(vertices_of_node_[n], gone.index());
-    if (vertices_of_node_[n].empty()) system_.nodes().remove(n);
+    if (unlink_vertex(n, gone.index())) system_.nodes().remove(n);
   });
   map_.template on_split<1>([this](AttrId<1> a, AttrId<1> b) {
     // a duplicated edge: a new spring (ends, stiffness and rest length follow in resync)
@@ -625,7 +624,7 @@ void MssModel<D>::resync() {
   }
   if (dirty_vertices_.empty() && dirty_edges_.empty()) return;
   if (++generation_ == 0) {  // wrapped: old stamps could collide
-    for (auto* v : {&seen_vertex_, &seen_edge_, &seen_element_, &seen_node_, &seen_spring_}) std::fill(v->begin(), v->end(), 0u);
+    for (auto* v : {&seen_edge_, &seen_element_, &seen_node_, &seen_spring_}) std::fill(v->begin(), v->end(), 0u);
     generation_ = 1;
   }
   const auto& vattr = map_.template attribute_container<0>();
@@ -633,22 +632,20 @@ void MssModel<D>::resync() {
   std::vector<std::uint32_t> vertices = std::move(dirty_vertices_), edges = std::move(dirty_edges_);
   dirty_vertices_.clear();
   dirty_edges_.clear();
-  std::vector<Index> elems, touched_nodes, touched_springs;
-  auto touch_node = [&](Index n) {
-    if (first_visit(seen_node_, n, generation_)) touched_nodes.push_back(n);
-  };
-  // 1) a touched vertex touches its edges (those whose darts end there too), elements and particle
-  std::vector<std::uint32_t> all_edges;
+  NodeTable& nodes = system_.nodes();
+  // 1) A particle's mass changes only with the vertex cells carrying it, so only the particles
+  //    of touched vertices are weighed again; one walk of each of their vertex cells also lists
+  //    the edges (those whose darts end there too) and the elements around, whose springs and
+  //    diagonals may have changed. The particles at the far end of those edges keep their mass.
+  std::vector<Index> elems, touched_springs;
+  std::vector<std::pair<Index, double>> masses;
   for (std::uint32_t v : vertices) {
-    if (!vattr.is_alive(v) || !first_visit(seen_vertex_, v, generation_)) continue;
-    touch_node(map_.value(AttrId<0>(v)).node);
-    for (Dart y : map_.template cell<0>(map_.dart_of(AttrId<0>(v)))) {
-      for (std::uint32_t x : {y.index(), map_.b(y.index(), 0)})
-        if (x != Dart::null_index)
-          if (const std::uint32_t a = map_.template attribute_index<1>(x); a != Dart::null_index) edges.push_back(a);
-      const Index e = element_of(y);
-      if (e != invalid_index && first_visit(seen_element_, e, generation_)) elems.push_back(e);
-    }
+    if (!vattr.is_alive(v)) continue;
+    const Index n = map_.value(AttrId<0>(v)).node;
+    if (!first_visit(seen_node_, n, generation_) || !nodes.is_alive(n)) continue;
+    double m = 0;
+    for (std::uint32_t u = first_vertex_[n]; u != Dart::null_index; u = next_vertex_[u]) m += walk_vertex(u, edges, elems);
+    masses.emplace_back(n, m);
   }
   // 2) edge springs: end particles, stiffness from the elements still around, rest length
   for (std::uint32_t e : edges) {
@@ -658,26 +655,23 @@ void MssModel<D>::resync() {
     if (springs_->node_i(s) != i || springs_->node_j(s) != j) springs_->set_endpoints(s, i, j);
     springs_->set_stiffness(s, edge_stiffness(d));
     springs_->set_rest_length(s, (rest_[j] - rest_[i]).norm());
-    touch_node(i);
-    touch_node(j);
+    touched_springs.push_back(s);
   }
   // 3) diagonals follow the particles their element's corners now carry
-  for (Index e : elems) attach_diagonals(e);
-  // 4) masses from the elements around each touched particle (all its vertex cells), collecting
-  //    on the way the springs whose per-spring viscosity depends on that mass
-  ++generation_;  // elements are listed again below, for their diagonals
-  const bool viscous = options_.damping == DampingModel::viscous;
-  NodeTable& nodes = system_.nodes();
-  for (Index n : touched_nodes) {
-    if (!nodes.is_alive(n)) continue;
-    double m = 0;
-    for (std::uint32_t v : vertices_of_node_[n]) m += vertex_mass(map_.dart_of(AttrId<0>(v)), viscous ? &touched_springs : nullptr);
+  for (Index e : elems) {
+    attach_diagonals(e);
+    for (Index s : elements_[e].diagonal)
+      if (s != invalid_index) touched_springs.push_back(s);
+  }
+  // 4) masses
+  for (const auto& [n, m] : masses) {
     if (!(m > 0))
       throw InputError(options_.source + ": particle " + std::to_string(n) + " is left with no element after the edit");
     nodes.set_mass(n, m);
   }
-  // 5) per-spring viscosity, now that both masses are known
-  if (viscous)
+  // 5) per-spring viscosity, now that both masses are known: the springs whose stiffness or
+  //    ends were set above, which include every spring at a particle weighed again
+  if (options_.damping == DampingModel::viscous)
     for (Index s : touched_springs)
       if (first_visit(seen_spring_, s, generation_) && springs_->is_alive(s))
         springs_->set_viscosity(s, paper_viscosity(springs_->stiffness(s), nodes.mass(springs_->node_i(s)),
@@ -698,16 +692,14 @@ void MssModel<D>::compact() {
   std::size_t kept = 0;
   for (std::size_t old = 0; old < node_map.size(); ++old) {
     if (node_map[old] == invalid_index) continue;
-    if (kept != old) {  // a vector moved onto itself would be emptied
-      rest_[kept] = rest_[old];
-      point_of_node_[kept] = point_of_node_[old];
-      vertices_of_node_[kept] = std::move(vertices_of_node_[old]);
-    }
+    rest_[kept] = rest_[old];
+    point_of_node_[kept] = point_of_node_[old];
+    first_vertex_[kept] = first_vertex_[old];
     ++kept;
   }
   rest_.resize(kept);
   point_of_node_.resize(kept);
-  vertices_of_node_.resize(kept);
+  first_vertex_.resize(kept);
 }
 
 template class MssModel<2>;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <random>
 #include <set>
 
@@ -33,6 +34,49 @@ Vector3d momentum(const NodeTable& n) {
   for (Index i = 0; i < n.size(); ++i)
     if (n.is_alive(i)) p += n.mass(i) * n.velocity(i);
   return p;
+}
+
+bool close(double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(std::abs(a), std::abs(b)); }
+
+// Each particle's mass, the stiffness between each pair of particles and each spring's
+// viscosity, recomputed from the live elements alone, as if the cut mesh had been built from
+// scratch: the model's incremental update after a cut must agree with them. Springs between the
+// same particles (an edge split along a slit whose ends stay shared) add up.
+template <int D>
+void check_physics(const MssModel<D>& m) {
+  const NodeTable& nodes = m.nodes();
+  const Springs& s = m.springs();
+  std::vector<double> mass(nodes.size(), 0.0);
+  std::map<std::pair<Index, Index>, double> edge_k;
+  auto pair = [](Index i, Index j) { return std::make_pair(std::min(i, j), std::max(i, j)); };
+  for (Index e = 0; e < m.elements().size(); ++e) {
+    const Element& el = m.elements()[e];
+    if (!el.alive) continue;
+    const auto corner = m.element_nodes(e);
+    for (Index n : corner) mass[n] += m.materials()[el.material].density * el.measure / static_cast<double>(corner.size());
+    const auto edges = MssModel<D>::local_edges(el.kind);
+    for (std::size_t k = 0; k < edges.size(); ++k) edge_k[pair(corner[edges[k][0]], corner[edges[k][1]])] += el.edge_k[k];
+  }
+  for (Index i = 0; i < nodes.size(); ++i)
+    if (nodes.is_alive(i)) {
+      CAPTURE(i);
+      REQUIRE(close(nodes.mass(i), mass[i]));
+    }
+  std::map<std::pair<Index, Index>, double> spring_k;
+  for (Index sp = 0; sp < s.size(); ++sp) {
+    if (!s.is_alive(sp)) continue;
+    CAPTURE(sp);
+    if (s.kind(sp) == SpringKind::edge) spring_k[pair(s.node_i(sp), s.node_j(sp))] += s.stiffness(sp);
+    if (m.options().damping == DampingModel::viscous)
+      REQUIRE(close(s.viscosity(sp), paper_viscosity(s.stiffness(sp), nodes.mass(s.node_i(sp)), nodes.mass(s.node_j(sp)))));
+  }
+  REQUIRE(spring_k.size() == edge_k.size());
+  for (const auto& [ij, k] : spring_k) {
+    CAPTURE(ij.first);
+    CAPTURE(ij.second);
+    REQUIRE(edge_k.count(ij) == 1);
+    REQUIRE(close(k, edge_k.at(ij)));
+  }
 }
 
 // Every spring hangs on the particles its cells carry now, every particle has an element, and
@@ -71,6 +115,7 @@ void check_consistent(const MssModel<D>& m) {
     if (m.nodes().is_alive(i)) REQUIRE(referenced[i]);
   const double total = m.element_mass();
   REQUIRE(std::abs(m.node_mass() - total) <= sum_rounding(8.0 * static_cast<double>(m.elements().size()), total));
+  check_physics(m);
 }
 
 // Live particles of the elements whose rest centroid satisfies pred.

@@ -192,18 +192,15 @@ class MssModel {
   [[nodiscard]] double edge_stiffness(Dart edge_dart) const;
   template <class F>
   void for_each_edge_dart(std::uint32_t d, F&& f) const;
-  // Mass of a vertex cell, and (if springs is non-null) the springs at it: its edges' and the
-  // diagonals of its elements. One pass over the cell's darts.
-  [[nodiscard]] double vertex_mass(Dart vertex_dart, std::vector<Index>* springs = nullptr);
+  // Mass of the vertex cell of 0-attribute v, in one pass over its darts that also appends its
+  // edges (those whose darts end there too) to `edges`, with duplicates, and its live elements
+  // not yet seen this resync to `elems`.
+  [[nodiscard]] double walk_vertex(std::uint32_t v, std::vector<std::uint32_t>& edges, std::vector<Index>& elems);
   void attach_diagonals(Index e);
   [[nodiscard]] Index end_node(Dart d) const;
-  // The edge attributes around the vertex of v, duplicates possible. A boundary edge of a
-  // surface has a single dart, which may end at v: hence the β0 predecessors too.
-  [[nodiscard]] std::vector<std::uint32_t> edges_at(Dart v) const;
-  template <int I>
-  [[nodiscard]] bool attr_alive(std::uint32_t a) const {
-    return map_.template attribute_container<I>().is_alive(a);
-  }
+  void link_vertex(Index node, std::uint32_t vertex);
+  // Unlinks `vertex` from node's list; true if the list is now empty.
+  bool unlink_vertex(Index node, std::uint32_t vertex);
 
   Map map_;
   System system_;
@@ -212,7 +209,11 @@ class MssModel {
   MssOptions options_;
   std::vector<Element> elements_;
   std::vector<Eigen::Vector3d> rest_;            // rest position per node
-  std::vector<std::vector<std::uint32_t>> vertices_of_node_;  // 0-attributes naming each node
+  // The 0-attributes naming each node, as singly linked lists threaded through the attribute
+  // indices: a node almost always has one, and a cut adds nodes one by one, so a vector per node
+  // would cost an allocation per particle and a move of all of them whenever the outer array grows.
+  std::vector<std::uint32_t> first_vertex_;  // per node: one of its 0-attributes, or null
+  std::vector<std::uint32_t> next_vertex_;   // per 0-attribute: the next naming the same node, or null
   std::vector<Index> node_of_point_;
   std::vector<std::uint32_t> point_of_node_;
   // Per dart: its local start vertex in its element, and its local edge index with bit 7 set on
@@ -223,8 +224,7 @@ class MssModel {
   std::vector<std::uint32_t> dirty_vertices_, dirty_edges_;
   // generation stamps: an index is listed once per resync without sorting
   std::uint32_t generation_ = 0;
-  std::vector<std::uint32_t> seen_vertex_, seen_edge_, seen_element_, seen_node_, seen_spring_;
-  std::vector<Index> dirty_elements_;
+  std::vector<std::uint32_t> seen_edge_, seen_element_, seen_node_, seen_spring_;
   std::string unsupported_;  // an edit the model cannot follow (element merge), reported by resync
 };
 
