@@ -1,7 +1,7 @@
 #pragma once
 // PodArray<T>: the growable arrays behind the map's per-dart data (β links, attribute indices,
 // mark planes, attribute bookkeeping). Like std::vector, except in how it grows. A large block
-// (from 1 MiB) is mapped by the array itself on Linux: it grows by moving its pages (mremap),
+// (from 256 KiB) is mapped by the array itself on Linux: it grows by moving its pages (mremap),
 // never by copying them into fresh ones, and asks for transparent huge pages, so that a map of
 // millions of darts takes one page fault per 2 MiB instead of one per 4 KiB (a fault costs 1-2 µs
 // on a virtual machine). glibc's realloc would remap too, but only until the first large free:
@@ -173,7 +173,7 @@ class PodArray {
   }
 
 #if defined(__linux__)
-  static constexpr std::size_t map_from = std::size_t{1} << 20;  // bytes
+  static constexpr std::size_t map_from = std::size_t{256} << 10;  // bytes
   static bool mapped(std::size_t cap) { return cap * sizeof(T) >= map_from; }
   static std::size_t mapped_bytes(std::size_t cap) {
     constexpr std::size_t page = 4096;
