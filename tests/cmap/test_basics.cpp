@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <set>
+#include <vector>
 
 #include "check.hpp"
+#include "sewn/cmap/build.hpp"
 #include "sewn/cmap/cmap.hpp"
 
 using namespace sewn;
@@ -255,4 +257,32 @@ TEST_CASE("a map without attributes stores only beta links") {
   CHECK(bare.memory_bytes() < full.memory_bytes());
   CHECK(bare.memory_bytes() >= 2400 * 16);
   CHECK(bare.memory_bytes() < 2400 * 16 * 2 + 4096);  // vector slack at most 2x, marks a few words
+}
+
+TEST_CASE("the darts of an edge of a 3-map come in chain order, closed or open") {
+  // From d: β2, β3, β2, ... until back at d or at a free dart, then β3, β2, ... from d.
+  auto chain = [](const CMap<3>& m, Dart d) {
+    std::vector<Dart> out{d};
+    for (int first = 2; first <= 3; ++first) {
+      Dart y = d;
+      for (int j = first;; j = 5 - j) {
+        y = m.beta(y, j);
+        if (y.is_null()) break;
+        if (y == d) return out;
+        out.push_back(y);
+      }
+    }
+    return out;
+  };
+  CMap<3> m;
+  build(m, hex_grid(3, 2, 2));  // interior, boundary and corner edges
+  std::size_t closed = 0, open = 0;
+  for (Dart d : m.darts()) {
+    const DartList got = m.cell<1>(d);
+    const std::vector<Dart> want = chain(m, d);
+    CHECK(std::vector<Dart>(got.begin(), got.end()) == want);
+    (m.beta<3>(want.back()).is_null() || m.beta<2>(want.back()).is_null() ? open : closed) += 1;
+  }
+  CHECK(closed > 0);
+  CHECK(open > 0);
 }

@@ -59,6 +59,20 @@ TEST_CASE("validate: a fixed point of beta2 is not an involution") {
   CHECK(report.str().find("fixed point") != std::string::npos);
 }
 
+TEST_CASE("validate: beta2 not an involution, each broken dart named once") {
+  CMap<2> m;
+  const Dart a = m.create_dart(), q = m.create_dart(), r = m.create_dart();
+  m.link_beta<2>(a, q);
+  m.link_beta<2>(r, q);  // beta2(a) = q but beta2(q) = r
+  const auto report = m.validate();
+  std::vector<std::uint32_t> darts;
+  for (const auto& i : report.issues()) {
+    CHECK(i.kind == Kind::not_involution);
+    darts.push_back(i.dart);
+  }
+  CHECK(darts == std::vector<std::uint32_t>{a.index()});
+}
+
 TEST_CASE("validate: beta1 o beta3 and beta2 o beta4 must be involutions") {
   {
     CMap<3> m;

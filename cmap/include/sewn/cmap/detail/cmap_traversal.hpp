@@ -189,7 +189,51 @@ void CMap<D, A...>::collect_unmarked(std::uint32_t root, Out& out) const {
 template <int D, class... A>
 template <int I, class Out>
 void CMap<D, A...>::collect_cell_unmarked(std::uint32_t root, Out& out) const {
-  if constexpr (chain_cell<I>) {  // a chain needs no mark to be walked once
+  if constexpr (D == 3 && I == 1) {
+    // The darts of an edge lie in different volumes, far apart in memory, and each step of the
+    // walk waits for the previous one's load. Walking the β2-first and the β3-first directions
+    // together until they meet halves that wait around an interior edge; the darts come out in
+    // walk_chain_cell's order (the β3-first ones reversed, unless the edge is open).
+    constexpr std::uint32_t null = detail::null_index;
+    using V = typename Out::value_type;
+    out.push_back(V(root));
+    detail::DartBuffer<16> back;
+    std::uint32_t a = root, bk = root;
+    int ja = 2, jb = 3;
+    bool a_on = true, b_on = true, met = false;
+    for (std::uint32_t budget = dart_capacity(); (a_on || b_on) && budget != 0; --budget) {
+      if (a_on) {
+        const std::uint32_t y = b(a, ja);
+        if (y == null || y == root) {
+          a_on = false;
+        } else if (!back.empty() && y == back.back()) {
+          met = true;
+          break;
+        } else {
+          out.push_back(V(y));
+          a = y;
+          ja = 5 - ja;
+        }
+      }
+      if (b_on) {
+        const std::uint32_t y = b(bk, jb);
+        if (y == null || y == root) {
+          b_on = false;
+        } else if (y == detail::raw(out.back()) && out.size() > 1) {
+          met = true;
+          break;
+        } else {
+          back.push_back(y);
+          bk = y;
+          jb = 5 - jb;
+        }
+      }
+    }
+    if (met)  // a cycle: the β3-first darts, last first, continue the β2-first ones
+      for (std::size_t i = back.size(); i-- > 0;) out.push_back(V(back[i]));
+    else
+      for (std::uint32_t y : back) out.push_back(V(y));
+  } else if constexpr (chain_cell<I>) {  // a chain needs no mark to be walked once
     out.push_back(typename Out::value_type(root));
     walk_chain_cell<I>(root, [&](std::uint32_t y) {
       out.push_back(typename Out::value_type(y));

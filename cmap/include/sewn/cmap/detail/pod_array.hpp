@@ -1,18 +1,21 @@
 #pragma once
 // PodArray<T>: the growable arrays behind the map's per-dart data (β links, attribute indices,
 // mark planes, attribute bookkeeping). Like std::vector, except in how it grows. A large block
-// (from 1 MiB) is mapped by the array itself on Linux: it grows by moving its pages (mremap),
+// (from 256 KiB) is mapped by the array itself on Linux: it grows by moving its pages (mremap),
 // never by copying them into fresh ones, and asks for transparent huge pages, so that a map of
 // millions of darts takes one page fault per 2 MiB instead of one per 4 KiB (a fault costs 1-2 µs
 // on a virtual machine). glibc's realloc would remap too, but only until the first large free:
 // its mmap threshold then rises and large blocks come from the heap, copied on every growth.
-// Small blocks use malloc/realloc. T must be trivially copyable; elements past size() are not
-// kept initialised.
+// Small blocks use malloc/realloc. A freed mapped block is kept, its pages still populated, for
+// the next array that needs one of about its size (see MappedBlocks): a map copied or rebuilt
+// again and again then faults no pages in, as the heap spares the small blocks. T must be
+// trivially copyable; elements past size() are not kept initialised.
 
 #include <algorithm>
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 #include <new>
 #include <type_traits>
 #include <utility>
@@ -22,6 +25,63 @@
 #endif
 
 namespace sewn::detail {
+
+#if defined(__linux__)
+// Mapped blocks released by PodArrays, kept for reuse up to a budget, the oldest given back to
+// the system first (the heap keeps freed memory the same way, up to its trim threshold). A block
+// is handed out only for a request of at least half its size, so that an array never holds more
+// than one doubling past its need.
+class MappedBlocks {
+ public:
+  static constexpr std::size_t budget = std::size_t{64} << 20;  // bytes kept at most
+  static MappedBlocks& instance() {
+    static MappedBlocks blocks;
+    return blocks;
+  }
+  // The smallest kept block of `bytes` to 2 * `bytes`, no longer kept; {nullptr, 0} if none.
+  std::pair<void*, std::size_t> take(std::size_t bytes) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    std::size_t best = count_;
+    for (std::size_t i = 0; i < count_; ++i)
+      if (blocks_[i].bytes >= bytes && blocks_[i].bytes / 2 <= bytes &&
+          (best == count_ || blocks_[i].bytes < blocks_[best].bytes))
+        best = i;
+    if (best == count_) return {nullptr, 0};
+    const Block b = blocks_[best];
+    remove(best);
+    return {b.p, b.bytes};
+  }
+  // Keeps a block that is no longer used, unmapping the oldest ones it does not fit beside.
+  void give(void* p, std::size_t bytes) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (bytes > budget) {
+      munmap(p, bytes);
+      return;
+    }
+    while (count_ == max_blocks || kept_ + bytes > budget) {
+      munmap(blocks_[0].p, blocks_[0].bytes);
+      remove(0);
+    }
+    blocks_[count_++] = {p, bytes};
+    kept_ += bytes;
+  }
+
+ private:
+  struct Block {
+    void* p;
+    std::size_t bytes;
+  };
+  void remove(std::size_t i) {
+    kept_ -= blocks_[i].bytes;
+    std::copy(blocks_ + i + 1, blocks_ + count_, blocks_ + i);
+    --count_;
+  }
+  static constexpr std::size_t max_blocks = 16;
+  std::mutex mutex_;
+  Block blocks_[max_blocks]{};
+  std::size_t count_ = 0, kept_ = 0;
+};
+#endif
 
 template <class T>
 class PodArray {
@@ -104,7 +164,7 @@ class PodArray {
     } else if (was_mapped && now_mapped) {
       p = remap(data_, cap_, cap);
     } else {  // crossing the threshold: a fresh block of the other kind
-      p = allocate(cap);
+      p = allocate(cap);  // may raise cap to a reused block's
       if (size_ != 0) std::memcpy(p, data_, size_ * sizeof(T));
       release(data_, cap_);
     }
@@ -113,18 +173,22 @@ class PodArray {
   }
 
 #if defined(__linux__)
-  static constexpr std::size_t map_from = std::size_t{1} << 20;  // bytes
+  static constexpr std::size_t map_from = std::size_t{256} << 10;  // bytes
   static bool mapped(std::size_t cap) { return cap * sizeof(T) >= map_from; }
   static std::size_t mapped_bytes(std::size_t cap) {
     constexpr std::size_t page = 4096;
     return (cap * sizeof(T) + page - 1) / page * page;
   }
   static void ask_huge_pages(void* p, std::size_t bytes) { (void)madvise(p, bytes, MADV_HUGEPAGE); }  // a hint: failure is harmless
-  static T* allocate(std::size_t cap) {
+  static T* allocate(std::size_t& cap) {
     if (!mapped(cap)) {
       T* p = static_cast<T*>(std::malloc(cap * sizeof(T)));
       if (!p) throw std::bad_alloc();
       return p;
+    }
+    if (auto [q, bytes] = MappedBlocks::instance().take(mapped_bytes(cap)); q) {
+      cap = bytes / sizeof(T);  // the whole block: what capacity() reports is what is held
+      return static_cast<T*>(q);
     }
     void* p = mmap(nullptr, mapped_bytes(cap), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (p == MAP_FAILED) throw std::bad_alloc();
@@ -140,13 +204,13 @@ class PodArray {
   static void release(T* p, std::size_t cap) {
     if (!p) return;
     if (mapped(cap))
-      munmap(p, mapped_bytes(cap));
+      MappedBlocks::instance().give(p, mapped_bytes(cap));
     else
       std::free(p);
   }
 #else
   static bool mapped(std::size_t) { return false; }
-  static T* allocate(std::size_t cap) {
+  static T* allocate(std::size_t& cap) {
     T* p = static_cast<T*>(std::malloc(cap * sizeof(T)));
     if (!p) throw std::bad_alloc();
     return p;
