@@ -192,7 +192,7 @@ std::uint32_t CMap<D, A...>::unsew_all(std::span<const Dart> darts) {
     all.insert(all.end(), pairs.begin(), pairs.end());
     ++done;
   }
-  update_attributes_around<I>(all);
+  if (done != 0) update_attributes_around<I>(all);
   return done;
 }
 
