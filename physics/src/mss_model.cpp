@@ -322,7 +322,8 @@ void MssModel<D>::build_elements(const IndexedMesh& mesh, const BuildResult& bui
   springs_->reserve(springs_->size() + springs_->size() / 4 + 16);
   for (auto* v : {&seen_node_, &seen_spring_}) v->assign(nodes.size() + springs_->size(), 0u);
   seen_element_.assign(elements_.size(), 0u);
-  seen_edge_.assign(map_.template attribute_container<1>().capacity() + 16, 0u);
+  const std::uint32_t edge_attributes = map_.template attribute_container<1>().capacity();
+  seen_edge_.assign(edge_attributes + edge_attributes / 4 + 16, 0u);
 
   // 4) fields
   if (options_.gravity.squaredNorm() > 0) system_.template add<Gravity>(options_.gravity);
@@ -392,7 +393,7 @@ Index MssModel<D>::end_node(Dart d) const {
 
 template <int D>
 void MssModel<D>::link_vertex(Index node, std::uint32_t vertex) {
-  if (vertex >= next_vertex_.size()) next_vertex_.resize(vertex + 1 + vertex / 4, Dart::null_index);
+  if (vertex >= next_vertex_.size()) next_vertex_.resize(vertex + 1, Dart::null_index);
   next_vertex_[vertex] = first_vertex_[node];
   first_vertex_[node] = vertex;
 }

@@ -466,7 +466,14 @@ void Springs::forces_by_rows(const StateView& st, std::span<double> f, bool accu
   const std::size_t n4 = 4 * std::size_t{n};
   // acc_ is all zeros between calls (the scatter below clears what it reads).
   if (acc_.size() != n4) {
-    acc_.assign(n4, 0.0);
+    // Out of room (first call, or a cut added nodes): fresh rows with headroom, so that the
+    // next cuts resize in place; nothing is copied over, to_rows rewrites every row.
+    if (acc_.capacity() < n4)
+      for (auto* rows : {&acc_, &x_rows_, &v_rows_}) {
+        rows->clear();
+        rows->reserve(n4 + n4 / 4);
+      }
+    acc_.resize(n4, 0.0);
     x_rows_.resize(n4);
     v_rows_.resize(n4);
   }

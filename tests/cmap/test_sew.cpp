@@ -2,6 +2,9 @@
 // 2013 paper's Fig. 5 example.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <map>
+#include <random>
 #include <set>
 #include <string>
 #include <vector>
@@ -238,4 +241,65 @@ TEST_CASE("Fig. 5 of the 2013 paper: 3-unsewing the face between the two upper h
     ++merges;
   }
   CHECK(merges == 2 + 3 + 1);
+}
+
+TEST_CASE("unsew_all leaves the cells, links and attribute values of the unsews one by one") {
+  // A third of the inner faces of a 6x5x5 block, at random: many vertices and edges are shared
+  // by several of them, and the update processes more cells than the claims' list holds. One
+  // face is listed twice and one from both sides.
+  const IndexedMesh mesh = hex_grid(6, 5, 5);
+  Map3 one, all;
+  for (Map3* m : {&one, &all}) {
+    (void)build(*m, mesh);
+    label_all_cells(*m);
+  }
+  std::vector<Dart> faces;
+  for (Dart d : one.cells<2>())
+    if (one.beta(d, 3)) faces.push_back(d);
+  std::mt19937 rng(4);
+  std::shuffle(faces.begin(), faces.end(), rng);
+  faces.resize(faces.size() / 3);
+  faces.push_back(faces.front());
+  faces.push_back(one.beta(faces[1], 3));
+  std::array<int, 4> splits_one{}, splits_all{};
+  auto count_splits = [](Map3& m, std::array<int, 4>& n) {
+    m.on_split<0>([&n](AttrId<0>, AttrId<0>) { ++n[0]; });
+    m.on_split<1>([&n](AttrId<1>, AttrId<1>) { ++n[1]; });
+    m.on_split<2>([&n](AttrId<2>, AttrId<2>) { ++n[2]; });
+    m.on_split<3>([&n](AttrId<3>, AttrId<3>) { ++n[3]; });
+  };
+  count_splits(one, splits_one);
+  count_splits(all, splits_all);
+  std::uint32_t unsewn = 0;
+  for (Dart d : faces)
+    if (one.beta(d, 3)) {
+      one.unsew<3>(d);
+      ++unsewn;
+    }
+  CHECK(all.unsew_all<3>(faces) == unsewn);
+  CHECK(unsewn == faces.size() - 2);
+  CHECK(check_map(all) == check_map(one));
+  CHECK(splits_all == splits_one);
+  CHECK(splits_one[0] > 0);
+  // same links, the same values on every dart, and darts that share an attribute in one map
+  // share it in the other
+  auto same_partition = [&](auto k) {
+    constexpr int I = decltype(k)::value;
+    std::map<std::uint32_t, std::uint32_t> to_all;
+    for (Dart d : one.darts()) {
+      const std::uint32_t a = one.attribute<I>(d).index(), b = all.attribute<I>(d).index();
+      CHECK(one.value(AttrId<I>(a)) == all.value(AttrId<I>(b)));
+      const auto [it, fresh] = to_all.emplace(a, b);
+      CHECK(it->second == b);
+    }
+    std::set<std::uint32_t> images;
+    for (const auto& [a, b] : to_all) images.insert(b);
+    CHECK(images.size() == to_all.size());
+  };
+  for (Dart d : one.darts())
+    for (int j = 0; j <= 3; ++j) REQUIRE(one.beta(d, j) == all.beta(d, j));
+  same_partition(std::integral_constant<int, 0>{});
+  same_partition(std::integral_constant<int, 1>{});
+  same_partition(std::integral_constant<int, 2>{});
+  same_partition(std::integral_constant<int, 3>{});
 }

@@ -319,6 +319,14 @@ class CMap {
   /// part holding d keeps the original). Throws TopologyError if d is I-free. O(orbit + cells).
   template <int I>
   void unsew(Dart d);
+  /// unsew<I> of every dart of `darts` still I-sewn when its turn comes (dead and I-free darts
+  /// are skipped: a facet listed twice, or from both sides), then one attribute update for all:
+  /// a cell that several of the orbits touch is walked once instead of once per orbit. Leaves
+  /// the same cells and attribute values as the unsews one by one; which piece of a split cell
+  /// keeps the original attribute may differ. Returns how many orbits were unsewn.
+  /// O(Σ orbits + cells touched).
+  template <int I>
+  std::uint32_t unsew_all(std::span<const Dart> darts);
   /// As sew<I> but leaves attributes untouched (the caller fixes them; validate() will tell).
   template <int I>
   void link(Dart a, Dart b);
@@ -555,8 +563,21 @@ class CMap {
   void update_attributes(std::span<const std::uint32_t> touched, unsigned dims);
   template <int I>
   void update_attributes_of(std::span<const std::uint32_t> touched);
-  template <int I, class Claimed>
-  void process_new_cell(std::span<const std::uint32_t> cell, Claimed& claimed);
+  // The survivors of the cells an attribute update has processed so far, each known by the
+  // dart it now names (its cell's first dart). An update of one sew or unsew has a handful,
+  // searched in a list; past the list's size a mark takes over (unsew_all of a whole plane has
+  // thousands, and a search per cell would be quadratic), so small updates reserve no mark and
+  // never allocate its plane.
+  struct Claims {
+    static constexpr std::size_t list_max = 64;
+    detail::DartBuffer<list_max> darts;
+    Mark mark;  // reserved once darts outgrows list_max
+  };
+  [[nodiscard]] bool in_claims(const Claims& c, std::uint32_t x) const;
+  void add_claim(Claims& c, std::uint32_t x);
+  void release_claims(Claims& c);
+  template <int I>
+  void process_new_cell(std::span<const std::uint32_t> cell, Claims& claims);
   template <int I>
   std::uint32_t copy_attribute(std::uint32_t a);
   template <int I>

@@ -121,18 +121,43 @@ void CMap<D, A...>::update_attributes_of(std::span<const std::uint32_t> touched)
   // count kept exact) and all are unmarked at the end.
   const Mark seen = marks_.reserve();
   detail::DartBuffer<256> visited;
-  boost::container::small_vector<std::uint32_t, 8> claimed;
+  Claims claims;
   for (std::uint32_t c : candidates) {
     if (marks_.test(c, seen)) continue;
     const std::size_t first = visited.size();
     collect_cell<I>(c, seen, visited);
-    process_new_cell<I>(std::span<const std::uint32_t>(visited.begin() + first, visited.end()), claimed);
+    process_new_cell<I>(std::span<const std::uint32_t>(visited.begin() + first, visited.end()), claims);
   }
   const MarkView mk = marks_.view(seen);
   std::int64_t cleared = 0;
   for (std::uint32_t x : visited) cleared += mk.clear(x) ? 1 : 0;
   marks_.add_count(seen, -cleared);
   marks_.release(seen);
+  release_claims(claims);
+}
+
+template <int D, class... A>
+bool CMap<D, A...>::in_claims(const Claims& c, std::uint32_t x) const {
+  if (c.mark.valid()) return marks_.test(x, c.mark);
+  return std::find(c.darts.begin(), c.darts.end(), x) != c.darts.end();
+}
+
+template <int D, class... A>
+void CMap<D, A...>::add_claim(Claims& c, std::uint32_t x) {
+  c.darts.push_back(x);
+  if (!c.mark.valid() && c.darts.size() > Claims::list_max) {
+    c.mark = marks_.reserve();
+    for (std::uint32_t y : c.darts) marks_.set(y, c.mark);
+  } else if (c.mark.valid()) {
+    marks_.set(x, c.mark);
+  }
+}
+
+template <int D, class... A>
+void CMap<D, A...>::release_claims(Claims& c) {
+  if (!c.mark.valid()) return;
+  for (std::uint32_t x : c.darts) marks_.clear(x, c.mark);
+  marks_.release(c.mark);
 }
 
 template <int D, class... A>
@@ -158,8 +183,8 @@ void CMap<D, A...>::relabel(std::span<const std::uint32_t> cell_darts, std::uint
 }
 
 template <int D, class... A>
-template <int I, class Claimed>
-void CMap<D, A...>::process_new_cell(std::span<const std::uint32_t> cell_darts, Claimed& claimed) {
+template <int I>
+void CMap<D, A...>::process_new_cell(std::span<const std::uint32_t> cell_darts, Claims& claims) {
   auto& st = store<I>();
   // Distinct attributes of the cell in BFS order, with how many of its darts carry each.
   boost::container::small_vector<std::pair<std::uint32_t, std::uint32_t>, 4> attrs;
@@ -174,7 +199,13 @@ void CMap<D, A...>::process_new_cell(std::span<const std::uint32_t> cell_darts, 
   }
   if (attrs.empty()) return;
   const bool hooks = hooks_on_;
-  auto is_claimed = [&](std::uint32_t a) { return std::find(claimed.begin(), claimed.end(), a) != claimed.end(); };
+  // An attribute is claimed once it is the survivor of a cell processed earlier in this update:
+  // it then names that cell's first dart, which is among the claims. (An attribute split off or
+  // merged never names a claimed dart: split_off re-points or clears it.)
+  auto is_claimed = [&](std::uint32_t a) {
+    const std::uint32_t x = st.values.dart(a);
+    return x != detail::null_index && st.of_dart[x] == a && in_claims(claims, x);
+  };
   // A piece of a cell whose identity went elsewhere (claimed by an earlier new cell, or, for
   // all but the survivor, still holding darts outside this cell) is split off into a copy.
   auto split_off = [&](std::uint32_t a) {
@@ -202,7 +233,7 @@ void CMap<D, A...>::process_new_cell(std::span<const std::uint32_t> cell_darts, 
   }
   relabel<I>(cell_darts, detail::null_index, survivor);
   st.values.set_dart(survivor, cell_darts.front());
-  claimed.push_back(survivor);
+  add_claim(claims, cell_darts.front());
 }
 
 }  // namespace sewn

@@ -180,4 +180,20 @@ void CMap<D, A...>::unsew(Dart d) {
   update_attributes_around<I>(pairs);
 }
 
+template <int D, class... A>
+template <int I>
+std::uint32_t CMap<D, A...>::unsew_all(std::span<const Dart> darts) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> all;
+  DartPairs pairs;
+  std::uint32_t done = 0;
+  for (Dart d : darts) {
+    if (!is_alive(d) || b(d.index(), I) == detail::null_index) continue;
+    unlink_orbits<I>(d, "unsew_all", pairs);
+    all.insert(all.end(), pairs.begin(), pairs.end());
+    ++done;
+  }
+  if (done != 0) update_attributes_around<I>(all);
+  return done;
+}
+
 }  // namespace sewn
