@@ -244,6 +244,9 @@ void SpringRuns::rebuild(const SpringArrays& a) {
   g_.clear();
   spring_.clear();
   rest_.clear();
+  // Headroom for the springs a cut adds, so that they do not copy these arrays.
+  lane_of_.reserve(a.count + a.count / 4);
+  in_rest_.reserve(a.count + a.count / 4);
   lane_of_.assign(a.count, no_lane);
   in_rest_.assign(a.count, 0);
   std::vector<Index> order;
@@ -366,12 +369,16 @@ void SpringRuns::refresh_parameters(const SpringArrays& a) {
 
 void SpringRuns::forces(const SpringArrays& a, RunDamping damping, double beta, std::span<const double> x,
                         std::span<const double> v, std::span<double> f, bool accumulate, Index n) const {
-  // Room for an unmasked 8-lane access starting at the last node.
-  const std::size_t stride = (std::size_t{n} + 2 * lanes - 1) / lanes * lanes;
-  if (stride != stride_) {
+  // Room for an unmasked 8-lane access starting at the last node, and a quarter of headroom
+  // when the arrays grow, so that a cut adding particles does not re-allocate (and fault in)
+  // all twelve arrays before its first step.
+  const std::size_t needed = (std::size_t{n} + 2 * lanes - 1) / lanes * lanes;
+  if (needed > stride_ || needed + needed / 2 < stride_) {
+    const std::size_t stride = (needed + needed / 4 + lanes - 1) / lanes * lanes;
     soa_.assign(num_arrays * stride, 0.0);
     stride_ = stride;
   }
+  const std::size_t stride = stride_;
   const Soa s = soa_view(soa_.data(), stride);
   split_axes(x.data(), s.a[X], s.a[Y], s.a[Z], n);
   if (damping != RunDamping::none) split_axes(v.data(), s.a[VX], s.a[VY], s.a[VZ], n);
