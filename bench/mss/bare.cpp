@@ -211,6 +211,20 @@ void Bare::accumulate_springs() {
   const double *__restrict vx = v_[0].data(), *__restrict vy = v_[1].data(), *__restrict vz = v_[2].data();
   double* __restrict fi[3] = {fi_[0].data(), fi_[1].data(), fi_[2].data()};
   double* __restrict fj[3] = {fj_[0].data(), fj_[1].data(), fj_[2].data()};
+  // One spring (i, j) at a time: the chunks without AVX-512, and the springs in no chunk.
+  const auto spring = [&](std::size_t i, std::size_t j, double k, double l, double g) {
+    const double dx = x[j] - x[i], dy = y[j] - y[i], dz = z[j] - z[i];
+    const double d2 = dx * dx + dy * dy + dz * dz;
+    if (!(d2 > degenerate_ratio_sq * l * l)) return;
+    const double inv = 1.0 / std::sqrt(d2);
+    const double cf = k * (1.0 - l * inv) + g * ((vx[j] - vx[i]) * dx + (vy[j] - vy[i]) * dy + (vz[j] - vz[i]) * dz) * inv * inv;
+    fi[0][i] += cf * dx;
+    fi[1][i] += cf * dy;
+    fi[2][i] += cf * dz;
+    fj[0][j] -= cf * dx;
+    fj[1][j] -= cf * dy;
+    fj[2][j] -= cf * dz;
+  };
   std::size_t c = 0;
 #ifdef SEWN_BARE_AVX512
   // Per chunk: contiguous loads of both ends (unmasked: arrays are padded and unused lanes
@@ -265,39 +279,11 @@ void Bare::accumulate_springs() {
   if (!chunks_.empty()) flush();
 #else
   for (; c < chunks_.size(); ++c)
-    for (std::size_t q = 0; q < lanes; ++q) {
-      if (((chunks_[c].mask >> q) & 1u) == 0) continue;
-      const std::size_t i = chunks_[c].i0 + q, j = chunks_[c].j0 + q;
-      const double dx = x[j] - x[i], dy = y[j] - y[i], dz = z[j] - z[i];
-      const double d2 = dx * dx + dy * dy + dz * dz;
-      const double l = cl_[lanes * c + q];
-      if (!(d2 > degenerate_ratio_sq * l * l)) continue;
-      const double inv = 1.0 / std::sqrt(d2);
-      const double cf = ck_[lanes * c + q] * (1.0 - l * inv) +
-                        cg_[lanes * c + q] * ((vx[j] - vx[i]) * dx + (vy[j] - vy[i]) * dy + (vz[j] - vz[i]) * dz) * inv * inv;
-      fi[0][i] += cf * dx;
-      fi[1][i] += cf * dy;
-      fi[2][i] += cf * dz;
-      fj[0][j] -= cf * dx;
-      fj[1][j] -= cf * dy;
-      fj[2][j] -= cf * dz;
-    }
+    for (std::size_t q = 0; q < lanes; ++q)
+      if ((chunks_[c].mask >> q) & 1u)
+        spring(chunks_[c].i0 + q, chunks_[c].j0 + q, ck_[lanes * c + q], cl_[lanes * c + q], cg_[lanes * c + q]);
 #endif
-  for (std::size_t s = 0; s < ri_.size(); ++s) {
-    const std::size_t i = ri_[s], j = rj_[s];
-    const double dx = x[j] - x[i], dy = y[j] - y[i], dz = z[j] - z[i];
-    const double d2 = dx * dx + dy * dy + dz * dz;
-    if (!(d2 > degenerate_ratio_sq * rl_[s] * rl_[s])) continue;
-    const double inv = 1.0 / std::sqrt(d2);
-    const double cf = rk_[s] * (1.0 - rl_[s] * inv) +
-                      rg_[s] * ((vx[j] - vx[i]) * dx + (vy[j] - vy[i]) * dy + (vz[j] - vz[i]) * dz) * inv * inv;
-    fi[0][i] += cf * dx;
-    fi[1][i] += cf * dy;
-    fi[2][i] += cf * dz;
-    fj[0][j] -= cf * dx;
-    fj[1][j] -= cf * dy;
-    fj[2][j] -= cf * dz;
-  }
+  for (std::size_t s = 0; s < ri_.size(); ++s) spring(ri_[s], rj_[s], rk_[s], rl_[s], rg_[s]);
 }
 
 void Bare::step(double h) {

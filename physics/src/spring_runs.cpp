@@ -260,52 +260,41 @@ void SpringRuns::rebuild(const SpringArrays& a) {
     const std::int64_t op = offset(p), oq = offset(q);
     return op != oq ? op < oq : a.ni[p] < a.ni[q];
   });
-  chunked_ = 0;
+  // Runs cut into chunks of up to 8 lanes, each known by its first entry in `order`.
+  struct Run {
+    std::size_t first, len;
+  };
+  std::vector<Run> runs;
   for (std::size_t t = 0; t < order.size();) {
     const Index first = order[t];
     std::size_t len = 1;
     while (t + len < order.size() && len < lanes && offset(order[t + len]) == offset(first) &&
            a.ni[order[t + len]] == a.ni[first] + len)
       ++len;
-    if (len < min_chunk_lanes) {
+    if (len < min_chunk_lanes)
       for (std::size_t q = 0; q < len; ++q) to_rest(order[t + q]);
-    } else {
-      const auto c = static_cast<std::uint32_t>(chunks_.size());
-      chunks_.push_back({a.ni[first], a.nj[first]});
-      mask_.push_back(static_cast<std::uint8_t>((1u << len) - 1u));
-      for (std::size_t q = 0; q < lanes; ++q) {
-        const bool used = q < len;
-        const Index s = used ? order[t + q] : invalid_index;
-        spring_.push_back(s);
-        k_.push_back(used ? a.k[s] : 0.0);
-        l_.push_back(used ? a.l[s] : 1.0);
-        g_.push_back(used ? a.g[s] : 0.0);
-        if (used) lane_of_[s] = c * lanes + static_cast<std::uint32_t>(q);
-      }
-      chunked_ += static_cast<Index>(len);
-    }
+    else
+      runs.push_back({t, len});
     t += len;
   }
   // Chunks in order of their first node, so that consecutive chunks touch nearby memory.
-  std::vector<std::uint32_t> by_node(chunks_.size());
-  for (std::uint32_t c = 0; c < by_node.size(); ++c) by_node[c] = c;
-  std::stable_sort(by_node.begin(), by_node.end(), [&](std::uint32_t p, std::uint32_t q) { return chunks_[p].i0 < chunks_[q].i0; });
-  const auto chunks = chunks_;
-  const auto mask = mask_;
-  const auto k = k_, l = l_, g = g_;
-  const auto spring = spring_;
-  for (std::uint32_t c = 0; c < by_node.size(); ++c) {
-    const std::uint32_t from = by_node[c];
-    chunks_[c] = chunks[from];
-    mask_[c] = mask[from];
-    for (std::uint32_t q = 0; q < lanes; ++q) {
-      const std::size_t to = c * lanes + q, src = from * lanes + q;
-      k_[to] = k[src];
-      l_[to] = l[src];
-      g_[to] = g[src];
-      spring_[to] = spring[src];
-      if (spring[src] != invalid_index) lane_of_[spring[src]] = static_cast<std::uint32_t>(to);
+  std::stable_sort(runs.begin(), runs.end(), [&](const Run& p, const Run& q) { return a.ni[order[p.first]] < a.ni[order[q.first]]; });
+  chunked_ = 0;
+  for (const Run& r : runs) {
+    const Index first = order[r.first];
+    const auto c = static_cast<std::uint32_t>(chunks_.size());
+    chunks_.push_back({a.ni[first], a.nj[first]});
+    mask_.push_back(static_cast<std::uint8_t>((1u << r.len) - 1u));
+    for (std::size_t q = 0; q < lanes; ++q) {
+      const bool used = q < r.len;
+      const Index s = used ? order[r.first + q] : invalid_index;
+      spring_.push_back(s);
+      k_.push_back(used ? a.k[s] : 0.0);
+      l_.push_back(used ? a.l[s] : 1.0);
+      g_.push_back(used ? a.g[s] : 0.0);
+      if (used) lane_of_[s] = c * lanes + static_cast<std::uint32_t>(q);
     }
+    chunked_ += static_cast<Index>(r.len);
   }
   rest_at_build_ = rest_.size();
   built_ = true;
@@ -323,27 +312,24 @@ void SpringRuns::on_added(Index s) {
   ++live_;
 }
 
+void SpringRuns::leave_chunk(Index s) {
+  const std::uint32_t lane = lane_of_[s];
+  if (lane == no_lane) return;
+  mask_[lane / lanes] &= static_cast<std::uint8_t>(~(1u << (lane % lanes)));
+  spring_[lane] = invalid_index;
+  lane_of_[s] = no_lane;
+  --chunked_;
+}
+
 void SpringRuns::on_removed(Index s) {
   if (!built_) return;
-  const std::uint32_t lane = lane_of_[s];
-  if (lane != no_lane) {
-    mask_[lane / lanes] &= static_cast<std::uint8_t>(~(1u << (lane % lanes)));
-    spring_[lane] = invalid_index;
-    lane_of_[s] = no_lane;
-    --chunked_;
-  }
+  leave_chunk(s);
   --live_;
 }
 
 void SpringRuns::on_endpoints_changed(Index s) {
   if (!built_) return;
-  const std::uint32_t lane = lane_of_[s];
-  if (lane != no_lane) {
-    mask_[lane / lanes] &= static_cast<std::uint8_t>(~(1u << (lane % lanes)));
-    spring_[lane] = invalid_index;
-    lane_of_[s] = no_lane;
-    --chunked_;
-  }
+  leave_chunk(s);
   to_rest(s);
 }
 

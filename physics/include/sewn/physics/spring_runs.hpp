@@ -77,6 +77,8 @@ class SpringRuns {
   };
   void ensure_lane_index(Index count);
   void to_rest(Index s);
+  // Switches off spring s's lane, if it has one.
+  void leave_chunk(Index s);
 
   bool built_ = false;
   std::vector<Chunk> chunks_;
