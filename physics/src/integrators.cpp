@@ -24,16 +24,18 @@ void check_step(double h, const char* who) {
   if (!(std::isfinite(h) && h > 0)) throw InputError(std::string(who) + ": time step must be finite and > 0, got " + fmt(h));
 }
 
-// True if every value of the three equally long arrays is finite, in one pass. Integer test of
-// the exponent bits: it vectorises (an OR reduction) without -ffast-math, which would break
-// NaN tests.
-bool all_finite(std::span<const double> a, std::span<const double> b, std::span<const double> c) {
+// 1 if x is an infinity or a NaN: an integer test of the exponent bits, which vectorises (as an
+// OR reduction) without -ffast-math, which would break NaN tests.
+inline std::uint64_t inf_or_nan(double x) {
   constexpr std::uint64_t exponent = 0x7ff0000000000000ull;
-  const auto inf_or_nan = [](double x) {
-    return static_cast<std::uint64_t>((std::bit_cast<std::uint64_t>(x) & exponent) == exponent);
-  };
+  return static_cast<std::uint64_t>((std::bit_cast<std::uint64_t>(x) & exponent) == exponent);
+}
+
+// True if every value of the equally long arrays is finite, in one pass.
+template <class... Spans>
+bool all_finite(std::span<const double> a, Spans... more) {
   std::uint64_t bad = 0;
-  for (std::size_t k = 0; k < a.size(); ++k) bad |= inf_or_nan(a[k]) | inf_or_nan(b[k]) | inf_or_nan(c[k]);
+  for (std::size_t k = 0; k < a.size(); ++k) bad |= (inf_or_nan(a[k]) | ... | inf_or_nan(more[k]));
   return bad == 0;
 }
 
@@ -58,7 +60,10 @@ bool all_finite(std::span<const double> a, std::span<const double> b, std::span<
 }
 
 void check_finite(const NodeTable& nodes, const char* who) {
-  if (!all_finite(nodes.x(), nodes.v(), nodes.f())) report_nonfinite(nodes, who, true);
+  // Positions and velocities that the last update found finite, untouched since, need no
+  // second pass; the forces are new.
+  const bool ok = nodes.state_known_finite() ? all_finite(nodes.f()) : all_finite(nodes.x(), nodes.v(), nodes.f());
+  if (!ok) report_nonfinite(nodes, who, true);
 }
 
 }  // namespace
@@ -142,10 +147,13 @@ StepReport SymplecticEuler::step(System& sys, double h) {
     double* __restrict v = nodes.v().data();
     const double* __restrict f = nodes.f().data();
     const double* __restrict im = nodes.inverse_mass_dof().data();
+    std::uint64_t bad = 0;
     for (std::size_t k = 0; k < n3; ++k) {
       v[k] += h * im[k] * f[k];
       x[k] += h * v[k];
+      bad |= inf_or_nan(v[k]) | inf_or_nan(x[k]);
     }
+    if (bad == 0) nodes.mark_state_finite();
   }
   ++steps_;
   if (watch && steps_ % static_cast<std::uint64_t>(opt_.health.energy_check_interval) == 0)
@@ -240,10 +248,13 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
     double* __restrict x = nodes.x().data();
     double* __restrict v = nodes.v().data();
     const double* __restrict dv = dv_.data();
+    std::uint64_t bad = 0;
     for (std::size_t k = 0; k < n3; ++k) {
       v[k] += dv[k];
       x[k] += h * v[k];
+      bad |= inf_or_nan(v[k]) | inf_or_nan(x[k]);
     }
+    if (bad == 0) nodes.mark_state_finite();
   }
   ++steps_;
   if (watch && steps_ % static_cast<std::uint64_t>(opt_.health.energy_check_interval) == 0)

@@ -17,6 +17,8 @@ constexpr double degenerate_ratio_sq = 1e-18;
 constexpr std::uint32_t no_lane = ~std::uint32_t{0};
 // A run shorter than this is cheaper one spring at a time than as a chunk.
 constexpr int min_chunk_lanes = 4;
+// Chunks per block of the split / join window (see forces()).
+constexpr std::size_t block_chunks = 32;
 
 // The per-axis arrays inside soa_, each `stride` long.
 enum Axis : int { X, Y, Z, VX, VY, VZ, FX, FY, FZ, GX, GY, GZ, num_arrays };
@@ -54,17 +56,17 @@ void split_axes(const double* __restrict in, double* __restrict x, double* __res
   }
 }
 
-// f (3n) = or += fi + gj per axis, and the accumulators back to zero.
-void join_axes(const Soa& s, double* __restrict out, std::size_t n, bool accumulate) {
+// f (3n) = or += fi + gj per axis for nodes [p, end), and their accumulators back to zero.
+// p must be a multiple of 8 (the accumulators' loads are aligned).
+void join_axes(const Soa& s, double* __restrict out, std::size_t p, std::size_t end, bool accumulate) {
   double *fx = s.a[FX], *fy = s.a[FY], *fz = s.a[FZ], *gx = s.a[GX], *gy = s.a[GY], *gz = s.a[GZ];
-  std::size_t p = 0;
 #ifdef SEWN_RUNS_AVX512
   // The inverse of split_axes: three registers of 8 interleaved nodes, two permutes each.
   const __m512i o0a = _mm512_setr_epi64(0, 8, 0, 1, 9, 0, 2, 10), o0b = _mm512_setr_epi64(0, 1, 8, 3, 4, 9, 6, 7);
   const __m512i o1a = _mm512_setr_epi64(0, 3, 11, 0, 4, 12, 0, 5), o1b = _mm512_setr_epi64(10, 1, 2, 11, 4, 5, 12, 7);
   const __m512i o2a = _mm512_setr_epi64(13, 0, 6, 14, 0, 7, 15, 0), o2b = _mm512_setr_epi64(0, 13, 2, 3, 14, 5, 6, 15);
   const __m512d zero = _mm512_setzero_pd();
-  for (; p + 8 <= n; p += 8) {
+  for (; p + 8 <= end; p += 8) {
     const __m512d X = _mm512_add_pd(_mm512_load_pd(fx + p), _mm512_load_pd(gx + p));
     const __m512d Y = _mm512_add_pd(_mm512_load_pd(fy + p), _mm512_load_pd(gy + p));
     const __m512d Z = _mm512_add_pd(_mm512_load_pd(fz + p), _mm512_load_pd(gz + p));
@@ -83,7 +85,7 @@ void join_axes(const Soa& s, double* __restrict out, std::size_t n, bool accumul
     _mm512_storeu_pd(o + 16, r2);
   }
 #endif
-  for (; p < n; ++p) {
+  for (; p < end; ++p) {
     const double v[3] = {fx[p] + gx[p], fy[p] + gy[p], fz[p] + gz[p]};
     for (int c = 0; c < 3; ++c) out[3 * p + c] = accumulate ? out[3 * p + c] + v[c] : v[c];
     fx[p] = fy[p] = fz[p] = gx[p] = gy[p] = gz[p] = 0.0;
@@ -211,10 +213,10 @@ void chunk_loop(const Arrays& A, const Chunk* __restrict chunks, const std::uint
     cf = _mm512_maskz_mov_pd(ok, cf);
     const __m512d d[3] = {dx, dy, dz};
     for (int a = 0; a < 3; ++a) {
-      __m512d f = _mm512_mul_pd(cf, d[a]);
-      if constexpr (D == RunDamping::stiffness_proportional) f = _mm512_fmadd_pd(e, u[a], f);
-      fi[a] = _mm512_mask_add_pd(fi[a], mk, fi[a], f);
-      _mm512_mask_storeu_pd(go[a] + j, mk, _mm512_sub_pd(_mm512_loadu_pd(go[a] + j), f));
+      __m512d f = _mm512_maskz_mul_pd(mk, cf, d[a]);
+      if constexpr (D == RunDamping::stiffness_proportional) f = _mm512_maskz_fmadd_pd(mk, e, u[a], f);
+      fi[a] = _mm512_add_pd(fi[a], f);
+      _mm512_storeu_pd(go[a] + j, _mm512_sub_pd(_mm512_loadu_pd(go[a] + j), f));
     }
   }
   if (count > 0) flush();
@@ -296,6 +298,22 @@ void SpringRuns::rebuild(const SpringArrays& a) {
     }
     chunked_ += static_cast<Index>(r.len);
   }
+  // Per block of chunks: the highest node it may read (lanes past a run's end included), over
+  // it and every block before; and the lowest node any later block touches.
+  const std::size_t blocks = (chunks_.size() + block_chunks - 1) / block_chunks;
+  reach_.assign(blocks, 0);
+  floor_.assign(blocks, invalid_index);
+  std::size_t reach = 0;
+  for (std::size_t c = 0; c < chunks_.size(); ++c) {
+    reach = std::max<std::size_t>(reach, std::size_t{std::max(chunks_[c].i0, chunks_[c].j0)} + lanes);
+    reach_[c / block_chunks] = reach;
+  }
+  Index floor = invalid_index;
+  for (std::size_t b = blocks; b-- > 0;) {
+    floor_[b] = floor;
+    for (std::size_t c = b * block_chunks; c < std::min(chunks_.size(), (b + 1) * block_chunks); ++c)
+      floor = std::min({floor, chunks_[c].i0, chunks_[c].j0});
+  }
   rest_at_build_ = rest_.size();
   built_ = true;
 }
@@ -366,18 +384,49 @@ void SpringRuns::forces(const SpringArrays& a, RunDamping damping, double beta, 
   }
   const std::size_t stride = stride_;
   const Soa s = soa_view(soa_.data(), stride);
-  split_axes(x.data(), s.a[X], s.a[Y], s.a[Z], n);
-  if (damping != RunDamping::none) split_axes(v.data(), s.a[VX], s.a[VY], s.a[VZ], n);
+  const bool damped = damping != RunDamping::none;
+  // Nodes are split into the per-axis arrays just before the first block of chunks that
+  // reads them, and joined into f as soon as no later chunk or rest spring touches them, so
+  // that on a large mesh each node's per-axis values are still in cache when they are used:
+  // the window between the two fronts is about one grid layer.
+  std::size_t split_to = 0, joined_to = 0;
+  const auto split_until = [&](std::size_t end) {
+    end = std::min<std::size_t>((end + lanes - 1) / lanes * lanes, n);
+    if (end <= split_to) return;
+    const std::size_t p = split_to, len = end - p;
+    split_axes(x.data() + 3 * p, s.a[X] + p, s.a[Y] + p, s.a[Z] + p, len);
+    if (damped) split_axes(v.data() + 3 * p, s.a[VX] + p, s.a[VY] + p, s.a[VZ] + p, len);
+    split_to = end;
+  };
+  Index rest_floor = n;
+  for (const Index r : rest_)
+    if (a.alive[r] != 0) rest_floor = std::min({rest_floor, a.ni[r], a.nj[r]});
+  const auto join_until = [&](std::size_t end) {
+    end = std::min<std::size_t>(end, rest_floor);
+    if (end < n) end = end / lanes * lanes;
+    if (end <= joined_to) return;
+    join_axes(s, f.data(), joined_to, end, accumulate);
+    joined_to = end;
+  };
   const auto run = [&]<RunDamping D>() {
 #ifdef SEWN_RUNS_AVX512
     const Arrays A{s.a[X], s.a[Y], s.a[Z], s.a[VX], s.a[VY], s.a[VZ], {s.a[FX], s.a[FY], s.a[FZ]}, {s.a[GX], s.a[GY], s.a[GZ]}};
-    chunk_loop<D>(A, chunks_.data(), mask_.data(), chunks_.size(), k_.data(), l_.data(), g_.data(), beta);
-#else
-    for (std::size_t c = 0; c < chunks_.size(); ++c)
-      for (int q = 0; q < lanes; ++q)
-        if ((mask_[c] >> q) & 1u)
-          one_spring<D>(s, chunks_[c].i0 + q, chunks_[c].j0 + q, k_[c * lanes + q], l_[c * lanes + q], g_[c * lanes + q], beta);
 #endif
+    for (std::size_t b = 0, c0 = 0; c0 < chunks_.size(); ++b, c0 += block_chunks) {
+      const std::size_t c1 = std::min(c0 + block_chunks, chunks_.size());
+      split_until(reach_[b]);
+#ifdef SEWN_RUNS_AVX512
+      chunk_loop<D>(A, chunks_.data() + c0, mask_.data() + c0, c1 - c0, k_.data() + lanes * c0, l_.data() + lanes * c0,
+                    g_.data() + lanes * c0, beta);
+#else
+      for (std::size_t c = c0; c < c1; ++c)
+        for (int q = 0; q < lanes; ++q)
+          if ((mask_[c] >> q) & 1u)
+            one_spring<D>(s, chunks_[c].i0 + q, chunks_[c].j0 + q, k_[c * lanes + q], l_[c * lanes + q], g_[c * lanes + q], beta);
+#endif
+      join_until(floor_[b]);
+    }
+    split_until(n);
     for (const Index r : rest_)
       if (a.alive[r] != 0) one_spring<D>(s, a.ni[r], a.nj[r], a.k[r], a.l[r], a.g[r], beta);
   };
@@ -386,7 +435,8 @@ void SpringRuns::forces(const SpringArrays& a, RunDamping damping, double beta, 
     case RunDamping::viscous: run.template operator()<RunDamping::viscous>(); break;
     case RunDamping::stiffness_proportional: run.template operator()<RunDamping::stiffness_proportional>(); break;
   }
-  join_axes(s, f.data(), n, accumulate);
+  rest_floor = n;
+  join_until(n);
 }
 
 }  // namespace sewn::physics::detail

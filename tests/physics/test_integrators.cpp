@@ -4,8 +4,10 @@
 // models, CG failure reporting and NaN injection.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -393,6 +395,48 @@ TEST_CASE("a NaN injected into the state is caught before use, naming the node")
     sys.nodes().v()[3 * 4] = INFINITY;
     sys.nodes().x()[3 * 13 + 1] = 0.1;
     CHECK_THROWS_WITH_AS((void)se.step(sys, 1e-4), doctest::Contains("velocity of node 4"), BlowupError);
+  }
+}
+
+TEST_CASE("after an update found finite, the next step checks only the forces; write access brings the full check back") {
+  for (int scheme = 0; scheme < 2; ++scheme) {
+    System sys;
+    const BoxLattice L = cube_lattice(sys, 2, 0.1, 1e5, 0.3, 1000, SpringDamping::viscous);
+    // A node no term reads (gravity reads masses only): a NaN there never reaches the forces.
+    const Index lone = sys.nodes().add({5, 5, 5}, {0, 0, 0}, 1.0);
+    sys.add<Gravity>(Eigen::Vector3d(0, 0, -9.81));
+    SymplecticEuler se;
+    LinearlyImplicitEuler ie;
+    const auto step = [&] {
+      if (scheme == 0) (void)se.step(sys, 1e-4);
+      else (void)ie.step(sys, 1e-3);
+    };
+    CHECK_FALSE(sys.nodes().state_known_finite());
+    step();
+    CHECK(sys.nodes().state_known_finite());
+    sys.nodes().set_position(0, sys.nodes().position(0));  // checked setter
+    CHECK(sys.nodes().state_known_finite());
+    const auto x = sys.nodes().x();  // write access: the flag is gone until the next update
+    CHECK_FALSE(sys.nodes().state_known_finite());
+    step();
+    CHECK(sys.nodes().state_known_finite());
+    // A NaN written through the span held across the step, at a node springs read: the forces
+    // carry it, their check stops the step before anything changes, and the report names the
+    // position it came from.
+    const Index inner = L.node(1, 1, 1);
+    x[3 * inner] = std::nan("");
+    const NodeTable& read = sys.nodes();  // reading through const access keeps the flag
+    const std::vector<double> v0(read.v().begin(), read.v().end());
+    REQUIRE(read.state_known_finite());
+    CHECK_THROWS_WITH_AS(step(), doctest::Contains(("position of node " + std::to_string(inner)).c_str()), BlowupError);
+    CHECK(std::equal(v0.begin(), v0.end(), read.v().begin()));
+    x[3 * inner] = 0.1;
+    sys.nodes().mark_state_finite();
+    // At the node no term reads, the step's own update finds it, and the next step names it.
+    x[3 * lone + 2] = std::nan("");
+    step();
+    CHECK_FALSE(sys.nodes().state_known_finite());
+    CHECK_THROWS_WITH_AS(step(), doctest::Contains(("position of node " + std::to_string(lone)).c_str()), BlowupError);
   }
 }
 

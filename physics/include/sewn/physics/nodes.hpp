@@ -50,10 +50,17 @@ class NodeTable {
   void remove(Index i);
   [[nodiscard]] bool is_alive(Index i) const { return i < size() && alive_[i] != 0; }
 
-  // ---- whole arrays (3n node-major, or n); invalidated by add/duplicate/reserve/compact
-  [[nodiscard]] std::span<double> x() { return {x_.data(), x_.size()}; }
+  // ---- whole arrays (3n node-major, or n); invalidated by add/duplicate/reserve/compact. Write
+  // access to positions or velocities clears state_known_finite().
+  [[nodiscard]] std::span<double> x() {
+    state_finite_ = false;
+    return std::span<double>{x_.data(), x_.size()};
+  }
   [[nodiscard]] std::span<const double> x() const { return {x_.data(), x_.size()}; }
-  [[nodiscard]] std::span<double> v() { return {v_.data(), v_.size()}; }
+  [[nodiscard]] std::span<double> v() {
+    state_finite_ = false;
+    return std::span<double>{v_.data(), v_.size()};
+  }
   [[nodiscard]] std::span<const double> v() const { return {v_.data(), v_.size()}; }
   [[nodiscard]] std::span<double> f() { return {f_.data(), f_.size()}; }
   [[nodiscard]] std::span<const double> f() const { return {f_.data(), f_.size()}; }
@@ -63,14 +70,26 @@ class NodeTable {
   /// Fixed-axis mask of every node (n).
   [[nodiscard]] std::span<const AxisMask> fixed_masks() const { return {fixed_.data(), fixed_.size()}; }
   /// The same arrays as Eigen maps: 3×n (column = node) or a 3n vector.
-  [[nodiscard]] Map3X positions() { return {x_.data(), 3, size()}; }
+  [[nodiscard]] Map3X positions() {
+    state_finite_ = false;
+    return Map3X{x_.data(), 3, size()};
+  }
   [[nodiscard]] ConstMap3X positions() const { return {x_.data(), 3, size()}; }
-  [[nodiscard]] Map3X velocities() { return {v_.data(), 3, size()}; }
+  [[nodiscard]] Map3X velocities() {
+    state_finite_ = false;
+    return Map3X{v_.data(), 3, size()};
+  }
   [[nodiscard]] ConstMap3X velocities() const { return {v_.data(), 3, size()}; }
   [[nodiscard]] Map3X forces() { return {f_.data(), 3, size()}; }
   [[nodiscard]] ConstMap3X forces() const { return {f_.data(), 3, size()}; }
-  [[nodiscard]] MapX positions_flat() { return {x_.data(), 3 * Eigen::Index{size()}}; }
-  [[nodiscard]] MapX velocities_flat() { return {v_.data(), 3 * Eigen::Index{size()}}; }
+  [[nodiscard]] MapX positions_flat() {
+    state_finite_ = false;
+    return MapX{x_.data(), 3 * Eigen::Index{size()}};
+  }
+  [[nodiscard]] MapX velocities_flat() {
+    state_finite_ = false;
+    return MapX{v_.data(), 3 * Eigen::Index{size()}};
+  }
   [[nodiscard]] MapX forces_flat() { return {f_.data(), 3 * Eigen::Index{size()}}; }
   /// The current state as force terms read it.
   [[nodiscard]] StateView state() const { return {x(), v(), masses()}; }
@@ -96,6 +115,17 @@ class NodeTable {
   /// Number of live nodes with at least one fixed axis. O(1).
   [[nodiscard]] Index num_fixed_nodes() const { return fixed_count_; }
 
+  /// True if every position and velocity is known to be finite: an integrator found the results
+  /// of its own update finite, and nothing has had write access to them since (every non-const
+  /// x(), v(), positions(), velocities() and *_flat() clears it; the checked setters keep it).
+  /// Lets the next step check only the forces. A value written later through a span or map
+  /// obtained earlier is not seen here: it reaches the forces (and their check) if any term
+  /// reads that node, and otherwise the next step's check of its own update. O(1).
+  [[nodiscard]] bool state_known_finite() const { return state_finite_; }
+  /// Records that every position and velocity was just found finite (integrators call it after
+  /// checking their update). O(1).
+  void mark_state_finite() { state_finite_ = true; }
+
   /// Incremented whenever nodes are added, removed or renumbered (matrix size and pattern).
   [[nodiscard]] std::uint64_t topology_version() const { return topology_version_; }
   /// Incremented whenever a mass or a fixed flag changes (stable step, preconditioner).
@@ -113,6 +143,7 @@ class NodeTable {
   AlignedVector<double> mass_;
   std::vector<AxisMask> fixed_;
   std::vector<std::uint8_t> alive_;
+  bool state_finite_ = false;
   Index alive_count_ = 0;
   Index fixed_count_ = 0;
   std::uint64_t topology_version_ = 0;

@@ -88,6 +88,8 @@ class SpringRuns {
   std::vector<std::uint32_t> lane_of_;      // spring -> chunk · 8 + lane, or none
   std::vector<std::uint8_t> in_rest_;       // spring -> listed in rest_
   std::vector<Index> rest_;
+  std::vector<std::size_t> reach_;  // per block of chunks: nodes below it are read up to it
+  std::vector<Index> floor_;        // per block: the lowest node a later block touches
   std::size_t rest_at_build_ = 0;
   Index chunked_ = 0, live_ = 0;
   // Per-axis node arrays: x y z, vx vy vz, and the i-side and j-side force accumulators fx fy
