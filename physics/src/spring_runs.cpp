@@ -213,10 +213,10 @@ void chunk_loop(const Arrays& A, const Chunk* __restrict chunks, const std::uint
     cf = _mm512_maskz_mov_pd(ok, cf);
     const __m512d d[3] = {dx, dy, dz};
     for (int a = 0; a < 3; ++a) {
-      __m512d f = _mm512_maskz_mul_pd(mk, cf, d[a]);
-      if constexpr (D == RunDamping::stiffness_proportional) f = _mm512_maskz_fmadd_pd(mk, e, u[a], f);
-      fi[a] = _mm512_add_pd(fi[a], f);
-      _mm512_storeu_pd(go[a] + j, _mm512_sub_pd(_mm512_loadu_pd(go[a] + j), f));
+      __m512d f = _mm512_mul_pd(cf, d[a]);
+      if constexpr (D == RunDamping::stiffness_proportional) f = _mm512_fmadd_pd(e, u[a], f);
+      fi[a] = _mm512_mask_add_pd(fi[a], mk, fi[a], f);
+      _mm512_mask_storeu_pd(go[a] + j, mk, _mm512_sub_pd(_mm512_loadu_pd(go[a] + j), f));
     }
   }
   if (count > 0) flush();
