@@ -28,7 +28,7 @@ Bare::Bare(const ModelSpec& spec) {
   springs_ = ms.k.size();
   const std::size_t padded = (n_ + 2 * lanes - 1) / lanes * lanes;
   for (int a = 0; a < 3; ++a)
-    for (auto* arr : {&x_[a], &v_[a], &fi_[a], &fj_[a], &inv_mass_[a], &g_[a]}) arr->assign(padded, 0.0);
+    for (auto* arr : {&x_[a], &v_[a], &f_[a], &inv_mass_[a], &g_[a]}) arr->assign(padded, 0.0);
   mass_.assign(ms.mass.begin(), ms.mass.end());
   gravity_ = spec.gravity;
   for (std::size_t p = 0; p < n_; ++p) {
@@ -209,8 +209,7 @@ void Bare::step_rows(double h) {
 void Bare::accumulate_springs() {
   const double *__restrict x = x_[0].data(), *__restrict y = x_[1].data(), *__restrict z = x_[2].data();
   const double *__restrict vx = v_[0].data(), *__restrict vy = v_[1].data(), *__restrict vz = v_[2].data();
-  double* __restrict fi[3] = {fi_[0].data(), fi_[1].data(), fi_[2].data()};
-  double* __restrict fj[3] = {fj_[0].data(), fj_[1].data(), fj_[2].data()};
+  double* __restrict f[3] = {f_[0].data(), f_[1].data(), f_[2].data()};
   // One spring (i, j) at a time: the chunks without AVX-512, and the springs in no chunk.
   const auto spring = [&](std::size_t i, std::size_t j, double k, double l, double g) {
     const double dx = x[j] - x[i], dy = y[j] - y[i], dz = z[j] - z[i];
@@ -218,12 +217,12 @@ void Bare::accumulate_springs() {
     if (!(d2 > degenerate_ratio_sq * l * l)) return;
     const double inv = 1.0 / std::sqrt(d2);
     const double cf = k * (1.0 - l * inv) + g * ((vx[j] - vx[i]) * dx + (vy[j] - vy[i]) * dy + (vz[j] - vz[i]) * dz) * inv * inv;
-    fi[0][i] += cf * dx;
-    fi[1][i] += cf * dy;
-    fi[2][i] += cf * dz;
-    fj[0][j] -= cf * dx;
-    fj[1][j] -= cf * dy;
-    fj[2][j] -= cf * dz;
+    f[0][i] += cf * dx;
+    f[1][i] += cf * dy;
+    f[2][i] += cf * dz;
+    f[0][j] -= cf * dx;
+    f[1][j] -= cf * dy;
+    f[2][j] -= cf * dz;
   };
   std::size_t c = 0;
 #ifdef SEWN_BARE_AVX512
@@ -237,7 +236,7 @@ void Bare::accumulate_springs() {
   std::size_t si_node = chunks_.empty() ? 0 : chunks_[0].i0;
   const auto flush = [&] {
     for (int a = 0; a < 3; ++a) {
-      _mm512_mask_storeu_pd(fi[a] + si_node, si_mask, _mm512_add_pd(_mm512_loadu_pd(fi[a] + si_node), si[a]));
+      _mm512_mask_storeu_pd(f[a] + si_node, si_mask, _mm512_add_pd(_mm512_loadu_pd(f[a] + si_node), si[a]));
       si[a] = _mm512_setzero_pd();
     }
     si_mask = 0;
@@ -271,9 +270,9 @@ void Bare::accumulate_springs() {
                             _mm512_mul_pd(_mm512_load_pd(ck_.data() + lanes * c), _mm512_fnmadd_pd(l, r, one))));
     const __m512d d[3] = {dx, dy, dz};
     for (int a = 0; a < 3; ++a) {
-      const __m512d f = _mm512_mul_pd(cf, d[a]);
-      si[a] = _mm512_mask_add_pd(si[a], mk, si[a], f);
-      _mm512_mask_storeu_pd(fj[a] + j, mk, _mm512_sub_pd(_mm512_loadu_pd(fj[a] + j), f));
+      const __m512d fs = _mm512_mul_pd(cf, d[a]);
+      si[a] = _mm512_mask_add_pd(si[a], mk, si[a], fs);
+      _mm512_mask_storeu_pd(f[a] + j, mk, _mm512_sub_pd(_mm512_loadu_pd(f[a] + j), fs));
     }
   }
   if (!chunks_.empty()) flush();
@@ -296,15 +295,13 @@ void Bare::step(double h) {
   for (int a = 0; a < 3; ++a) {
     double* __restrict x = x_[a].data();
     double* __restrict v = v_[a].data();
-    double* __restrict fi = fi_[a].data();
-    double* __restrict fj = fj_[a].data();
+    double* __restrict f = f_[a].data();
     const double* __restrict im = inv_mass_[a].data();
     const double* __restrict g = g_[a].data();
     for (std::size_t p = 0; p < n_; ++p) {
-      v[p] += h * (im[p] * (fi[p] + fj[p]) + g[p]);
+      v[p] += h * (im[p] * f[p] + g[p]);
       x[p] += h * v[p];
-      fi[p] = 0.0;
-      fj[p] = 0.0;
+      f[p] = 0.0;
     }
   }
 }
@@ -367,8 +364,8 @@ std::vector<double> Bare::forces() {
   std::vector<double> f(3 * n_);
   for (std::size_t p = 0; p < n_; ++p)
     for (std::size_t a = 0; a < 3; ++a) {
-      f[3 * p + a] = fi_[a][p] + fj_[a][p] + mass_[p] * gravity_[a];
-      fi_[a][p] = fj_[a][p] = 0.0;
+      f[3 * p + a] = f_[a][p] + mass_[p] * gravity_[a];
+      f_[a][p] = 0.0;
     }
   return f;
 }

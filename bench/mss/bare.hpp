@@ -56,8 +56,9 @@ class Bare {
   };
   std::size_t n_ = 0, springs_ = 0;
   // Per axis, padded past the last node so that an 8-lane access may start at any node:
-  // positions, velocities, the i-side and j-side force accumulators, 1/m and g (0 on fixed axes).
-  std::array<Vec<double>, 3> x_, v_, fi_, fj_, inv_mass_, g_;
+  // positions, velocities, the force accumulator (both ends of every spring), 1/m and g (0 on
+  // fixed axes).
+  std::array<Vec<double>, 3> x_, v_, f_, inv_mass_, g_;
   Vec<double> mass_;  // per node, for forces()
   std::array<double, 3> gravity_{};
   std::vector<Chunk> chunks_;        // in order of i0

@@ -21,7 +21,7 @@ constexpr int min_chunk_lanes = 4;
 constexpr std::size_t block_chunks = 32;
 
 // The per-axis arrays inside soa_, each `stride` long.
-enum Axis : int { X, Y, Z, VX, VY, VZ, FX, FY, FZ, GX, GY, GZ, num_arrays };
+enum Axis : int { X, Y, Z, VX, VY, VZ, FX, FY, FZ, num_arrays };
 
 struct Soa {
   double* a[num_arrays];
@@ -56,10 +56,10 @@ void split_axes(const double* __restrict in, double* __restrict x, double* __res
   }
 }
 
-// f (3n) = or += fi + gj per axis for nodes [p, end), and their accumulators back to zero.
+// f (3n) = or += the per-axis accumulators for nodes [p, end), and those back to zero.
 // p must be a multiple of 8 (the accumulators' loads are aligned).
 void join_axes(const Soa& s, double* __restrict out, std::size_t p, std::size_t end, bool accumulate) {
-  double *fx = s.a[FX], *fy = s.a[FY], *fz = s.a[FZ], *gx = s.a[GX], *gy = s.a[GY], *gz = s.a[GZ];
+  double *fx = s.a[FX], *fy = s.a[FY], *fz = s.a[FZ];
 #ifdef SEWN_RUNS_AVX512
   // The inverse of split_axes: three registers of 8 interleaved nodes, two permutes each.
   const __m512i o0a = _mm512_setr_epi64(0, 8, 0, 1, 9, 0, 2, 10), o0b = _mm512_setr_epi64(0, 1, 8, 3, 4, 9, 6, 7);
@@ -67,10 +67,8 @@ void join_axes(const Soa& s, double* __restrict out, std::size_t p, std::size_t 
   const __m512i o2a = _mm512_setr_epi64(13, 0, 6, 14, 0, 7, 15, 0), o2b = _mm512_setr_epi64(0, 13, 2, 3, 14, 5, 6, 15);
   const __m512d zero = _mm512_setzero_pd();
   for (; p + 8 <= end; p += 8) {
-    const __m512d X = _mm512_add_pd(_mm512_load_pd(fx + p), _mm512_load_pd(gx + p));
-    const __m512d Y = _mm512_add_pd(_mm512_load_pd(fy + p), _mm512_load_pd(gy + p));
-    const __m512d Z = _mm512_add_pd(_mm512_load_pd(fz + p), _mm512_load_pd(gz + p));
-    for (double* a : {fx, fy, fz, gx, gy, gz}) _mm512_store_pd(a + p, zero);
+    const __m512d X = _mm512_load_pd(fx + p), Y = _mm512_load_pd(fy + p), Z = _mm512_load_pd(fz + p);
+    for (double* a : {fx, fy, fz}) _mm512_store_pd(a + p, zero);
     __m512d r0 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(X, o0a, Y), o0b, Z);
     __m512d r1 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(X, o1a, Y), o1b, Z);
     __m512d r2 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(X, o2a, Y), o2b, Z);
@@ -86,9 +84,9 @@ void join_axes(const Soa& s, double* __restrict out, std::size_t p, std::size_t 
   }
 #endif
   for (; p < end; ++p) {
-    const double v[3] = {fx[p] + gx[p], fy[p] + gy[p], fz[p] + gz[p]};
+    const double v[3] = {fx[p], fy[p], fz[p]};
     for (int c = 0; c < 3; ++c) out[3 * p + c] = accumulate ? out[3 * p + c] + v[c] : v[c];
-    fx[p] = fy[p] = fz[p] = gx[p] = gy[p] = gz[p] = 0.0;
+    fx[p] = fy[p] = fz[p] = 0.0;
   }
 }
 
@@ -120,9 +118,9 @@ inline void one_spring(const Soa& s, std::size_t i, std::size_t j, double k, dou
   s.a[FX][i] += fx;
   s.a[FY][i] += fy;
   s.a[FZ][i] += fz;
-  s.a[GX][j] -= fx;
-  s.a[GY][j] -= fy;
-  s.a[GZ][j] -= fz;
+  s.a[FX][j] -= fx;
+  s.a[FY][j] -= fy;
+  s.a[FZ][j] -= fz;
 }
 
 #ifdef SEWN_RUNS_AVX512
@@ -147,7 +145,6 @@ struct Arrays {
   const double* __restrict vy;
   const double* __restrict vz;
   double* __restrict f[3];
-  double* __restrict g[3];
 };
 
 // Chunks of eight springs (i0 + q, j0 + q). Loads are unmasked (the arrays are padded past
@@ -162,7 +159,6 @@ void chunk_loop(const Arrays& A, const Chunk* __restrict chunks, const std::uint
   const double* __restrict vy = A.vy;
   const double* __restrict vz = A.vz;
   double* __restrict fo[3] = {A.f[0], A.f[1], A.f[2]};
-  double* __restrict go[3] = {A.g[0], A.g[1], A.g[2]};
   const __m512d one = _mm512_set1_pd(1.0), tiny = _mm512_set1_pd(degenerate_ratio_sq);
   // Chunks are sorted by i0, and the i-side forces of chunks with the same i0 are summed in
   // registers and stored once: a load of the accumulator right after a masked store to it
@@ -216,7 +212,7 @@ void chunk_loop(const Arrays& A, const Chunk* __restrict chunks, const std::uint
       __m512d f = _mm512_mul_pd(cf, d[a]);
       if constexpr (D == RunDamping::stiffness_proportional) f = _mm512_fmadd_pd(e, u[a], f);
       fi[a] = _mm512_mask_add_pd(fi[a], mk, fi[a], f);
-      _mm512_mask_storeu_pd(go[a] + j, mk, _mm512_sub_pd(_mm512_loadu_pd(go[a] + j), f));
+      _mm512_mask_storeu_pd(fo[a] + j, mk, _mm512_sub_pd(_mm512_loadu_pd(fo[a] + j), f));
     }
   }
   if (count > 0) flush();
@@ -410,7 +406,7 @@ void SpringRuns::forces(const SpringArrays& a, RunDamping damping, double beta, 
   };
   const auto run = [&]<RunDamping D>() {
 #ifdef SEWN_RUNS_AVX512
-    const Arrays A{s.a[X], s.a[Y], s.a[Z], s.a[VX], s.a[VY], s.a[VZ], {s.a[FX], s.a[FY], s.a[FZ]}, {s.a[GX], s.a[GY], s.a[GZ]}};
+    const Arrays A{s.a[X], s.a[Y], s.a[Z], s.a[VX], s.a[VY], s.a[VZ], {s.a[FX], s.a[FY], s.a[FZ]}};
 #endif
     for (std::size_t b = 0, c0 = 0; c0 < chunks_.size(); ++b, c0 += block_chunks) {
       const std::size_t c1 = std::min(c0 + block_chunks, chunks_.size());

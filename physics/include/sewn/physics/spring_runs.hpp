@@ -92,9 +92,8 @@ class SpringRuns {
   std::vector<Index> floor_;        // per block: the lowest node a later block touches
   std::size_t rest_at_build_ = 0;
   Index chunked_ = 0, live_ = 0;
-  // Per-axis node arrays: x y z, vx vy vz, and the i-side and j-side force accumulators fx fy
-  // fz, gx gy gz (two, so that the two ends of a chunk never overlap in one array). The
-  // accumulators are all zero between calls.
+  // Per-axis node arrays: x y z, vx vy vz, and the force accumulators fx fy fz, which are all
+  // zero between calls.
   mutable AlignedVector<double> soa_;
   mutable std::size_t stride_ = 0;
 };
