@@ -252,11 +252,14 @@ void SpringRuns::rebuild(const SpringArrays& a) {
   for (Index s = 0; s < a.count; ++s)
     if (a.alive[s] != 0) order.push_back(s);
   live_ = static_cast<Index>(order.size());
-  const auto offset = [&](Index s) { return std::int64_t{a.nj[s]} - std::int64_t{a.ni[s]}; };
-  // Same offset j - i, then increasing i: each run is a stretch of consecutive entries.
+  // A spring's force does not depend on which end is called i, so each is taken from its lower
+  // node: builders that orient springs by element or dart order, not by node, still form runs.
+  const auto lo = [&](Index s) { return std::min(a.ni[s], a.nj[s]); };
+  const auto offset = [&](Index s) { return std::max(a.ni[s], a.nj[s]) - lo(s); };
+  // Same offset, then increasing lower node: each run is a stretch of consecutive entries.
   std::sort(order.begin(), order.end(), [&](Index p, Index q) {
-    const std::int64_t op = offset(p), oq = offset(q);
-    return op != oq ? op < oq : a.ni[p] < a.ni[q];
+    const Index op = offset(p), oq = offset(q);
+    return op != oq ? op < oq : lo(p) < lo(q);
   });
   // Runs cut into chunks of up to 8 lanes, each known by its first entry in `order`.
   struct Run {
@@ -266,8 +269,7 @@ void SpringRuns::rebuild(const SpringArrays& a) {
   for (std::size_t t = 0; t < order.size();) {
     const Index first = order[t];
     std::size_t len = 1;
-    while (t + len < order.size() && len < lanes && offset(order[t + len]) == offset(first) &&
-           a.ni[order[t + len]] == a.ni[first] + len)
+    while (t + len < order.size() && len < lanes && offset(order[t + len]) == offset(first) && lo(order[t + len]) == lo(first) + len)
       ++len;
     if (len < min_chunk_lanes)
       for (std::size_t q = 0; q < len; ++q) to_rest(order[t + q]);
@@ -276,12 +278,12 @@ void SpringRuns::rebuild(const SpringArrays& a) {
     t += len;
   }
   // Chunks in order of their first node, so that consecutive chunks touch nearby memory.
-  std::stable_sort(runs.begin(), runs.end(), [&](const Run& p, const Run& q) { return a.ni[order[p.first]] < a.ni[order[q.first]]; });
+  std::stable_sort(runs.begin(), runs.end(), [&](const Run& p, const Run& q) { return lo(order[p.first]) < lo(order[q.first]); });
   chunked_ = 0;
   for (const Run& r : runs) {
     const Index first = order[r.first];
     const auto c = static_cast<std::uint32_t>(chunks_.size());
-    chunks_.push_back({a.ni[first], a.nj[first]});
+    chunks_.push_back({lo(first), lo(first) + offset(first)});
     mask_.push_back(static_cast<std::uint8_t>((1u << r.len) - 1u));
     for (std::size_t q = 0; q < lanes; ++q) {
       const bool used = q < r.len;
