@@ -167,6 +167,36 @@ TEST_CASE("Fig. 5 and Fig. 6 through the cutting API") {
   CHECK_THROWS_WITH_AS(facets_with_points(m, std::span(bottom)), doctest::Contains("boundary"), InputError);
 }
 
+TEST_CASE("selections: faces among a path of particles, faces across a plane within a region, elements in a region") {
+  const double a = 0.05;
+  const IndexedMesh mesh = hex_grid(10, 2, 2, {{a, a, a}, {}});
+  // The particles of the section x = 0.25 with z <= a: the lower half of the section (3 × 2).
+  std::vector<std::uint32_t> path;
+  for (std::uint32_t p = 0; p < mesh.num_points(); ++p)
+    if (std::abs(mesh.points[p][0] - 0.25) < 1e-12 && mesh.points[p][2] < a + 1e-12) path.push_back(p);
+  REQUIRE(path.size() == 6);
+  MssModel<3> by_path(mesh, {paper_material}, {}, options(false));
+  const auto among = facets_among_points(by_path, std::span(path));
+  CHECK(among.size() == 2);  // the section's two lower faces
+  MssModel<3> by_plane(mesh, {paper_material}, {}, options(false));
+  const auto across = facets_across_plane(by_plane, Vector3d(0.25, 0, 0), Vector3d(1, 0, 0),
+                                          [&](const Vector3d& c) { return c.z() < a; });
+  CHECK(across.size() == 2);
+  // Both name the same two faces: cutting them splits the 3 particles of the section's bottom
+  // edge and its 5 edges (2 along the bottom, 3 upright), and nothing else.
+  for (MssModel<3>* m : {&by_path, &by_plane}) {
+    const CutReport r = cut(*m, std::span(m == &by_path ? among : across));
+    check_consistent(*m);
+    CHECK(r.particles == 3);
+    CHECK(r.springs == 5);
+    CHECK(m->map().count_components() == 1);
+  }
+  CHECK(by_path.nodes().num_alive() == by_plane.nodes().num_alive());
+  for (Index i = 0; i < by_path.nodes().size(); ++i) CHECK(by_path.nodes().position(i) == by_plane.nodes().position(i));
+  // Elements whose centroid is in x < 0.1: the first two slabs of 2 × 2.
+  CHECK(elements_in(by_path, [](const Vector3d& c) { return c.x() < 0.1; }).size() == 8);
+}
+
 TEST_CASE("a cut between two steps conserves mass and momentum") {
   MssModel<3> m(tet_grid(4, 2, 2, TetSplit::kuhn6, {{0.05, 0.05, 0.05}, {}}), {paper_material}, {}, options(false));
   std::mt19937 rng(7);
