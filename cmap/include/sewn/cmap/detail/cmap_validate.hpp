@@ -31,8 +31,7 @@ ValidationReport CMap<D, A...>::validate() const {
   // 2) links: live targets, β0 = β1⁻¹, involutions, commuting pairs. A lean test settles the
   //    darts whose links are sound (all of them in a valid map); a dart it rejects is checked
   //    again by `report_links`, which names each broken link. Kept apart, the lean test keeps
-  //    its pointers in registers, and it asks for the rows of βi partners (i ≥ 2, anywhere in
-  //    the map) a few darts ahead, so that their cache misses overlap.
+  //    its pointers in registers.
   const std::array<std::uint32_t, D + 1>* rows = beta_.data();
   auto sound = [rows, cap](std::uint32_t x) {
     const std::array<std::uint32_t, D + 1> row = rows[x];
@@ -110,11 +109,7 @@ ValidationReport CMap<D, A...>::validate() const {
                     std::to_string(i) + "(beta" + std::to_string(j) + ") = " + s(ji));
       }
   };
-  constexpr std::uint32_t ahead = 16;
   for (std::uint32_t x = 0; x < cap; ++x) {
-    if (x + ahead < cap)
-      for (int i = 2; i <= D; ++i)
-        if (const std::uint32_t y = rows[x + ahead][static_cast<std::size_t>(i)]; y < cap) __builtin_prefetch(&rows[y]);
     if (rows[x][0] != detail::dead_marker && !sound(x)) [[unlikely]]
       report_links(x);
   }
