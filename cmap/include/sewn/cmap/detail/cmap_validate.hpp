@@ -132,6 +132,18 @@ ValidationReport CMap<D, A...>::validate() const {
       // Whether the dart each attribute records was met carrying it: checked during the walks
       // (every live dart is met once) rather than by looking each recorded dart up afterwards.
       std::vector<std::uint8_t> recorded_ok(vals.capacity(), 0);
+      // Records that dart y of the cell of `root` carries a; reports a second cell carrying it.
+      auto book_cell = [&](std::uint32_t a, std::uint32_t y, std::uint32_t root) {
+        std::uint32_t& c = cell_of[a];
+        if (c == null) {
+          c = root;
+        } else if (c != root && c != reported) [[unlikely]] {
+          r.add(K::attribute_two_cells, y, I,
+                dim + " " + s(a) + " is carried by darts of two " + std::to_string(I) + "-cells: those of darts " +
+                    s(c) + " and " + s(root));
+          c = reported;
+        }
+      };
       for_each_cell_root<I>([&](std::uint32_t root, const auto& darts) {
         const std::uint32_t a0 = st.of_dart[root];
         // The common case, a cell whose darts all carry one live attribute (or none), is booked
@@ -148,15 +160,7 @@ ValidationReport CMap<D, A...>::validate() const {
           if (a0 == null) return;
           counted[a0] += static_cast<std::uint32_t>(darts.size());
           recorded_ok[a0] |= static_cast<std::uint8_t>(has_rec);
-          std::uint32_t& c = cell_of[a0];
-          if (c == null) {
-            c = root;
-          } else if (c != reported) [[unlikely]] {
-            r.add(K::attribute_two_cells, root, I,
-                  dim + " " + s(a0) + " is carried by darts of two " + std::to_string(I) + "-cells: those of darts " +
-                      s(c) + " and " + s(root));
-            c = reported;
-          }
+          book_cell(a0, root, root);
           return;
         }
         for (std::uint32_t y : darts) {
@@ -172,15 +176,7 @@ ValidationReport CMap<D, A...>::validate() const {
           }
           ++counted[a];
           if (vals.dart(a) == y) recorded_ok[a] = 1;
-          std::uint32_t& c = cell_of[a];
-          if (c == null) {
-            c = root;
-          } else if (c != root && c != reported) [[unlikely]] {
-            r.add(K::attribute_two_cells, y, I,
-                  dim + " " + s(a) + " is carried by darts of two " + std::to_string(I) + "-cells: those of darts " +
-                      s(c) + " and " + s(root));
-            c = reported;
-          }
+          book_cell(a, y, root);
         }
       });
       for (std::uint32_t a = 0; a < vals.capacity(); ++a) {
