@@ -7,9 +7,9 @@
 // on a virtual machine). glibc's realloc would remap too, but only until the first large free:
 // its mmap threshold then rises and large blocks come from the heap, copied on every growth.
 // Small blocks use malloc/realloc. A freed mapped block is kept, its pages still populated, for
-// the next array that needs one of about its size (see MappedBlocks): a map copied or rebuilt
-// again and again then faults no pages in, as the heap spares the small blocks. T must be
-// trivially copyable; elements past size() are not kept initialised.
+// the next arrays that need it (see MappedBlocks): a map copied or rebuilt again and again then
+// faults no pages in, as the heap spares the small blocks. T must be trivially copyable;
+// elements past size() are not kept initialised.
 
 #include <algorithm>
 #include <cstddef>
@@ -28,9 +28,13 @@ namespace sewn::detail {
 
 #if defined(__linux__)
 // Mapped blocks released by PodArrays, kept for reuse up to a budget, the oldest given back to
-// the system first (the heap keeps freed memory the same way, up to its trim threshold). A block
-// is handed out only for a request of at least half its size, so that an array never holds more
-// than one doubling past its need.
+// the system first (the heap keeps freed memory the same way, up to its trim threshold). Blocks
+// are byte ranges, split and joined as the heap splits and joins its chunks: a request gets the
+// front of the smallest block that holds it and the rest stays kept, so an array reserved to its
+// exact size holds no slack of whatever array was freed before it (hex32's β array took the 2x
+// block of a map whose edges had all been split: 16 bytes per dart that nothing used); and an
+// array that grows takes the kept range right after its end, in place (a map copied and then
+// grown again and again faults no pages in).
 class MappedBlocks {
  public:
   static constexpr std::size_t budget = std::size_t{64} << 20;  // bytes kept at most
@@ -38,22 +42,44 @@ class MappedBlocks {
     static MappedBlocks blocks;
     return blocks;
   }
-  // The smallest kept block of `bytes` to 2 * `bytes`, no longer kept; {nullptr, 0} if none.
-  std::pair<void*, std::size_t> take(std::size_t bytes) {
+  // The first `bytes` of the smallest kept block that holds them, no longer kept; nullptr if none.
+  void* take(std::size_t bytes) {
     const std::lock_guard<std::mutex> lock(mutex_);
     std::size_t best = count_;
     for (std::size_t i = 0; i < count_; ++i)
-      if (blocks_[i].bytes >= bytes && blocks_[i].bytes / 2 <= bytes &&
-          (best == count_ || blocks_[i].bytes < blocks_[best].bytes))
-        best = i;
-    if (best == count_) return {nullptr, 0};
-    const Block b = blocks_[best];
-    remove(best);
-    return {b.p, b.bytes};
+      if (blocks_[i].bytes >= bytes && (best == count_ || blocks_[i].bytes < blocks_[best].bytes)) best = i;
+    if (best == count_) return nullptr;
+    return cut_front(best, bytes);
   }
-  // Keeps a block that is no longer used, unmapping the oldest ones it does not fit beside.
+  // If a kept block starts at `at` and holds `bytes`, its first `bytes` are no longer kept and
+  // true is returned: the array ending at `at` may extend over them.
+  bool take_at(void* at, std::size_t bytes) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    for (std::size_t i = 0; i < count_; ++i)
+      if (blocks_[i].p == at) {
+        if (blocks_[i].bytes < bytes) return false;
+        cut_front(i, bytes);
+        return true;
+      }
+    return false;
+  }
+  // Keeps a range that is no longer used, joined with the kept ranges it touches, unmapping the
+  // oldest ones it does not fit beside.
   void give(void* p, std::size_t bytes) {
     const std::lock_guard<std::mutex> lock(mutex_);
+    for (std::size_t i = 0; i < count_;) {
+      char* q = static_cast<char*>(blocks_[i].p);
+      if (q + blocks_[i].bytes == p) {
+        p = q;
+        bytes += blocks_[i].bytes;
+        remove(i);
+      } else if (static_cast<char*>(p) + bytes == q) {
+        bytes += blocks_[i].bytes;
+        remove(i);
+      } else {
+        ++i;
+      }
+    }
     if (bytes > budget) {
       munmap(p, bytes);
       return;
@@ -71,12 +97,24 @@ class MappedBlocks {
     void* p;
     std::size_t bytes;
   };
+  void* cut_front(std::size_t i, std::size_t bytes) {
+    Block& b = blocks_[i];
+    void* p = b.p;
+    if (b.bytes == bytes) {
+      remove(i);
+    } else {
+      b.p = static_cast<char*>(b.p) + bytes;
+      b.bytes -= bytes;
+      kept_ -= bytes;
+    }
+    return p;
+  }
   void remove(std::size_t i) {
     kept_ -= blocks_[i].bytes;
     std::copy(blocks_ + i + 1, blocks_ + count_, blocks_ + i);
     --count_;
   }
-  static constexpr std::size_t max_blocks = 16;
+  static constexpr std::size_t max_blocks = 32;
   std::mutex mutex_;
   Block blocks_[max_blocks]{};
   std::size_t count_ = 0, kept_ = 0;
@@ -150,11 +188,19 @@ class PodArray {
   }
 
  private:
-  void grow_for(std::size_t n) { set_capacity(std::max(n, cap_ < 8 ? std::size_t{8} : 2 * cap_)); }
-  // Moves the first size_ elements into a block of capacity cap (cap >= size_).
+  // A heap block doubles, as growth copies it; a mapped block grows by a quarter, as mremap
+  // copies nothing: at most a quarter of it is slack (a doubled block of 263 169 quad512
+  // vertices held 2^19 slots).
+  void grow_for(std::size_t n) {
+    const std::size_t step = mapped(cap_) ? cap_ + cap_ / 4 : (cap_ < 8 ? std::size_t{8} : 2 * cap_);
+    set_capacity(std::max(n, step));
+  }
+  // Moves the first size_ elements into a block of capacity cap (cap >= size_). A mapped block
+  // is whole pages, all of them usable and counted in capacity().
   void set_capacity(std::size_t cap) {
     if (cap > max_elements) throw std::bad_alloc();
     const bool was_mapped = mapped(cap_), now_mapped = mapped(cap);
+    if (now_mapped) cap = mapped_bytes(cap) / sizeof(T);
     T* p = nullptr;
     if (cap == 0) {
       release(data_, cap_);
@@ -162,9 +208,9 @@ class PodArray {
       p = static_cast<T*>(std::realloc(data_, cap * sizeof(T)));
       if (!p) throw std::bad_alloc();
     } else if (was_mapped && now_mapped) {
-      p = remap(data_, cap_, cap);
+      p = remap(data_, cap_, cap, size_);
     } else {  // crossing the threshold: a fresh block of the other kind
-      p = allocate(cap);  // may raise cap to a reused block's
+      p = allocate(cap);
       if (size_ != 0) std::memcpy(p, data_, size_ * sizeof(T));
       release(data_, cap_);
     }
@@ -180,25 +226,37 @@ class PodArray {
     return (cap * sizeof(T) + page - 1) / page * page;
   }
   static void ask_huge_pages(void* p, std::size_t bytes) { (void)madvise(p, bytes, MADV_HUGEPAGE); }  // a hint: failure is harmless
-  static T* allocate(std::size_t& cap) {
+  static T* allocate(std::size_t cap) {
     if (!mapped(cap)) {
       T* p = static_cast<T*>(std::malloc(cap * sizeof(T)));
       if (!p) throw std::bad_alloc();
       return p;
     }
-    if (auto [q, bytes] = MappedBlocks::instance().take(mapped_bytes(cap)); q) {
-      cap = bytes / sizeof(T);  // the whole block: what capacity() reports is what is held
-      return static_cast<T*>(q);
-    }
+    if (void* q = MappedBlocks::instance().take(mapped_bytes(cap)); q) return static_cast<T*>(q);
     void* p = mmap(nullptr, mapped_bytes(cap), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (p == MAP_FAILED) throw std::bad_alloc();
     ask_huge_pages(p, mapped_bytes(cap));
     return static_cast<T*>(p);
   }
-  static T* remap(T* p, std::size_t old_cap, std::size_t cap) {
-    void* q = mremap(p, mapped_bytes(old_cap), mapped_bytes(cap), MREMAP_MAYMOVE);
-    if (q == MAP_FAILED) throw std::bad_alloc();
-    ask_huge_pages(q, mapped_bytes(cap));
+  // Grows in place over a kept range right after the block if there is one, else moves the
+  // pages (mremap); shrinking keeps the freed tail. A block joined from two mappings cannot be
+  // moved by mremap: it is then copied into a fresh one.
+  static T* remap(T* p, std::size_t old_cap, std::size_t cap, std::size_t size) {
+    const std::size_t old_bytes = mapped_bytes(old_cap), bytes = mapped_bytes(cap);
+    char* end = reinterpret_cast<char*>(p) + old_bytes;
+    if (bytes <= old_bytes) {
+      if (bytes < old_bytes) MappedBlocks::instance().give(end - (old_bytes - bytes), old_bytes - bytes);
+      return p;
+    }
+    if (MappedBlocks::instance().take_at(end, bytes - old_bytes)) return p;
+    void* q = mremap(p, old_bytes, bytes, MREMAP_MAYMOVE);
+    if (q == MAP_FAILED) {
+      T* fresh = allocate(cap);
+      if (size != 0) std::memcpy(fresh, p, size * sizeof(T));
+      release(p, old_cap);
+      return fresh;
+    }
+    ask_huge_pages(q, bytes);
     return static_cast<T*>(q);
   }
   static void release(T* p, std::size_t cap) {
@@ -210,12 +268,13 @@ class PodArray {
   }
 #else
   static bool mapped(std::size_t) { return false; }
-  static T* allocate(std::size_t& cap) {
+  static std::size_t mapped_bytes(std::size_t cap) { return cap * sizeof(T); }
+  static T* allocate(std::size_t cap) {
     T* p = static_cast<T*>(std::malloc(cap * sizeof(T)));
     if (!p) throw std::bad_alloc();
     return p;
   }
-  static T* remap(T*, std::size_t, std::size_t) { return nullptr; }  // never called: nothing is mapped
+  static T* remap(T*, std::size_t, std::size_t, std::size_t) { return nullptr; }  // never called: nothing is mapped
   static void release(T* p, std::size_t) { std::free(p); }
 #endif
   static constexpr std::size_t max_elements = std::size_t(-1) / 2 / sizeof(T);
