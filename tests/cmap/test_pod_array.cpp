@@ -5,6 +5,10 @@
 
 #include <cstdint>
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
 #include "sewn/cmap/detail/pod_array.hpp"
 
 using sewn::detail::PodArray;
@@ -85,6 +89,27 @@ TEST_CASE("pod array: freed neighbours join, and an array grows in place over a 
   bool kept = true;
   for (std::size_t i = 0; i < g.size(); ++i) kept = kept && g[i] == i;
   CHECK(kept);
+}
+
+TEST_CASE("pod array: kept ranges of two mappings are neither joined nor extended across") {
+  // mremap moves one mapping and fails on a range across two: ranges are tagged with the
+  // mapping they lie in. One mapping stands for two here, its halves tagged apart.
+  constexpr std::size_t half = std::size_t{4} << 12;
+  char* r = static_cast<char*>(mmap(nullptr, 2 * half, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0));
+  REQUIRE(r != MAP_FAILED);
+  void* other = r + half;  // the tag of the second half
+  auto& kept = sewn::detail::MappedBlocks::instance();
+  kept.give(r, half, r);
+  kept.give(r + half, half, other);
+  CHECK(!kept.take_at(r + half, half, r));  // the array ending at r + half may not extend over it
+  CHECK(!kept.take_at(r, 2 * half, r));     // not joined: the first range is half long
+  CHECK(kept.take_at(r, half, r));
+  CHECK(kept.take_at(r + half, half, other));
+  // with one tag the halves join
+  kept.give(r, half, r);
+  kept.give(r + half, half, r);
+  CHECK(kept.take_at(r, 2 * half, r));
+  munmap(r, 2 * half);
 }
 
 TEST_CASE("pod array: a mapped array grows by a quarter, a heap one doubles") {
