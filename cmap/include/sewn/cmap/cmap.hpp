@@ -570,6 +570,10 @@ class CMap {
   void update_attributes_around(const Pairs& pairs);
 
   std::uint32_t new_dart();
+  // k new darts appended to out, as k calls of new_dart would (free slots first, same indices)
+  // but growing the arrays once: operations that make several darts at a time.
+  template <class Out>
+  void new_darts(std::uint32_t k, Out& out);
   void erase_dart_raw(std::uint32_t x);
   // insert_vertex_in_edge; `made` receives the new darts, which are the new vertex's.
   Dart split_edge(Dart d, detail::DartBuffer<32>& made);
