@@ -71,6 +71,42 @@ TEST_CASE_TEMPLATE("insert a vertex in an edge shared by several faces and volum
   CHECK(after == plus<M>(before, {1, 1}));
 }
 
+TEST_CASE_TEMPLATE("insert a vertex in an edge with a value gives the whole new vertex one attribute", M, Map1, Map2,
+                   Map3, Map4) {
+  M m;
+  Dart e = m.make_polygon(3);
+  if constexpr (M::dimension >= 3) {  // an edge of a face shared by two volumes: 4 darts around it
+    const Dart a = m.make_hexahedron(), b = m.make_hexahedron();
+    Dart partner;
+    for (Dart x : m.template cell<2>(b))
+      if (m.template is_sewable<3>(a, x)) partner = x;
+    m.template sew<3>(a, partner);
+    e = a;
+  }
+  label_all_cells(m);
+  int splits = 0;
+  m.template on_split<1>([&](AttrId<1>, AttrId<1>) { ++splits; });
+  const auto before = check_map(m);
+  const std::uint32_t vertices = m.template num_attributes<0>(), darts = m.num_darts();
+  const Dart v = m.insert_vertex_in_edge(e, 77);
+  CHECK(m.beta(e, 1) == v);
+  const auto after = check_map(m);  // validates: every dart of the vertex carries its attribute
+  CHECK(after == plus<M>(before, {1, 1}));
+  CHECK(splits == 1);
+  const AttrId<0> a = m.template attribute<0>(v);
+  REQUIRE(!a.is_null());
+  CHECK(m.value(a) == 77);
+  CHECK(m.template num_attributes<0>() == vertices + 1);
+  const auto vertex = m.template cell<0>(v);
+  CHECK(vertex.size() == m.num_darts() - darts);  // the new darts, and only they
+  for (Dart x : vertex) CHECK(m.template attribute<0>(x) == a);
+  // a dead dart is refused before anything is made
+  m.template remove_cell<0>(v);
+  CHECK_THROWS_AS(m.insert_vertex_in_edge(v, 5), TopologyError);
+  CHECK(m.template num_attributes<0>() == vertices);
+  CHECK(check_map(m) == before);
+}
+
 TEST_CASE("insert an edge in a face: 2D, and a face shared by two volumes") {
   SUBCASE("a quad becomes two triangles") {
     Map2 m;

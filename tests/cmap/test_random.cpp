@@ -144,6 +144,7 @@ TEST_CASE("randomized operation sequences on a 2-map") {
   };
   std::vector<std::pair<std::string, std::function<bool()>>> ops = {
       {"insert_vertex_in_edge", [&] { return bool(m.insert_vertex_in_edge(f.random_dart())); }},
+      {"insert_vertex_in_edge with a value", [&] { return bool(m.insert_vertex_in_edge(f.random_dart(), f.next_label++)); }},
       {"insert_edge_in_face",
        [&] {
          const Dart a = f.random_dart();
@@ -224,6 +225,7 @@ TEST_CASE("randomized operation sequences on a 3-map") {
   };
   std::vector<std::pair<std::string, std::function<bool()>>> ops = {
       {"insert_vertex_in_edge", [&] { return bool(m.insert_vertex_in_edge(f.random_dart())); }},
+      {"insert_vertex_in_edge with a value", [&] { return bool(m.insert_vertex_in_edge(f.random_dart(), f.next_label++)); }},
       {"insert_edge_in_face",
        [&] {
          const Dart a = f.random_dart();

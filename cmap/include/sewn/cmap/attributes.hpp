@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <ostream>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -96,7 +97,9 @@ class AttributeContainer {
   }
 
  private:
-  std::vector<T> values_;
+  // Plain values grow as the per-dart arrays do (a mapped block grows by a quarter, see
+  // PodArray); std::vector would double them.
+  std::conditional_t<std::is_trivially_copyable_v<T>, detail::PodArray<T>, std::vector<T>> values_;
   detail::PodArray<std::uint32_t> dart_;   // one dart of the cell, `dead` for a free slot
   detail::PodArray<std::uint32_t> count_;  // darts referring to the slot
   std::vector<std::uint32_t> free_;

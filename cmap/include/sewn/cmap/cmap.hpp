@@ -370,7 +370,25 @@ class CMap {
   /// Splits the edge of d at a new vertex. Returns the new dart following d in its face (it
   /// starts at the new vertex). The edge's attribute is copied to the second half (on_split);
   /// the new vertex gets no 0-attribute. O(edge).
-  Dart insert_vertex_in_edge(Dart d);
+  Dart insert_vertex_in_edge(Dart d) {
+    detail::DartBuffer<32> made;
+    return split_edge(d, made);
+  }
+  /// As insert_vertex_in_edge(d) followed by set_attribute<0> on the new vertex with v (on_split
+  /// fires for the edge before the vertex has its attribute), without walking the vertex: its
+  /// darts are the ones the split made. O(edge).
+  template <int I = 0>
+    requires(I == 0 && has_attribute<0>)
+  Dart insert_vertex_in_edge(Dart d, attribute_type<I> v) {
+    detail::DartBuffer<32> made;
+    const Dart nd = split_edge(d, made);
+    auto& st = store<0>();
+    const std::uint32_t a = st.values.create(std::move(v));
+    for (std::uint32_t x : made) st.of_dart[x] = a;
+    st.values.add_count(a, static_cast<std::int64_t>(made.size()));
+    st.values.set_dart(a, nd.index());
+    return nd;
+  }
   /// True if insert_edge_in_face(a, b) may be called: a ≠ b, both live, b on a's closed β1 cycle.
   [[nodiscard]] bool is_insertable_edge_in_face(Dart a, Dart b) const;
   /// Splits the face of a and b by a new edge from a's start vertex to b's start vertex (D ≥ 2;
@@ -552,7 +570,13 @@ class CMap {
   void update_attributes_around(const Pairs& pairs);
 
   std::uint32_t new_dart();
+  // k new darts appended to out, as k calls of new_dart would (free slots first, same indices)
+  // but growing the arrays once: operations that make several darts at a time.
+  template <class Out>
+  void new_darts(std::uint32_t k, Out& out);
   void erase_dart_raw(std::uint32_t x);
+  // insert_vertex_in_edge; `made` receives the new darts, which are the new vertex's.
+  Dart split_edge(Dart d, detail::DartBuffer<32>& made);
   // A bit per dimension whose attributes are enabled: work that only serves attributes is
   // skipped at compile time when an operation's dimensions have none.
   static constexpr unsigned attribute_dims = []<int... I>(std::integer_sequence<int, I...>) {

@@ -46,6 +46,25 @@ std::uint32_t CMap<D, A...>::new_dart() {
 }
 
 template <int D, class... A>
+template <class Out>
+void CMap<D, A...>::new_darts(std::uint32_t k, Out& out) {
+  for (; k != 0 && free_head_ != detail::null_index; --k) out.push_back(new_dart());
+  if (k == 0) return;
+  const auto x0 = static_cast<std::uint32_t>(beta_.size());
+  if (x0 + std::uint64_t{k} > detail::dead_marker - 1)
+    throw CapacityError("cmap: the map cannot hold more than 2^32 - 3 darts");
+  std::array<std::uint32_t, D + 1> unlinked;
+  unlinked.fill(detail::null_index);
+  beta_.resize(x0 + k, unlinked);
+  for_each_dim([&](auto kk) {
+    if constexpr (has_attribute<kk()>) store<kk()>().of_dart.resize(x0 + k, detail::null_index);
+  });
+  if ((x0 + 63) / 64 != (x0 + k + 63) / 64) marks_.resize(x0 + k);
+  alive_ += k;
+  for (std::uint32_t i = 0; i < k; ++i) out.push_back(x0 + i);
+}
+
+template <int D, class... A>
 Dart CMap<D, A...>::create_dart() {
   return Dart(new_dart());
 }

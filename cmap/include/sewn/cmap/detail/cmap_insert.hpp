@@ -5,15 +5,16 @@
 namespace sewn {
 
 template <int D, class... A>
-Dart CMap<D, A...>::insert_vertex_in_edge(Dart d) {
+Dart CMap<D, A...>::split_edge(Dart d, detail::DartBuffer<32>& made) {
   check_alive(d, "insert_vertex_in_edge");
   constexpr std::uint32_t null = detail::null_index;
   // 1) the darts of the edge (every dart on it, in every face and volume)
   detail::DartBuffer<32> edge;
   collect_cell_unmarked<1>(d.index(), edge);
   // 2) a new dart after each of them, in its face: x -> x' -> old β1(x)
-  for (std::uint32_t x : edge) {
-    const std::uint32_t nx = new_dart(), next = b(x, 1);
+  new_darts(static_cast<std::uint32_t>(edge.size()), made);
+  for (std::size_t i = 0; i < edge.size(); ++i) {
+    const std::uint32_t x = edge[i], nx = made[i], next = b(x, 1);
     inherit_attributes(x, nx, ~1u);  // same edge (for now), face, volume...; a new vertex
     raw_link(nx, 1, next);
     raw_link(x, 1, nx);

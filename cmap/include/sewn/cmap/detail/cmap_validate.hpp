@@ -31,8 +31,7 @@ ValidationReport CMap<D, A...>::validate() const {
   // 2) links: live targets, β0 = β1⁻¹, involutions, commuting pairs. A lean test settles the
   //    darts whose links are sound (all of them in a valid map); a dart it rejects is checked
   //    again by `report_links`, which names each broken link. Kept apart, the lean test keeps
-  //    its pointers in registers, and it asks for the rows of βi partners (i ≥ 2, anywhere in
-  //    the map) a few darts ahead, so that their cache misses overlap.
+  //    its pointers in registers.
   const std::array<std::uint32_t, D + 1>* rows = beta_.data();
   auto sound = [rows, cap](std::uint32_t x) {
     const std::array<std::uint32_t, D + 1> row = rows[x];
@@ -110,11 +109,7 @@ ValidationReport CMap<D, A...>::validate() const {
                     std::to_string(i) + "(beta" + std::to_string(j) + ") = " + s(ji));
       }
   };
-  constexpr std::uint32_t ahead = 16;
   for (std::uint32_t x = 0; x < cap; ++x) {
-    if (x + ahead < cap)
-      for (int i = 2; i <= D; ++i)
-        if (const std::uint32_t y = rows[x + ahead][static_cast<std::size_t>(i)]; y < cap) __builtin_prefetch(&rows[y]);
     if (rows[x][0] != detail::dead_marker && !sound(x)) [[unlikely]]
       report_links(x);
   }
@@ -137,6 +132,18 @@ ValidationReport CMap<D, A...>::validate() const {
       // Whether the dart each attribute records was met carrying it: checked during the walks
       // (every live dart is met once) rather than by looking each recorded dart up afterwards.
       std::vector<std::uint8_t> recorded_ok(vals.capacity(), 0);
+      // Records that dart y of the cell of `root` carries a; reports a second cell carrying it.
+      auto book_cell = [&](std::uint32_t a, std::uint32_t y, std::uint32_t root) {
+        std::uint32_t& c = cell_of[a];
+        if (c == null) {
+          c = root;
+        } else if (c != root && c != reported) [[unlikely]] {
+          r.add(K::attribute_two_cells, y, I,
+                dim + " " + s(a) + " is carried by darts of two " + std::to_string(I) + "-cells: those of darts " +
+                    s(c) + " and " + s(root));
+          c = reported;
+        }
+      };
       for_each_cell_root<I>([&](std::uint32_t root, const auto& darts) {
         const std::uint32_t a0 = st.of_dart[root];
         // The common case, a cell whose darts all carry one live attribute (or none), is booked
@@ -153,15 +160,7 @@ ValidationReport CMap<D, A...>::validate() const {
           if (a0 == null) return;
           counted[a0] += static_cast<std::uint32_t>(darts.size());
           recorded_ok[a0] |= static_cast<std::uint8_t>(has_rec);
-          std::uint32_t& c = cell_of[a0];
-          if (c == null) {
-            c = root;
-          } else if (c != reported) [[unlikely]] {
-            r.add(K::attribute_two_cells, root, I,
-                  dim + " " + s(a0) + " is carried by darts of two " + std::to_string(I) + "-cells: those of darts " +
-                      s(c) + " and " + s(root));
-            c = reported;
-          }
+          book_cell(a0, root, root);
           return;
         }
         for (std::uint32_t y : darts) {
@@ -177,15 +176,7 @@ ValidationReport CMap<D, A...>::validate() const {
           }
           ++counted[a];
           if (vals.dart(a) == y) recorded_ok[a] = 1;
-          std::uint32_t& c = cell_of[a];
-          if (c == null) {
-            c = root;
-          } else if (c != root && c != reported) [[unlikely]] {
-            r.add(K::attribute_two_cells, y, I,
-                  dim + " " + s(a) + " is carried by darts of two " + std::to_string(I) + "-cells: those of darts " +
-                      s(c) + " and " + s(root));
-            c = reported;
-          }
+          book_cell(a, y, root);
         }
       });
       for (std::uint32_t a = 0; a < vals.capacity(); ++a) {
