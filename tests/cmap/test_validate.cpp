@@ -133,6 +133,55 @@ TEST_CASE("validate: darts of one cell carrying different attributes are named")
   CHECK(report.str().find("carry") != std::string::npos);
 }
 
+// Vertices of a 2-map and edges of a 3-map are chain cells, whose attributes validate() first
+// checks dart by dart with their neighbours, walking only one cell per attribute.
+TEST_CASE("validate: chain cells carrying different attributes, or one attribute in two cells, are named") {
+  SUBCASE("vertices of a 2-map merged by a link") {
+    CMap<2, int> m;
+    const Dart p = m.make_quad(), q = m.make_quad();
+    m.create_attributes<0>([](Dart d) { return static_cast<int>(d.index()); });
+    m.link<2>(p, q);
+    const auto report = m.validate();
+    const ValidationIssue* i = find(report, Kind::attribute_mismatch);
+    REQUIRE(i != nullptr);
+    CHECK(i->index == 0);
+  }
+  SUBCASE("vertices of a 2-map split by an unlink") {
+    CMap<2, int> m;
+    const Dart p = m.make_quad(), q = m.make_quad();
+    m.sew<2>(p, q);
+    m.create_attributes<0>([](Dart d) { return static_cast<int>(d.index()); });
+    REQUIRE(m.validate().ok());
+    m.unlink<2>(p);
+    const auto report = m.validate();
+    const ValidationIssue* i = find(report, Kind::attribute_two_cells);
+    REQUIRE(i != nullptr);
+    CHECK(i->index == 0);
+  }
+  SUBCASE("edges of a 3-map merged by a link, then split by an unlink") {
+    CMap<3, void, int> m;
+    const Dart a = m.make_hexahedron(), b = m.make_hexahedron();
+    Dart partner;
+    for (Dart x : m.cell<2>(b))
+      if (m.is_sewable<3>(a, x)) partner = x;
+    m.create_attributes<1>([](Dart d) { return static_cast<int>(d.index()); });
+    m.link<3>(a, partner);
+    const auto merged = m.validate();
+    const ValidationIssue* i = find(merged, Kind::attribute_mismatch);
+    REQUIRE(i != nullptr);
+    CHECK(i->index == 1);
+    m.unlink<3>(a);
+    REQUIRE(m.validate().ok());
+    m.sew<3>(a, partner);
+    REQUIRE(m.validate().ok());
+    m.unlink<3>(a);
+    const auto split = m.validate();
+    i = find(split, Kind::attribute_two_cells);
+    REQUIRE(i != nullptr);
+    CHECK(i->index == 1);
+  }
+}
+
 TEST_CASE("validate: a built grid is valid, and stays valid through cuts") {
   CMap<3, int, int, int, int> m;
   build(m, hex_grid(3, 3, 3));

@@ -523,6 +523,10 @@ class CMap {
   // True if x is the smallest dart of its I-cell (a chain cell).
   template <int I>
   [[nodiscard]] bool is_chain_root(std::uint32_t x) const;
+  // True if the I-attributes (I a chain cell) pass every check of validate(), found without
+  // walking every cell; false if validate() must look closer. Links must be sound.
+  template <int I>
+  [[nodiscard]] bool chain_attributes_sound() const;
   // Cells whose smallest dart is recognised without marks: chain cells, and the faces of a
   // 3-map (a β1 cycle and its β3 partner's, checked to have that shape).
   template <int I>

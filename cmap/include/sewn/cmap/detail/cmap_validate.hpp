@@ -4,6 +4,43 @@
 namespace sewn {
 
 template <int D, class... A>
+template <int I>
+bool CMap<D, A...>::chain_attributes_sound() const {
+  constexpr std::uint32_t null = detail::null_index;
+  const auto& st = store<I>();
+  const auto& vals = st.values;
+  const auto cap = static_cast<std::uint32_t>(beta_.size());
+  const std::uint32_t slots = vals.capacity();
+  const std::uint32_t* of = st.of_dart.data();
+  // 1) how many darts carry each attribute: the attribute indices alone, in order (a dead dart
+  //    carries none; one that did would only send validate() the long way)
+  std::vector<std::uint32_t> counted(slots, 0);
+  for (std::uint32_t x = 0; x < cap; ++x) {
+    const std::uint32_t a = of[x];
+    if (a == null) continue;
+    if (a >= slots) return false;
+    ++counted[a];
+  }
+  // 2) each live attribute: its reference count, and the cell of its recorded dart, walked,
+  //    is exactly the darts that carry it. Then no other cell carries it, no cell carries it in
+  //    part, and every other cell carries none.
+  for (std::uint32_t a = 0; a < slots; ++a) {
+    if (!vals.is_alive(a)) {
+      if (counted[a] != 0) return false;
+      continue;
+    }
+    const std::uint32_t n = counted[a];
+    if (n == 0 || n != vals.count(a)) return false;
+    const std::uint32_t d = vals.dart(a);
+    if (d >= cap || !is_live_index(d) || of[d] != a) return false;
+    std::uint32_t size = 1;
+    const bool whole = walk_chain_cell<I>(d, [&](std::uint32_t y) { return of[y] == a && ++size <= n; });
+    if (!whole || size != n) return false;
+  }
+  return true;
+}
+
+template <int D, class... A>
 ValidationReport CMap<D, A...>::validate() const {
   using K = ValidationIssue::Kind;
   constexpr std::uint32_t null = detail::null_index;
@@ -35,12 +72,14 @@ ValidationReport CMap<D, A...>::validate() const {
   const std::array<std::uint32_t, D + 1>* rows = beta_.data();
   auto sound = [rows, cap](std::uint32_t x) {
     const std::array<std::uint32_t, D + 1> row = rows[x];
-    for (int i = 0; i <= D; ++i) {
-      const std::uint32_t y = row[static_cast<std::size_t>(i)];
-      if (y != null && (y >= cap || rows[y][0] == detail::dead_marker)) return false;
-    }
+    bool outside = false;  // null + 1 wraps to 0
+    for (int i = 0; i <= D; ++i) outside |= row[static_cast<std::size_t>(i)] + 1u > cap;
+    if (outside) return false;
+    // A dead dart's β0 is the dead marker and its βi (i ≥ 2) are null, so a link to one fails
+    // the inverse checks below; only β0's target is checked alive, as a dead dart's β1 threads
+    // the free list.
     if (row[1] != null && rows[row[1]][0] != x) return false;
-    if (row[0] != null && rows[row[0]][1] != x) return false;
+    if (row[0] != null && (rows[row[0]][1] != x || rows[row[0]][0] == detail::dead_marker)) return false;
     for (int i = 2; i <= D; ++i) {
       const std::uint32_t y = row[static_cast<std::size_t>(i)];
       if (y == x || (y != null && rows[y][static_cast<std::size_t>(i)] != x)) return false;
@@ -121,6 +160,8 @@ ValidationReport CMap<D, A...>::validate() const {
   for_each_dim([&](auto k) {
     constexpr int I = k();
     if constexpr (has_attribute<I>) {
+      if constexpr (chain_cell<I>)
+        if (chain_attributes_sound<I>()) return;  // nothing to report
       const auto& st = store<I>();
       const auto& vals = st.values;
       const std::string dim = std::to_string(I) + "-attribute";
