@@ -433,8 +433,8 @@ void SpringRuns::forces(const SpringArrays& a, RunDamping damping, double beta, 
     case RunDamping::viscous: run.template operator()<RunDamping::viscous>(); break;
     case RunDamping::stiffness_proportional: run.template operator()<RunDamping::stiffness_proportional>(); break;
   }
-  rest_floor = n;
-  join_until(n);
+  // Every spring is done: the nodes not joined yet are final.
+  join_axes(s, f.data(), joined_to, n, accumulate);
 }
 
 }  // namespace sewn::physics::detail
