@@ -217,3 +217,82 @@ TEST_CASE("traversals end on a map whose links are inconsistent") {
   (void)m.count_all();
   CHECK(m.num_reserved_marks() == 0);
 }
+
+namespace {
+
+// The darts of a 3-map from which no smaller dart is reached by β0, β1 and β3, found by a
+// search of their own from each dart: in a valid map the smallest dart of each face; with
+// inconsistent links, where "face" loses its meaning, the darts cells<2>() must still yield.
+std::vector<std::uint32_t> face_roots(const CMap<3>& m) {
+  const std::uint32_t cap = m.dart_capacity();
+  std::vector<std::uint32_t> roots;
+  for (std::uint32_t s = 0; s < cap; ++s) {
+    if (!m.is_alive(Dart(s))) continue;
+    std::vector<char> seen(cap, 0);
+    std::vector<std::uint32_t> todo{s};
+    seen[s] = 1;
+    bool least = true;
+    while (!todo.empty() && least) {
+      const std::uint32_t x = todo.back();
+      todo.pop_back();
+      least = x >= s;
+      for (int i : {0, 1, 3}) {
+        const std::uint32_t y = m.b(x, i);
+        if (y != Dart::null_index && !seen[y]) {
+          seen[y] = 1;
+          todo.push_back(y);
+        }
+      }
+    }
+    if (least) roots.push_back(s);
+  }
+  return roots;
+}
+
+std::vector<std::uint32_t> ranged_faces(const CMap<3>& m) {
+  std::vector<std::uint32_t> out;
+  for (Dart d : m.cells<2>()) out.push_back(d.index());
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("faces of a 3-map whose links low-level calls left inconsistent are still found exactly") {
+  // A pentagon (darts 0-4) and two squares q (5-8) and u (9-12), q and u 3-sewn as a valid face.
+  CMap<3> m;
+  (void)m.make_polygon(5);
+  const Dart q = m.make_polygon(4), u = m.make_polygon(4);
+  REQUIRE(q.index() == 5);
+  REQUIRE(u.index() == 9);
+  m.sew<3>(q, u);
+  REQUIRE(m.validate().ok());
+  CHECK(face_roots(m) == std::vector<std::uint32_t>{0, 5});
+  CHECK(ranged_faces(m) == std::vector<std::uint32_t>{0, 5});
+  // Splice dart 0 into u's cycle (β1(12) = 0, β1(0) = 9): q and u's face now reaches 0 through
+  // β1 of a partner dart, though every dart of q and each β3 of them is larger than 5. Only a
+  // walk that checks the links' shape (or a mark) sees that 5 is not the smallest of its face.
+  m.link_beta<1>(Dart(12), Dart(0));
+  m.link_beta<1>(Dart(0), Dart(9));
+  const std::vector<std::uint32_t> want = face_roots(m);
+  CHECK(want == std::vector<std::uint32_t>{0});
+  CHECK(ranged_faces(m) == want);
+  CHECK(m.count<2>() == want.size());
+  // A grid built into the same map keeps its links sound, but must not vouch for the rest.
+  (void)build(m, hex_grid(2, 1, 1));
+  CHECK(face_roots(m).size() == 1 + 11);
+  CHECK(ranged_faces(m) == face_roots(m));
+  CHECK_FALSE(m.validate().ok());
+  CHECK(ranged_faces(m) == face_roots(m));
+  // Repaired by hand: each ring closed again on its own.
+  m.link_beta<1>(Dart(0), Dart(1));
+  m.link_beta<1>(Dart(4), Dart(0));
+  m.link_beta<1>(Dart(12), Dart(9));
+  REQUIRE(m.validate().ok());
+  const std::vector<std::uint32_t> roots = face_roots(m);
+  REQUIRE(roots.size() == 2 + 11);
+  CHECK(roots[0] == 0);
+  CHECK(roots[1] == 5);
+  CHECK(ranged_faces(m) == roots);
+  CHECK(m.count<2>() == roots.size());
+  CHECK(m.num_reserved_marks() == 0);
+}

@@ -289,6 +289,8 @@ BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOption
   }
   if (!opt.sew) return res;
 
+  // link_beta below marks the links unsound; every orbit it touches is complete on return.
+  const bool links_sound = detail::LinkSoundness::get(map);
   // 4) glue facets shared by exactly two cells of the same dimension: 2D cells along edges
   //    (β2) if they run along them in opposite directions, volumes across faces (β3)
   auto start_of = [&](std::uint32_t x) { return res.vertex_of_dart[x]; };
@@ -364,6 +366,7 @@ BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOption
     }
     ++res.sewn_facets;
   });
+  detail::LinkSoundness::restore(map, links_sound);
   return res;
 }
 

@@ -93,6 +93,15 @@ struct StoreTuple<std::integer_sequence<int, I...>, A...> {
 inline constexpr std::uint32_t null_index = Dart::null_index;
 inline constexpr std::uint32_t dead_marker = Dart::null_index - 1;  // β0 of a free-listed dart
 
+// For builders in sibling headers that link with link_beta and complete every orbit they
+// touch: they read whether the links were sound before and say so again when done.
+struct LinkSoundness {
+  template <class Map>
+  static bool get(const Map& m) { return m.links_sound_; }
+  template <class Map>
+  static void restore(const Map& m, bool sound) { m.links_sound_ = sound; }
+};
+
 }  // namespace detail
 
 /// A face table checked once and ready to instantiate: each half-edge (a dart-to-be, in table
@@ -335,9 +344,12 @@ class CMap {
   void unlink(Dart d);
   /// Low level: sets βI(a) = b and its inverse, nothing else. For builders that complete whole
   /// orbits themselves; the map is invalid until they do. Throws TopologyError on dead darts.
+  /// Until a validate() finds the links sound again, face traversals of a 3-map check the
+  /// links' shape as they go (a little slower) instead of relying on it.
   template <int I>
   void link_beta(Dart a, Dart b);
-  /// Low level: makes d I-free (and its partner's inverse link), nothing else.
+  /// Low level: makes d I-free (and its partner's inverse link), nothing else. As link_beta,
+  /// face traversals check the links' shape until a validate() finds them sound.
   template <int I>
   void unlink_beta(Dart d);
 
@@ -427,7 +439,8 @@ class CMap {
   /// Checks every invariant and names each violation with its dart: β0∘β1 = id, βi involutions
   /// without fixed points (i ≥ 2), βi∘βj involutions for i+2 ≤ j, links to live darts only,
   /// attribute consistency (one attribute per cell, reference counts, no orphan, one cell per
-  /// attribute), the free list, and marks. O(n·D²).
+  /// attribute), the free list, and marks. O(n·D²). A report with sound links (and free list)
+  /// lets face traversals rely on the links again after link_beta / unlink_beta.
   [[nodiscard]] ValidationReport validate() const;
 
   // ---------------------------------------------------------------- internals for sibling headers
@@ -535,10 +548,11 @@ class CMap {
   // neighbour in their own row and stop there; the others walk the face (face_root_walk).
   [[nodiscard]] bool is_face_root(std::uint32_t x) const {
     const auto& r = beta_[x];
-    auto smaller = [x](std::uint32_t y) { return y != detail::null_index && y < x; };
-    return !(smaller(r[0]) || smaller(r[1]) || smaller(r[3])) && face_root_walk(x);
+    // null is the largest index, so a free link never counts as smaller.
+    return !(r[0] < x || r[1] < x || r[3] < x) && face_root_walk(x);
   }
   [[nodiscard]] bool face_root_walk(std::uint32_t x) const;
+  [[nodiscard, gnu::noinline]] bool face_root_by_mark(std::uint32_t x) const;
   template <int I>
   [[nodiscard]] bool is_cell_root(std::uint32_t x) const {
     static_assert(rooted_without_marks<I>);
@@ -638,6 +652,11 @@ class CMap {
   Stores stores_;
   mutable detail::MarkPlanes marks_;
   bool hooks_on_ = true;
+  friend struct detail::LinkSoundness;
+  // The β links are known to pass validate()'s link checks: true from construction (every
+  // operation but link_beta / unlink_beta keeps sound links sound), false after those two,
+  // true again after a validate() that finds no broken link.
+  mutable bool links_sound_ = true;
   std::vector<std::pair<int, std::uint32_t>> pending_erase_;  // (dimension, attribute) to free
 };
 

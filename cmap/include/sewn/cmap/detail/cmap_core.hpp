@@ -164,6 +164,7 @@ void CMap<D, A...>::link_beta(Dart a, Dart b2) {
   static_assert(I >= 0 && I <= D);
   check_alive(a, "link_beta");
   check_alive(b2, "link_beta");
+  links_sound_ = false;
   raw_link(a.index(), I, b2.index());
 }
 
@@ -175,6 +176,7 @@ void CMap<D, A...>::unlink_beta(Dart d) {
   const std::uint32_t x = d.index();
   const std::uint32_t y = b(x, I);
   if (y == detail::null_index) return;
+  links_sound_ = false;
   constexpr int inv = I == 0 ? 1 : (I == 1 ? 0 : I);
   set_b(x, I, detail::null_index);
   set_b(y, inv, detail::null_index);
@@ -202,6 +204,7 @@ void CMap<D, A...>::clear() {
   });
   marks_.clear_storage();
   pending_erase_.clear();
+  links_sound_ = true;  // no links left
 }
 
 template <int D, class... A>

@@ -323,35 +323,42 @@ bool CMap<D, A...>::is_chain_root(std::uint32_t x) const {
 }
 
 template <int D, class... A>
+bool CMap<D, A...>::face_root_by_mark(std::uint32_t x) const {
+  DartList face;
+  collect_cell_unmarked<2>(x, face);
+  return std::all_of(face.begin(), face.end(), [x](Dart d) { return d.index() >= x; });
+}
+
+template <int D, class... A>
 bool CMap<D, A...>::face_root_walk(std::uint32_t x) const {
   static_assert(D == 3);
   constexpr std::uint32_t null = detail::null_index;
-  auto by_mark = [&] {
-    DartList face;
-    collect_cell_unmarked<2>(x, face);
-    return std::all_of(face.begin(), face.end(), [x](Dart d) { return d.index() >= x; });
-  };
-  // A face is x's β1 cycle z and, if x is 3-sewn, its partner's cycle w, run the other way
-  // (β3∘β1 = β0∘β3). Both are walked together, each dart checked to be larger than x and its
-  // links to have this shape, which proves the two cycles are the whole orbit (closed under β0,
-  // β1, β3). Any other shape (an open or partly sewn face, inconsistent links) is settled by
-  // collecting the orbit with a mark.
-  const std::uint32_t w0 = b(x, 3);
-  std::uint32_t z = x, w = w0;
+  // A face is x's β1 cycle z and, if x is 3-sewn, its partner's cycle w = β3(z), run the other
+  // way (β3∘β1 = β0∘β3). The walk follows z and checks each dart of z and w to be larger than x;
+  // each w is read from its z, so the partner's rows are not needed for that. β1(z) and β3(z)
+  // lie in the orbit whatever its shape, so a smaller one answers at once. When the links are
+  // not known sound, the walk also checks that they have this shape (z closed under β0 and β1,
+  // w under β0, β1 and β3), which proves the two cycles are the whole orbit; that loads the
+  // partner's rows too (each from its z, so the loads overlap), a cache miss per face on a
+  // large mesh. An open face, or links of another shape, is settled by collecting the orbit
+  // with a mark.
+  const auto* rows = beta_.data();
+  const bool sewn = rows[x][3] != null;
+  const bool checked = !links_sound_;
+  std::uint32_t z = x;
   for (std::uint32_t budget = dart_capacity(); budget != 0; --budget) {
-    const std::uint32_t z1 = b(z, 1);
-    if (z1 == null || b(z1, 0) != z || b(z, 3) != w) return by_mark();
-    if (z1 < x) return false;
-    if (w != null) {
-      const std::uint32_t w1 = b(w, 0);
-      if (w < x) return false;
-      if (b(w, 3) != z || w1 == null || b(w1, 1) != w) return by_mark();
-      w = w1;
+    const std::uint32_t z1 = rows[z][1], w = rows[z][3];
+    if (z1 < x || w < x) return false;
+    if (z1 == null) return face_root_by_mark(x);
+    if (checked) {
+      const std::uint32_t w1 = rows[z1][3];
+      if (rows[z1][0] != z || (sewn ? w1 == null || rows[w][3] != z || rows[w][0] != w1 || rows[w1][1] != w : w1 != null))
+        return face_root_by_mark(x);
     }
     z = z1;
-    if (z == x) return w == w0 || by_mark();
+    if (z == x) return true;
   }
-  return by_mark();
+  return face_root_by_mark(x);
 }
 
 template <int D, class... A>

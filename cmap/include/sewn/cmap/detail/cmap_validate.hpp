@@ -152,6 +152,7 @@ ValidationReport CMap<D, A...>::validate() const {
     if (rows[x][0] != detail::dead_marker && !sound(x)) [[unlikely]]
       report_links(x);
   }
+  links_sound_ = r.ok();
   if (!r.ok()) return r;  // attribute checks traverse orbits and need sound links
 
   // 3) attributes, walking each cell once: every dart carries the attribute of the cell's
