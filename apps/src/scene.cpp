@@ -1,12 +1,23 @@
 #include "sewn/apps/scene.hpp"
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "json_file.hpp"
+#include "sewn/io/render.hpp"
+
 namespace sewn::app {
 
 namespace {
+
+// Point indices are 32-bit; the largest value is kept as the "no point" marker.
+constexpr double max_point_index = 4294967294.0;
+constexpr std::size_t max_name_length = 100;
+constexpr double default_memory_limit = 8e9;  // bytes
+constexpr double default_step_limit = 1e8;
 
 Field selector_schema(std::string key, std::string doc) {
   Field s = field(std::move(key), Kind::object);
@@ -20,9 +31,9 @@ Field selector_schema(std::string key, std::string doc) {
             {field("center", Kind::vec3).unit("m").required().doc("Centre."),
              field("radius", Kind::number).unit("m").required().above(0).doc("Radius.")});
   s.variant("tag", "Cells carrying a mesh tag (Gmsh physical group, MEDIT reference); for points: points of such cells.",
-            {field("tag", Kind::integer).required().doc("The tag.")});
+            {field("tag", Kind::integer).required().at_least(-2147483648.0).at_most(2147483647.0).doc("The tag (a 32-bit signed integer).")});
   s.variant("points", "Mesh points by index (cells: all of whose points are listed).",
-            {field("indices", Kind::number_list).required().at_least(0).items(1, 1u << 30).doc("Point indices.")});
+            {field("indices", Kind::number_list).required().whole().at_least(0).at_most(max_point_index).items(1, 1u << 30).doc("Point indices.")});
   return s;
 }
 
@@ -52,10 +63,10 @@ Field build_schema() {
       field("material", Kind::string).required().doc("Name of the material of every cell (see `regions` for exceptions)."),
       field("regions", Kind::array).of(region).fallback(nlohmann::json::array()).doc("Per-region materials."),
   });
-  auto cells3 = field("cells", Kind::number_list).items(3, 3).at_least(1).at_most(4096).required().doc("Cells along x, y, z (whole numbers).");
+  auto cells3 = field("cells", Kind::number_list).items(3, 3).whole().at_least(1).at_most(4096).required().doc("Cells along x, y, z (whole numbers).");
   auto size3 = field("size", Kind::vec3).unit("m").above(0).required().doc("Extent along x, y, z.");
   auto origin = field("origin", Kind::vec3).unit("m").fallback({0.0, 0.0, 0.0}).doc("Position of the minimum corner (or centre, for discs and cylinders).");
-  auto cells2 = field("cells", Kind::number_list).items(2, 2).at_least(1).at_most(65536).required().doc("Cells along the two in-plane axes.");
+  auto cells2 = field("cells", Kind::number_list).items(2, 2).whole().at_least(1).at_most(65536).required().doc("Cells along the two in-plane axes.");
   auto size2 = field("size", Kind::number_list).items(2, 2).unit("m").above(0).required().doc("Extent along the two in-plane axes.");
   auto plane = field("plane", Kind::string).one_of({"xy", "xz", "yz"}).fallback("xy").doc("The plane the membrane lies in.");
   mesh.variant("hex_grid", "A box of hexahedra.", {cells3, size3, origin});
@@ -79,8 +90,8 @@ Field build_schema() {
                 origin});
   Field box = field("box", Kind::object);
   box.doc("Lattice cells [min, max) along x, y, z (whole numbers, max exclusive).")
-      .members({field("min", Kind::number_list).items(3, 3).at_least(-1e6).at_most(1e6).required().doc("First cell."),
-                field("max", Kind::number_list).items(3, 3).at_least(-1e6).at_most(1e6).required().doc("One past the last cell.")});
+      .members({field("min", Kind::number_list).items(3, 3).whole().at_least(-1e6).at_most(1e6).required().doc("First cell."),
+                field("max", Kind::number_list).items(3, 3).whole().at_least(-1e6).at_most(1e6).required().doc("One past the last cell.")});
   mesh.variant("boxes",
                "A union of boxes of hexahedra on one lattice (a voxel shape): boxes that touch share points, so they form one body.",
                {field("spacing", Kind::vec3).unit("m").above(0).required().doc("Size of a lattice cell."), origin,
@@ -108,10 +119,10 @@ Field build_schema() {
                field("normal", Kind::vec3).required().doc("Its normal (any length but zero)."),
                selector_schema("within", "Only faces whose centroid lies in this region.")});
   cut.variant("faces", "Explicit faces, each given by its mesh point indices.",
-              {field("faces", Kind::array).of(field("face", Kind::number_list).items(2, 4).at_least(0)).items(1, 1u << 24).required()
+              {field("faces", Kind::array).of(field("face", Kind::number_list).items(2, 4).whole().at_least(0).at_most(max_point_index)).items(1, 1u << 24).required()
                    .doc("Each face as 3 or 4 point indices (2 for an edge of a 2D mesh).")});
   cut.variant("particles", "Every inner face (edge) all of whose points are among the listed particles: a cut along a path.",
-              {field("particles", Kind::number_list).at_least(0).items(2, 1u << 30).required().doc("Mesh point indices.")});
+              {field("particles", Kind::number_list).whole().at_least(0).at_most(max_point_index).items(2, 1u << 30).required().doc("Mesh point indices.")});
   cut.variant("pierce", "Unsew every face of the volumes whose centroid lies in a region.",
               {selector_schema("where", "Volumes to free.").required(),
                field("remove", Kind::boolean).fallback(true).doc("Remove the freed volumes (true) or keep them as loose pieces.")});
@@ -122,8 +133,8 @@ Field build_schema() {
                 field("color_by", Kind::string).one_of({"displacement", "speed", "force", "fixed", "material"})
                     .fallback("displacement").doc("Per-point quantity shown by colour."),
                 field("style", Kind::string).one_of({"shaded", "wireframe"}).fallback("shaded").doc("Drawing style."),
-                field("width", Kind::integer).fallback(1280).at_least(64).at_most(8192).unit("px").doc("Width."),
-                field("height", Kind::integer).fallback(800).at_least(64).at_most(8192).unit("px").doc("Height.")});
+                field("width", Kind::integer).fallback(1280).at_least(io::min_render_width).at_most(8192).unit("px").doc("Width."),
+                field("height", Kind::integer).fallback(800).at_least(io::min_render_height).at_most(8192).unit("px").doc("Height.")});
   Field output = field("output", Kind::object);
   output.doc("What is written to the output folder (`--out`, default `out/<name>/`).")
       .fallback(nlohmann::json::object())
@@ -152,10 +163,18 @@ Field build_schema() {
                 field("allow_unstable", Kind::boolean).fallback(false)
                     .doc("Run a semi-implicit step larger than the estimated stable bound (otherwise refused with the bound).")});
 
+  Field limits = field("limits", Kind::object);
+  limits.doc("Bounds on what a scene may ask for, checked when it is read, before anything is built: a scene over them is refused with the estimate, and runs only if it raises the limit here.")
+      .fallback(nlohmann::json::object())
+      .members({field("memory", Kind::number).unit("bytes").fallback(default_memory_limit).above(0)
+                    .doc("Largest memory the generated meshes may need, estimated from their cell counts (about 4.4 kB per hexahedron, 2.5 kB per quad, 1.3 kB per triangle, 1.2 kB per tetrahedron, 1 kB per segment, measured on this code; mesh files are not counted)."),
+                field("steps", Kind::number).fallback(default_step_limit).above(0)
+                    .doc("Most time steps the run may take (duration / integrator.step).")});
+
   Field root = field("scene", Kind::object);
   root.doc("A scene file is one JSON object. Lengths in metres, times in seconds, SI units throughout.");
   root.members({
-      field("name", Kind::string).fallback("").doc("Name of the scene (default: the file name without extension); the output goes to `out/<name>/`."),
+      field("name", Kind::string).fallback("").doc("Name of the scene (default: the file name without extension); the output goes to `out/<name>/` and its files are named after it, so it must be a plain file name: no `/` or `\\`, not `.` or `..`, no control characters, at most " + std::to_string(max_name_length) + " bytes."),
       field("description", Kind::string).fallback("").doc("Free text."),
       field("materials", Kind::map).of(material).items(1, 1u << 20).required().doc("Named materials."),
       field("meshes", Kind::array).of(mesh).items(1, 1u << 16).required().doc("The bodies."),
@@ -166,6 +185,7 @@ Field build_schema() {
       field("duration", Kind::number).unit("s").fallback(1.0).above(0).at_most(1e6).doc("Simulated time."),
       field("cuts", Kind::array).of(cut).fallback(nlohmann::json::array()).doc("Scheduled cuts."),
       output,
+      limits,
   });
   return root;
 }
@@ -188,7 +208,7 @@ Selector read_selector(const nlohmann::json& j, const Field& schema) {
     s.tag = static_cast<int>(r.integer("tag"));
   } else if (type == "points") {
     s.type = Selector::Type::points;
-    for (const auto& x : r["indices"]) s.points.push_back(x.get<std::uint32_t>());
+    for (const auto& x : r["indices"]) s.points.push_back(static_cast<std::uint32_t>(x.get<double>()));
   }
   return s;
 }
@@ -197,14 +217,110 @@ std::array<bool, 3> read_axes(const std::string& a) {
   return {a.find('x') != std::string::npos, a.find('y') != std::string::npos, a.find('z') != std::string::npos};
 }
 
-void check_whole(const nlohmann::json& list, const std::string& file, const std::string& path) {
-  for (std::size_t i = 0; i < list.size(); ++i) {
-    const double x = list[i].get<double>();
-    if (x != static_cast<double>(static_cast<long long>(x)))
-      throw SceneError(file, path + "[" + std::to_string(i) + "]", "must be a whole number (got " + list[i].dump() + ")");
-  }
+
+// Why `name` cannot be the name of files in the output folder, or "" if it can: outputs are
+// `<out>/<name>.pvd` and `<out>/<name>.png`, which must stay inside `<out>`.
+std::string name_problem(const std::string& n) {
+  if (n.size() > max_name_length)
+    return "is " + std::to_string(n.size()) + " bytes long; at most " + std::to_string(max_name_length) + " are allowed";
+  if (n == "." || n == "..") return "must be a plain file name, not \"" + n + "\"";
+  if (n.find_first_of("/\\") != std::string::npos) return "must be a plain file name, without '/' or '\\' (got \"" + n + "\")";
+  for (const char c : n)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "0x%02x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      return std::string("contains the control character ") + buf;
+    }
+  return {};
 }
 
+// Bytes of memory a run needs per cell, the points, springs, map darts and solver vectors it
+// brings included: peak resident size over cell count on grids of 10^4 to 10^5 cells (one step,
+// no output), rounded up.
+constexpr double bytes_per_hexahedron = 4400, bytes_per_tetrahedron = 1200, bytes_per_quad = 2500,
+                 bytes_per_triangle = 1300, bytes_per_segment = 1000;
+
+struct MeshEstimate {
+  double bytes = 0;
+  std::string key;   // the key that sets the size
+  std::string what;  // e.g. "4096 x 4096 x 4096 = 6.87e+10 hexahedra"
+};
+
+std::string short_number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, x < 1e6 && std::trunc(x) == x ? "%.0f" : "%.3g", x);
+  return buf;
+}
+
+std::string bytes_text(double b) {
+  const char* units[] = {"bytes", "kB", "MB", "GB", "TB", "PB", "EB"};
+  std::size_t u = 0;
+  while (b >= 1000 && u + 1 < std::size(units)) b /= 1000, ++u;
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.3g %s", b, units[u]);
+  return buf;
+}
+
+// The memory a procedural mesh will need, from its cell count (0 for mesh files: their readers
+// check counts against the data they hold).
+MeshEstimate estimate(const MeshSpec& m) {
+  const double cx = m.cells[0], cy = m.cells[1], cz = m.cells[2];
+  auto make = [](double cells, double per_cell, std::string key, std::string what) {
+    return MeshEstimate{cells * per_cell, std::move(key), what + " = " + short_number(cells)};
+  };
+  const std::string grid3 = short_number(cx) + " x " + short_number(cy) + " x " + short_number(cz);
+  const std::string grid2 = short_number(cx) + " x " + short_number(cy);
+  if (m.type == "hex_grid") return make(cx * cy * cz, bytes_per_hexahedron, "cells", grid3);
+  if (m.type == "tet_grid") {
+    const double per = m.split == "five" ? 5 : 6;
+    return make(per * cx * cy * cz, bytes_per_tetrahedron, "cells", short_number(per) + " x " + grid3);
+  }
+  if (m.type == "quad_grid") return make(cx * cy, bytes_per_quad, "cells", grid2);
+  if (m.type == "tri_grid") return make(2 * cx * cy, bytes_per_triangle, "cells", "2 x " + grid2);
+  const double rings = m.rings, sectors = m.sectors;
+  if (m.type == "disc")  // ring k adds sectors·(2k − 1) triangles
+    return make(sectors * rings * rings, bytes_per_triangle, "rings", short_number(sectors) + " sectors x " + short_number(rings) + "² rings");
+  if (m.type == "cylinder")
+    return make(3 * m.layers * sectors * rings * rings, bytes_per_tetrahedron, "layers",
+                "3 x " + short_number(m.layers) + " layers x " + short_number(sectors) + " sectors x " + short_number(rings) + "² rings");
+  if (m.type == "boxes") {
+    double cells = 0;
+    for (const auto& b : m.boxes)
+      cells += static_cast<double>(b.hi[0] - b.lo[0]) * static_cast<double>(b.hi[1] - b.lo[1]) * static_cast<double>(b.hi[2] - b.lo[2]);
+    return make(cells, bytes_per_hexahedron, "boxes", "the boxes' cells");
+  }
+  if (m.type == "polyline")
+    return make(static_cast<double>(m.points.size()) - 1, bytes_per_segment, "points", "the segments");
+  return {};
+}
+
+// Refuses a scene whose meshes or step count exceed its limits, naming the estimate and the key
+// that raises the limit.
+void check_limits(const Scene& s, const nlohmann::json& limits_json, const Field& limits_schema) {
+  Reader lim(limits_json, limits_schema);
+  const double max_memory = lim.number("memory"), max_steps = lim.number("steps");
+  double total = 0;
+  std::size_t largest = 0;
+  std::vector<MeshEstimate> est;
+  for (std::size_t i = 0; i < s.meshes.size(); ++i) {
+    est.push_back(estimate(s.meshes[i]));
+    total += est.back().bytes;
+    if (est.back().bytes > est[largest].bytes) largest = i;
+  }
+  if (total > max_memory) {
+    const MeshEstimate& e = est[largest];
+    throw SceneError(s.file, "meshes[" + std::to_string(largest) + "]." + e.key,
+                     "the scene needs about " + bytes_text(total) + " of memory (this mesh: " + e.what + " cells, about " +
+                         bytes_text(e.bytes) + "), more than limits.memory = " + bytes_text(max_memory) +
+                         "; use fewer cells, or raise limits.memory if the machine has it");
+  }
+  const double steps = s.duration / s.step;
+  if (!(steps <= max_steps))
+    throw SceneError(s.file, "integrator.step",
+                     "a step of " + short_number(s.step) + " s over duration " + short_number(s.duration) + " s makes " +
+                         short_number(steps) + " steps, more than limits.steps = " + short_number(max_steps) +
+                         "; use a longer step or a shorter duration, or raise limits.steps");
+}
 }  // namespace
 
 bool Selector::contains(const Vec3& p) const {
@@ -232,7 +348,13 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
   Scene s;
   s.file = file;
   s.name = r.string("name");
-  if (s.name.empty()) s.name = file == "(default)" ? "default" : std::filesystem::path(file).stem().string();
+  if (const std::string why = name_problem(s.name); !why.empty()) throw SceneError(file, "name", why);
+  if (s.name.empty()) {
+    s.name = file == "(default)" ? "default" : std::filesystem::path(file).stem().string();
+    if (const std::string why = name_problem(s.name); !why.empty() || s.name.empty())
+      throw SceneError(file, "name", "is not set, and the file name \"" + s.name + "\" cannot stand for it: " +
+                                         (why.empty() ? std::string("it is empty") : why) + "; set `name`");
+  }
   s.description = r.string("description");
 
   const Field& material_schema = *schema.member("materials")->element_;
@@ -276,7 +398,6 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
       m.regions.emplace_back(read_selector(rj.at("where"), *region_schema.member("where")), rr.string("material"));
     }
     if (mesh_schema.member("cells", m.type)) {
-      check_whole(mr["cells"], file, path + ".cells");
       const auto& c = mr["cells"];
       for (std::size_t k = 0; k < c.size(); ++k) m.cells[k] = static_cast<std::uint32_t>(c[k].get<double>());
       const auto& sz = mr["size"];
@@ -299,8 +420,6 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
       for (std::size_t k = 0; k < mr["boxes"].size(); ++k) {
         const auto& bj = mr["boxes"][k];
         const std::string bpath = path + ".boxes[" + std::to_string(k) + "]";
-        check_whole(bj.at("min"), file, bpath + ".min");
-        check_whole(bj.at("max"), file, bpath + ".max");
         LatticeBoxSpec b;
         for (std::size_t a = 0; a < 3; ++a) {
           b.lo[a] = static_cast<int>(bj.at("min")[a].get<double>());
@@ -344,6 +463,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
   }
   s.duration = r.number("duration");
   if (s.step > s.duration) throw SceneError(file, "integrator.step", "is longer than the whole run (duration " + std::to_string(s.duration) + " s)");
+  check_limits(s, r["limits"], *schema.member("limits"));
 
   const Field& cut_schema = *schema.member("cuts")->element_;
   for (std::size_t i = 0; i < r["cuts"].size(); ++i) {
@@ -361,13 +481,11 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
       if (cr.has("within")) c.within = read_selector(cj.at("within"), *cut_schema.member("within", "plane"));
     } else if (c.type == "faces") {
       for (std::size_t k = 0; k < cr["faces"].size(); ++k) {
-        check_whole(cr["faces"][k], file, path + ".faces[" + std::to_string(k) + "]");
         std::vector<std::uint32_t> f;
         for (const auto& x : cr["faces"][k]) f.push_back(static_cast<std::uint32_t>(x.get<double>()));
         c.faces.push_back(std::move(f));
       }
     } else if (c.type == "particles") {
-      check_whole(cr["particles"], file, path + ".particles");
       for (const auto& x : cr["particles"]) c.particles.push_back(static_cast<std::uint32_t>(x.get<double>()));
     } else if (c.type == "pierce") {
       c.where = read_selector(cj.at("where"), *cut_schema.member("where", "pierce"));
@@ -394,20 +512,16 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
 }
 
 Scene load_scene(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw SceneError(path, "", std::filesystem::exists(path) ? "cannot be read" : "no such file");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in, nullptr, true, /*ignore_comments=*/true);
-  } catch (const nlohmann::json::parse_error& e) {
-    // e.byte is the offset of the error; turn it into a line for the message
-    std::ifstream again(path);
-    std::string text((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>());
-    std::size_t line = 1;
-    for (std::size_t k = 0; k < std::min<std::size_t>(e.byte, text.size()); ++k) line += text[k] == '\n';
-    throw SceneError(path, "line " + std::to_string(line), std::string("not valid JSON: ") + e.what());
-  }
-  return parse_scene(j, path);
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec && ec != std::errc::no_such_file_or_directory) throw SceneError(path, "", "cannot be read: " + ec.message());
+  if (!std::filesystem::exists(status)) throw SceneError(path, "", "no such file");
+  if (std::filesystem::is_directory(status)) throw SceneError(path, "", "is a folder, not a scene file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path, "", "cannot be read");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw SceneError(path, "", "cannot be read");
+  return parse_scene(parse_json(text, path), path);
 }
 
 const char* default_scene_json() {

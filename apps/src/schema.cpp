@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace sewn::app {
@@ -25,13 +26,24 @@ const char* kind_name(Kind k) {
   return "?";
 }
 
+// A short description of a bad value. Lists and objects are summarised, never dumped: dumping
+// recurses once per nesting level, and a value nested 10^4 deep would overflow the stack.
 std::string describe(const nlohmann::json& v) {
+  if (v.is_array()) return "a list of " + std::to_string(v.size()) + (v.size() == 1 ? " entry" : " entries");
+  if (v.is_object()) return "an object with " + std::to_string(v.size()) + (v.size() == 1 ? " key" : " keys");
   std::string s = v.dump();
   if (s.size() > 40) s = s.substr(0, 37) + "...";
   return s;
 }
 
+// Whole numbers in full (an index bound of 4294967294 must not read as 4.29497e+09), others in
+// the stream's short form.
 std::string format_number(double x) {
+  if (std::isfinite(x) && std::trunc(x) == x && std::fabs(x) < 1e16) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.0f", x);
+    return buf;
+  }
   std::ostringstream os;
   os << x;
   return os.str();
@@ -57,6 +69,7 @@ void check_number(const nlohmann::json& v, const Field& f, const std::string& fi
                                      ", got " + describe(v));
   const double x = v.get<double>();
   if (!std::isfinite(x)) throw SceneError(file, path, "must be finite");
+  if (f.whole_ && std::trunc(x) != x) throw SceneError(file, path, "must be a whole number (got " + describe(v) + ")");
   check_range(x, f, file, path);
 }
 

@@ -222,8 +222,11 @@ void render_png(const std::filesystem::path& path, std::span<const Point3> point
   if (!scalar.empty() && scalar.size() != points.size())
     throw std::invalid_argument("render_png: the scalar has " + std::to_string(scalar.size()) + " values for " +
                                 std::to_string(points.size()) + " points");
-  if (opt.width < 200 || opt.height < 150 || opt.width > 16384 || opt.height > 16384)
-    throw std::invalid_argument("render_png: image size must be between 200 x 150 and 16384 x 16384");
+  if (opt.width < min_render_width || opt.height < min_render_height || opt.width > max_render_size ||
+      opt.height > max_render_size)
+    throw std::invalid_argument("render_png: image size must be between " + std::to_string(min_render_width) + " x " +
+                                std::to_string(min_render_height) + " and " + std::to_string(max_render_size) + " x " +
+                                std::to_string(max_render_size));
   if (cells.offsets.size() != cells.size() + 1 || cells.offsets.back() != cells.conn.size())
     throw std::invalid_argument("render_png: cell offsets do not match the cell types and connectivity");
   for (std::uint32_t v : cells.conn)

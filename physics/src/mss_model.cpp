@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/stiffness.hpp"
@@ -9,6 +10,14 @@
 namespace sewn::physics {
 
 namespace {
+
+constexpr std::uint32_t no_cell = 0xffffffffu;
+
+std::string sci(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return buf;
+}
 
 using Vec3 = Eigen::Vector3d;
 using Edge = std::array<std::uint8_t, 2>;
@@ -252,17 +261,33 @@ void MssModel<D>::build_elements(const IndexedMesh& mesh, const BuildResult& bui
     elements_.back().reversed = built.flipped[c];
   }
   // 1) particles: one per mesh point used by a cell, with its lumped mass
+  // Points no cell uses get no particle. A used point must get a normal positive mass: one that
+  // underflows to zero (density 1e-320) would leave its darts linked to no particle, and a
+  // subnormal or infinite one has no usable inverse.
   std::vector<double> point_mass(mesh.num_points(), 0.0);
+  std::vector<std::uint32_t> cell_of_point(mesh.num_points(), no_cell);
   for (std::uint32_t c = 0; c < nc; ++c) {
     const Element& el = elements_[c];
     const double share = materials_[el.material].density * el.measure / corners(el.kind);
-    for (std::uint32_t q : mesh.cell(c)) point_mass[q] += share;
+    for (std::uint32_t q : mesh.cell(c)) {
+      point_mass[q] += share;
+      cell_of_point[q] = c;
+    }
+  }
+  for (std::uint32_t q = 0; q < mesh.num_points(); ++q) {
+    if (cell_of_point[q] == no_cell || std::isnormal(point_mass[q])) continue;
+    const std::uint32_t c = cell_of_point[q];
+    throw InputError(options_.source + ": cell " + std::to_string(c) + " (" + to_string(mesh.types[c]) + ", material " +
+                     std::to_string(elements_[c].material) + "): its point " + std::to_string(q) + " gets a mass of " +
+                     sci(point_mass[q]) + " kg (density " + sci(materials_[elements_[c].material].density) +
+                     " kg/m³), which " + (std::isinf(point_mass[q]) ? "overflows" : "underflows") +
+                     " a double: the density or the cell size is out of range");
   }
   node_of_point_.assign(mesh.num_points(), invalid_index);
   NodeTable& nodes = system_.nodes();
   nodes.reserve(mesh.num_points());
   for (std::uint32_t q = 0; q < mesh.num_points(); ++q) {
-    if (point_mass[q] == 0) continue;
+    if (cell_of_point[q] == no_cell) continue;
     const Vec3 x(mesh.points[q][0], mesh.points[q][1], mesh.points[q][2]);
     node_of_point_[q] = nodes.add(x, Vec3::Zero(), point_mass[q]);
     rest_.push_back(x);

@@ -39,6 +39,7 @@ struct Field {
   bool required_ = false;
   double min_ = -std::numeric_limits<double>::infinity(), max_ = std::numeric_limits<double>::infinity();
   bool min_open_ = false, max_open_ = false;
+  bool whole_ = false;  // numbers (and list items) must be whole: indices, counts, lattice cells
   std::size_t min_items_ = 0, max_items_ = std::numeric_limits<std::size_t>::max();
   std::vector<std::string> choices_;
   std::vector<Field> fields_;                          // object members (common to every variant)
@@ -55,6 +56,7 @@ struct Field {
   Field& above(double v) { min_ = v; min_open_ = true; return *this; }
   Field& at_most(double v) { max_ = v; max_open_ = false; return *this; }
   Field& below(double v) { max_ = v; max_open_ = true; return *this; }
+  Field& whole() { whole_ = true; return *this; }
   Field& items(std::size_t lo, std::size_t hi) { min_items_ = lo; max_items_ = hi; return *this; }
   Field& one_of(std::vector<std::string> c) { choices_ = std::move(c); return *this; }
   Field& members(std::vector<Field> f) { fields_ = std::move(f); return *this; }

@@ -44,6 +44,9 @@ enum class RenderMode {
   wireframe  ///< every edge of the drawn faces and segments, hidden ones included
 };
 
+/// Picture sizes render_png accepts, in pixels (smaller leaves no room for the colour bar).
+inline constexpr int min_render_width = 200, min_render_height = 150, max_render_size = 16384;
+
 struct RenderOptions {
   int width = 1200;
   int height = 800;
