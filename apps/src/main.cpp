@@ -1,5 +1,7 @@
 // The `sewn` command-line tool: run a scene, check a mesh, print the scene reference.
+#include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -130,10 +132,20 @@ int cmd_check(const std::vector<std::string>& args) {
   const auto by_dim = mesh.count_by_dimension();
   std::printf("%s: %u points, %u cells (%u volumes, %u surface cells, %u segments)\n", path.c_str(), mesh.num_points(),
               mesh.num_cells(), by_dim[3], by_dim[2], by_dim[1]);
+  // what `sewn run` refuses, refused here with the same reason
+  if (mesh.num_cells() == 0) {
+    std::fprintf(stderr, "sewn: bad mesh: %s: the mesh has no cell\n", path.c_str());
+    return bad_input;
+  }
   bool sound = true;
   const auto issues = sewn::io::find_geometry_issues(mesh, path);
   for (const auto& issue : issues) std::printf("  geometry: %s\n", issue.message.c_str());
   if (!issues.empty()) sound = false;
+  // the map builder would only restate a duplicate as a clash of orientations
+  if (std::any_of(issues.begin(), issues.end(), [](const auto& i) { return i.kind == sewn::io::GeometryProblem::duplicate; })) {
+    std::printf("map: not built (duplicate cells)\n");
+    return bad_input;
+  }
   sewn::CMap<3, std::uint32_t> map;
   sewn::BuildOptions bopt;
   bopt.source = path;
@@ -154,6 +166,9 @@ int cmd_check(const std::vector<std::string>& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Past a file size limit (ulimit -f) a write must fail with EFBIG, reported as a failed
+  // output, rather than the signal killing the tool with half its files written.
+  std::signal(SIGXFSZ, SIG_IGN);
   const std::vector<std::string> all(argv + 1, argv + argc);
   const std::string cmd = all.empty() ? "--help" : all[0];
   const std::vector<std::string> args(all.begin() + (all.empty() ? 0 : 1), all.end());
@@ -171,6 +186,12 @@ int main(int argc, char** argv) {
     }
     std::fprintf(stderr, "sewn: unknown command '%s'\n\n%s", cmd.c_str(), usage);
     return bad_input;
+  } catch (const sewn::app::OutputPathError& e) {
+    std::fprintf(stderr, "sewn: bad output folder: %s\n", e.what());
+    return bad_input;
+  } catch (const sewn::app::OutputError& e) {
+    std::fprintf(stderr, "sewn: the run failed: cannot write the output: %s\n", e.what());
+    return run_failed;
   } catch (const sewn::app::SceneError& e) {
     std::fprintf(stderr, "sewn: bad scene: %s\n", e.what());
     return bad_input;

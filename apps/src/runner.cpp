@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -184,6 +186,51 @@ std::set<std::array<std::uint32_t, 4>> interior_faces(const IndexedMesh& m) {
   return out;
 }
 
+// Makes `dir` the output folder, refusing what cannot be one (OutputPathError, bad input) and
+// what cannot be written (OutputError), before any work is done.
+void prepare_output(const std::filesystem::path& dir) {
+  for (const auto& part : dir)
+    if (part.native().size() > 255)
+      throw OutputPathError(dir, "a folder name of " + std::to_string(part.native().size()) +
+                                     " bytes is longer than file systems allow (255)");
+  std::error_code ec;
+  const auto status = std::filesystem::status(dir, ec);
+  if (std::filesystem::exists(status) && !std::filesystem::is_directory(status))
+    throw OutputPathError(dir, "exists and is not a folder");
+  std::filesystem::create_directories(dir, ec);
+  if (ec == std::errc::not_a_directory || ec == std::errc::file_exists || ec == std::errc::filename_too_long)
+    throw OutputPathError(dir, "cannot be created: " + ec.message());
+  if (ec) throw OutputError(dir, "cannot be created: " + ec.message());
+  if (::access(dir.c_str(), W_OK | X_OK) != 0) throw OutputError(dir, std::string("cannot be written: ") + std::strerror(errno));
+}
+
+// Runs one write, turning a file error into the run's OutputError (exit 1) rather than the
+// bad-input error a mesh file's FileError means.
+template <class F>
+void writing(F&& write) {
+  try {
+    write();
+  } catch (const io::FileError& e) {
+    throw OutputError(e.file(), e.reason());
+  }
+}
+
+// A semi-implicit step, its stable-step refusal told in the scene's terms: the user sets scene
+// keys, not the library's enforce_stable_step.
+void step_semi_implicit(physics::SymplecticEuler& semi, physics::System& sys, double h, double t, const Scene& scene) {
+  try {
+    (void)semi.step(sys, h);
+  } catch (const physics::StabilityError& e) {
+    char text[512];
+    std::snprintf(text, sizeof text,
+                  "%s: integrator.step: h = %.4g s is not below the semi-implicit stable-step bound %.4g s (at t = %.4g s). "
+                  "Use a step below %.4g s, the implicit integrator (integrator.type = \"implicit\"), or set "
+                  "integrator.allow_unstable = true to run it anyway; the run stopped there.",
+                  scene.file.c_str(), h, e.bound(), t, e.bound());
+    throw physics::StabilityError(text, e.step(), e.bound());
+  }
+}
+
 std::string format_seconds(double s) {
   char buf[32];
   if (s < 60)
@@ -218,6 +265,10 @@ Assembly assemble(const Scene& scene) {
 }
 
 RunSummary run(const Scene& scene, const RunOptions& options) {
+  RunSummary sum;
+  sum.out = options.out.empty() ? std::filesystem::path("out") / scene.name : options.out;
+  prepare_output(sum.out);
+
   // 1) the bodies and the model
   const Assembly assembly = assemble(scene);
   std::vector<physics::MaterialParams> materials;
@@ -275,22 +326,21 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   std::stable_sort(cuts.begin(), cuts.end());
 
   // 4) outputs
-  RunSummary sum;
-  sum.out = options.out.empty() ? std::filesystem::path("out") / scene.name : options.out;
-  std::filesystem::create_directories(sum.out);
   Snapshot snap;
   std::unique_ptr<io::PvdWriter> pvd;
   if (scene.write_vtu) {
     sum.pvd = sum.out / (scene.name + ".pvd");
-    pvd = std::make_unique<io::PvdWriter>(sum.pvd);
+    writing([&] { pvd = std::make_unique<io::PvdWriter>(sum.pvd); });
   }
   std::unique_ptr<io::CsvWriter> csv;
   if (scene.write_csv) {
     sum.csv = sum.out / "frames.csv";
-    csv = std::make_unique<io::CsvWriter>(
-        sum.csv, std::vector<std::string>{"frame", "time", "kinetic_energy", "potential_energy", "elastic_energy",
-                                          "particles", "springs", "elements", "steps", "ms_per_step",
-                                          "cg_iterations_mean", "cg_iterations_max", "cuts", "faces_cut"});
+    writing([&] {
+      csv = std::make_unique<io::CsvWriter>(
+          sum.csv, std::vector<std::string>{"frame", "time", "kinetic_energy", "potential_energy", "elastic_energy",
+                                            "particles", "springs", "elements", "steps", "ms_per_step",
+                                            "cg_iterations_mean", "cg_iterations_max", "cuts", "faces_cut"});
+    });
   }
   std::uint32_t frame = 0;
   double frame_ms = 0, frame_cg_sum = 0;
@@ -309,17 +359,20 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
       const io::DataArray cell_data[] = {io::DataArray::ints("material", snap.material),
                                          io::DataArray::ints("refinement_level", snap.level),
                                          io::DataArray::ints("mesh_cell", snap.mesh_cell)};
-      io::write_vtu(sum.out / name, snap.points, snap.cells(), point_data, cell_data);
-      pvd->add(t, sum.out / name);
+      // the frame is complete on disk before the series lists it
+      writing([&] {
+        io::write_vtu(sum.out / name, snap.points, snap.cells(), point_data, cell_data);
+        pvd->add(t, sum.out / name);
+      });
     }
     if (csv) {
       const auto elements = std::count_if(model->elements().begin(), model->elements().end(), [](const auto& e) { return e.alive; });
-      csv->row({static_cast<double>(frame), t, sys.kinetic_energy(), sys.potential_energy(),
+      writing([&] { csv->row({static_cast<double>(frame), t, sys.kinetic_energy(), sys.potential_energy(),
                 sys.potential_energy(physics::EnergyKind::internal), static_cast<double>(model->nodes().num_alive()),
                 static_cast<double>(model->springs().num_alive()), static_cast<double>(elements),
                 static_cast<double>(frame_steps), frame_steps ? frame_ms / static_cast<double>(frame_steps) : 0.0,
                 frame_steps ? frame_cg_sum / static_cast<double>(frame_steps) : 0.0, static_cast<double>(frame_cg_max),
-                static_cast<double>(sum.cuts), static_cast<double>(sum.faces_cut)});
+                static_cast<double>(sum.cuts), static_cast<double>(sum.faces_cut)}); });
     }
     ++frame;
     frame_ms = frame_cg_sum = 0;
@@ -385,7 +438,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     if (use_implicit)
       cg = implicit.step(model->system(), h).cg_iterations;
     else
-      (void)semi.step(model->system(), h);
+      step_semi_implicit(semi, model->system(), h, t, scene);
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     frame_ms += ms;
     frame_cg_sum += cg;
@@ -412,6 +465,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   sum.simulated = static_cast<double>(steps) * h;
   sum.ms_per_step = steps ? sum.wall * 1e3 / static_cast<double>(steps) : 0;
   sum.kinetic_end = model->system().kinetic_energy();
+  if (csv) writing([&] { csv->flush(); });
 
   // 6) the picture of the last frame
   if (scene.write_picture) {
@@ -438,7 +492,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
         return interior.count(face_key(face, [&](std::uint32_t q) { return model->point_of_node(q); })) > 0;
       };
     sum.picture = sum.out / (scene.name + ".png");
-    io::render_png(sum.picture, snap.points, snap.cells(), *scalar, ro);
+    writing([&] { io::render_png(sum.picture, snap.points, snap.cells(), *scalar, ro); });
   }
   return sum;
 }

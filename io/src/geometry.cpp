@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <span>
 
 namespace sewn::io {
@@ -209,6 +210,19 @@ std::vector<GeometryIssue> find_geometry_issues(const IndexedMesh& mesh, const s
     issues.push_back({kind, c, std::vector<std::uint32_t>(v.begin(), v.end()),
                       source + ": " + cell_name(mesh, c) + " " + reason + "; " + describe_points(mesh, v)});
   }
+  // A cell given twice (same type, same points in any order) would double its mass and stiffness
+  // silently in 2D and 1D, and make the map builder fail in 3D.
+  std::map<std::pair<CellType, std::vector<std::uint32_t>>, std::uint32_t> seen;
+  for (std::uint32_t c = 0; c < mesh.num_cells() && !full(); ++c) {
+    const auto v = mesh.cell(c);
+    std::vector<std::uint32_t> key(v.begin(), v.end());
+    std::sort(key.begin(), key.end());
+    const auto [it, fresh] = seen.emplace(std::make_pair(mesh.types[c], std::move(key)), c);
+    if (fresh) continue;
+    issues.push_back({GeometryProblem::duplicate, c, std::vector<std::uint32_t>(v.begin(), v.end()),
+                      source + ": " + cell_name(mesh, c) + " repeats cell " + std::to_string(it->second) +
+                          " (the same points): a duplicate cell; " + describe_points(mesh, v)});
+  }
   return issues;
 }
 
@@ -222,6 +236,7 @@ void check_mesh_geometry(const IndexedMesh& mesh, const std::string& source, con
     case GeometryProblem::non_finite_point: throw NonFiniteCoordinateError(is.message, is.cell, is.points);
     case GeometryProblem::inverted: throw InvertedCellError(is.message, is.cell, is.points);
     case GeometryProblem::degenerate: throw DegenerateCellError(is.message, is.cell, is.points);
+    case GeometryProblem::duplicate: throw DuplicateCellError(is.message, is.cell, is.points);
   }
 }
 

@@ -1,5 +1,7 @@
 #include "sewn/io/render.hpp"
 
+#include "atomic_file.hpp"
+
 #include <cairo.h>
 
 #include <algorithm>
@@ -517,14 +519,12 @@ void render_png(const std::filesystem::path& path, std::span<const Point3> point
   // written aside and renamed, like the VTU frames, so a viewer never catches half a picture
   const std::string part = path.string() + ".part";
   const cairo_status_t st = cairo_surface_write_to_png(cx.surface, part.c_str());
-  if (st != CAIRO_STATUS_SUCCESS)
+  if (st != CAIRO_STATUS_SUCCESS) {
+    std::error_code ec;
+    std::filesystem::remove(part, ec);  // half a picture: never left behind
     throw FileError(path.string(), 0, std::string("cannot write the PNG: ") + cairo_status_to_string(st));
-  std::error_code ec;
-  std::filesystem::rename(part, path, ec);
-  if (ec) {
-    std::filesystem::remove(part, ec);
-    throw FileError(path.string(), 0, "cannot move the finished picture into place");
   }
+  publish_part(part, path);
 }
 
 }  // namespace sewn::io

@@ -2,6 +2,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "atomic_file.hpp"
 #include "sewn/io/write.hpp"
 
 namespace sewn::io {
@@ -22,29 +23,42 @@ std::string csv_field(const std::string& s) {
 }  // namespace
 
 CsvWriter::CsvWriter(const std::filesystem::path& path, std::vector<std::string> columns)
-    : path_(path), columns_(std::move(columns)), out_(path, std::ios::binary | std::ios::trunc) {
-  if (!out_) throw FileError(path_.string(), 0, std::string("cannot open for writing: ") + std::strerror(errno));
+    : path_(path), columns_(std::move(columns)) {
   if (columns_.empty()) throw std::invalid_argument("CsvWriter: needs at least one column");
-  std::string line;
   for (std::size_t i = 0; i < columns_.size(); ++i) {
-    if (i) line += ',';
-    line += csv_field(columns_[i]);
+    if (i) content_ += ',';
+    content_ += csv_field(columns_[i]);
   }
-  out_ << line << '\n' << std::flush;
-  if (!out_) throw FileError(path_.string(), 1, "write error");
+  content_ += '\n';
+  flush();
+}
+
+CsvWriter::~CsvWriter() {
+  try {
+    flush();
+  } catch (const std::exception&) {
+    // already unwinding, or the caller did not flush: the file keeps its last complete version
+  }
 }
 
 void CsvWriter::row(std::span<const double> values) {
   if (values.size() != columns_.size())
     throw std::invalid_argument("CsvWriter::row: " + std::to_string(values.size()) + " values for " +
                                 std::to_string(columns_.size()) + " columns in " + path_.string());
-  std::string line;
   for (std::size_t i = 0; i < values.size(); ++i) {
-    if (i) line += ',';
-    line += format_double(values[i]);
+    if (i) content_ += ',';
+    content_ += format_double(values[i]);
   }
-  out_ << line << '\n' << std::flush;  // a run that stops early still leaves every finished row
-  if (!out_) throw FileError(path_.string(), 0, "write error (disk full?)");
+  content_ += '\n';
+  // every row while the file is small; then at doubling sizes, so rewriting stays linear overall
+  constexpr std::size_t small = 64 * 1024;
+  if (content_.size() <= small || content_.size() >= 2 * written_) flush();
+}
+
+void CsvWriter::flush() {
+  if (written_ == content_.size()) return;
+  write_file_atomically(path_, content_);
+  written_ = content_.size();
 }
 
 }  // namespace sewn::io

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "atomic_file.hpp"
 #include "sewn/io/write.hpp"
 
 namespace sewn::io {
@@ -40,25 +41,6 @@ std::size_t DataArray::tuples() const {
 }
 
 namespace {
-
-// Writes `content` next to `path` and renames it into place, so readers see the old file or the
-// new one, never a partial one.
-void write_atomically(const std::filesystem::path& path, const std::string& content) {
-  const std::filesystem::path tmp = path.string() + ".part";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw FileError(path.string(), 0, std::string("cannot open for writing: ") + std::strerror(errno));
-    out.write(content.data(), static_cast<std::streamsize>(content.size()));
-    out.flush();
-    if (!out) throw FileError(path.string(), 0, "write error (disk full?)");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw FileError(path.string(), 0, "cannot move the finished file into place");
-  }
-}
 
 std::string xml_escape(const std::string& s) {
   std::string r;
@@ -197,7 +179,7 @@ void write_vtu(const std::filesystem::path& path, std::span<const Point3> points
   out += "      </PointData>\n      <CellData>\n";
   for (const auto& a : cell_data) user_array(out, a, opt.encoding);
   out += "      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
-  write_atomically(path, out);
+  write_file_atomically(path, out);
 }
 
 void write_vtu(const std::filesystem::path& path, const IndexedMesh& mesh, std::span<const DataArray> point_data,
@@ -221,7 +203,7 @@ void PvdWriter::flush() const {
   for (const auto& [t, file] : entries_)
     out += "    <DataSet timestep=\"" + format_double(t) + "\" group=\"\" part=\"0\" file=\"" + xml_escape(file) + "\"/>\n";
   out += "  </Collection>\n</VTKFile>\n";
-  write_atomically(path_, out);
+  write_file_atomically(path_, out);
 }
 
 }  // namespace sewn::io

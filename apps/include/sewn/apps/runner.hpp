@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,30 @@
 #include "sewn/cmap/mesh.hpp"
 
 namespace sewn::app {
+
+/// The output folder cannot be one: an existing file, a name too long for the file system, a
+/// parent that is a file. Bad input (the tool exits 2); thrown before anything is built.
+class OutputPathError : public std::invalid_argument {
+ public:
+  OutputPathError(const std::filesystem::path& path, const std::string& reason)
+      : std::invalid_argument(path.string() + ": " + reason), path_(path) {}
+  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// An output file or folder cannot be written (no permission, full disk, file size limit): the
+/// run failed (the tool exits 1). Files written before stay complete and valid.
+class OutputError : public std::runtime_error {
+ public:
+  OutputError(const std::filesystem::path& path, const std::string& reason)
+      : std::runtime_error(path.string() + ": " + reason), path_(path) {}
+  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
 
 /// All bodies of a scene in one mesh, each cell with its material index (materials in name order).
 struct Assembly {
@@ -48,9 +73,12 @@ struct RunSummary {
   std::filesystem::path out, pvd, csv, picture;
 };
 
-/// Runs the scene to its end. Throws SceneError / io errors / physics::InputError for bad input
-/// (exit 2), physics::StabilityError when a semi-implicit step is above its stable bound
-/// (exit 2: choose a smaller step), physics::BlowupError / SolverError when the run fails (exit 1).
+/// Runs the scene to its end. Throws SceneError / io errors / physics::InputError / OutputPathError
+/// for bad input (exit 2), physics::StabilityError when a semi-implicit step is above its stable
+/// bound (exit 2: choose a smaller step), physics::BlowupError / SolverError / OutputError when
+/// the run fails (exit 1). Every output file is replaced whole (written aside and renamed), the
+/// .pvd lists only frames whose .vtu is complete, and nothing is written outside the output
+/// folder.
 RunSummary run(const Scene& scene, const RunOptions& options);
 
 }  // namespace sewn::app

@@ -52,6 +52,12 @@ class DegenerateCellError : public GeometryError {
   using GeometryError::GeometryError;
 };
 
+/// A cell has the same type and the same points (in any order) as an earlier one.
+class DuplicateCellError : public GeometryError {
+ public:
+  using GeometryError::GeometryError;
+};
+
 struct GeometryOptions {
   /// Scaled Jacobians (volumes) and scaled areas (2D cells) at or below this count as degenerate.
   double min_scaled_jacobian = 1e-8;
@@ -61,7 +67,7 @@ struct GeometryOptions {
   std::size_t max_issues = 100;
 };
 
-enum class GeometryProblem { non_finite_point, inverted, degenerate };
+enum class GeometryProblem { non_finite_point, inverted, degenerate, duplicate };
 
 struct GeometryIssue {
   GeometryProblem kind;
@@ -78,13 +84,14 @@ double min_scaled_jacobian(const IndexedMesh& mesh, std::uint32_t cell);
 /// inverted; faces are fanned from their first vertex), area for 2D cells, length for segments.
 double cell_measure(const IndexedMesh& mesh, std::uint32_t cell);
 
-/// Every geometric problem (up to max_issues), in cell order after the non-finite points.
+/// Every geometric problem (up to max_issues): non-finite points, then bad cells in cell order,
+/// then duplicate cells (cost O(n log n) in the cells).
 /// Throws MeshError if an index is out of range (mesh.check_indices).
 std::vector<GeometryIssue> find_geometry_issues(const IndexedMesh& mesh, const std::string& source = "mesh",
                                                 const GeometryOptions& opt = {});
 
 /// Throws the first problem find_geometry_issues would report, as NonFiniteCoordinateError,
-/// InvertedCellError or DegenerateCellError; messages name `source`, the cell and its points.
+/// InvertedCellError, DegenerateCellError or DuplicateCellError; messages name `source`, the cell and its points.
 void check_mesh_geometry(const IndexedMesh& mesh, const std::string& source = "mesh", const GeometryOptions& opt = {});
 
 }  // namespace sewn::io

@@ -104,22 +104,33 @@ class PvdWriter {
 };
 
 /// A CSV file of numeric rows under a header line. Values are written in the shortest form that
-/// reads back to the same double (nan and inf as such); each row is flushed at once.
+/// reads back to the same double (nan and inf as such). The file is only ever replaced whole
+/// (written aside and renamed), so a reader never sees half a row: after every row while it is
+/// under 64 KiB (about 250 rows of 15 columns), then each time it has doubled since it was last
+/// written, and by flush() and the destructor, so the whole cost stays linear in its size.
 class CsvWriter {
  public:
-  /// Creates the file and writes the header (names quoted when they need it). Throws FileError.
+  /// Creates the file with the header (names quoted when they need it). Throws FileError.
   CsvWriter(const std::filesystem::path& path, std::vector<std::string> columns);
-  /// Appends a row; std::invalid_argument unless it has one value per column; FileError on I/O.
+  /// Writes the rows not yet on disk; errors are swallowed here (call flush() to see them).
+  ~CsvWriter();
+  CsvWriter(const CsvWriter&) = delete;
+  CsvWriter& operator=(const CsvWriter&) = delete;
+  /// Appends a row; std::invalid_argument unless it has one value per column; FileError on I/O
+  /// (the file then keeps the rows it had).
   void row(std::span<const double> values);
   /// row() for a braced list of values.
   void row(std::initializer_list<double> values) { row(std::span<const double>(values.begin(), values.size())); }
+  /// Puts every row so far on disk. Throws FileError.
+  void flush();
   /// Number of columns (values each row must have).
   [[nodiscard]] std::size_t columns() const { return columns_.size(); }
 
  private:
   std::filesystem::path path_;
   std::vector<std::string> columns_;
-  std::ofstream out_;
+  std::string content_;        // the whole file
+  std::size_t written_ = 0;    // bytes of content_ on disk
 };
 
 /// The shortest decimal form of x that reads back exactly ("nan", "inf", "-inf" if not finite).
