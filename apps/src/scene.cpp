@@ -41,9 +41,11 @@ Field build_schema() {
   Field material = field("material", Kind::object);
   material.doc("A linear elastic material. The mass-spring stiffnesses follow Baudet et al. (hexahedra, quads) and van Gelder (tetrahedra, triangles), see PHYSICS_NOTES §1.");
   material.members({
-      field("young", Kind::number).unit("Pa").required().above(0).doc("Young's modulus E."),
+      field("young", Kind::number).unit("Pa").required().above(0).at_most(1e13)
+          .doc("Young's modulus E (the bound is ten times diamond's: beyond it the stiffnesses overflow the solver)."),
       field("poisson", Kind::number).fallback(0.3).above(-1).below(0.5).doc("Poisson's ratio ν."),
-      field("density", Kind::number).unit("kg/m³").required().above(0).doc("Mass density ρ (per unit area for 2D cells of unit thickness)."),
+      field("density", Kind::number).unit("kg/m³").required().above(0).at_most(1e5)
+          .doc("Mass density ρ (per unit area for 2D cells of unit thickness; the bound is four times osmium's)."),
       field("thickness", Kind::number).unit("m").fallback(1.0).above(0).doc("Thickness of 2D cells (membranes): scales their mass and stiffness."),
       field("area", Kind::number).unit("m²").fallback(1e-4).above(0).doc("Cross-section of 1D cells (polylines): axial spring k = E·area/length."),
       field("elongated", Kind::string).one_of({"refuse", "clamp"}).fallback("refuse")

@@ -128,6 +128,13 @@ TEST_CASE("a number too large for a double is refused with its key path, not as 
   expect_file_refused(R"({"gravity": [0, 0, -1e400]})", "gravity[2]", "out of range");
   expect_file_refused(R"({"meshes": [{"type": "polyline", "points": [[0, 0, 0], [1, 1, -2e308]]}]})", "meshes[0].points[1][2]",
                       "out of range");
+  // finite but beyond any material: the run used to fail on NaN in the solver (exit 1, no key)
+  json j = minimal();
+  j["materials"]["steel"]["young"] = 1e308;
+  expect_refused(j, "materials.steel.young", "<= 10000000000000");
+  j = minimal();
+  j["materials"]["steel"]["density"] = 1e308;
+  expect_refused(j, "materials.steel.density", "<= 100000");
   // a key given twice would silently keep the last value
   expect_file_refused(R"({"duration": 1, "materials": {}, "duration": 2})", "duration", "appears twice");
   // syntax errors keep their line
