@@ -4,7 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <map>
+#include <limits>
 #include <span>
 
 namespace sewn::io {
@@ -211,16 +211,34 @@ std::vector<GeometryIssue> find_geometry_issues(const IndexedMesh& mesh, const s
                       source + ": " + cell_name(mesh, c) + " " + reason + "; " + describe_points(mesh, v)});
   }
   // A cell given twice (same type, same points in any order) would double its mass and stiffness
-  // silently in 2D and 1D, and make the map builder fail in 3D.
-  std::map<std::pair<CellType, std::vector<std::uint32_t>>, std::uint32_t> seen;
-  for (std::uint32_t c = 0; c < mesh.num_cells() && !full(); ++c) {
+  // silently in 2D and 1D, and make the map builder fail in 3D. Sorted keys of fixed size: one
+  // allocation, O(n log n).
+  using Key = std::array<std::uint32_t, 10>;  // type, up to 8 sorted points padded, cell
+  std::vector<Key> keys(mesh.num_cells());
+  for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
     const auto v = mesh.cell(c);
-    std::vector<std::uint32_t> key(v.begin(), v.end());
-    std::sort(key.begin(), key.end());
-    const auto [it, fresh] = seen.emplace(std::make_pair(mesh.types[c], std::move(key)), c);
-    if (fresh) continue;
+    Key& k = keys[c];
+    k.fill(std::numeric_limits<std::uint32_t>::max());
+    k[0] = static_cast<std::uint32_t>(mesh.types[c]);
+    std::copy_n(v.begin(), std::min<std::size_t>(v.size(), 8), k.begin() + 1);
+    std::sort(k.begin() + 1, k.begin() + 9);
+    k[9] = c;
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> repeats;  // (cell, the first cell it repeats)
+  for (std::size_t i = 1, first = 0; i < keys.size(); ++i) {
+    if (!std::equal(keys[i - 1].begin(), keys[i - 1].begin() + 9, keys[i].begin())) {
+      first = i;
+    } else {
+      repeats.emplace_back(keys[i][9], keys[first][9]);
+    }
+  }
+  std::sort(repeats.begin(), repeats.end());
+  for (const auto& [c, original] : repeats) {
+    if (full()) break;
+    const auto v = mesh.cell(c);
     issues.push_back({GeometryProblem::duplicate, c, std::vector<std::uint32_t>(v.begin(), v.end()),
-                      source + ": " + cell_name(mesh, c) + " repeats cell " + std::to_string(it->second) +
+                      source + ": " + cell_name(mesh, c) + " repeats cell " + std::to_string(original) +
                           " (the same points): a duplicate cell; " + describe_points(mesh, v)});
   }
   return issues;

@@ -151,4 +151,9 @@ TEST_CASE("duplicate cells, in any vertex order, are a geometry problem") {
   CHECK(issues[0].message.find("m.msh: cell 2 (quad) repeats cell 0") == 0);
   CHECK(issues[1].cell == 4);
   message_of<DuplicateCellError>([&] { check_mesh_geometry(m, "m.msh"); });
+  // a third copy names the first one, not the second
+  m.add_cell(CellType::quad, {1, 2, 3, 0});
+  const auto three = find_geometry_issues(m, "m.msh");
+  REQUIRE(three.size() == 3);
+  CHECK(three[2].message.find("m.msh: cell 5 (quad) repeats cell 0 ") == 0);
 }
