@@ -152,7 +152,7 @@ Field build_schema() {
                     .doc("`viscous`: the 2013 paper's per-spring γ = 2√(k(mᵢ+mⱼ)/2); `rayleigh`: C = αM + βK."),
                 field("alpha", Kind::number).unit("1/s").fallback(0.0).at_least(0).doc("Rayleigh mass coefficient α."),
                 field("beta", Kind::number).unit("s").fallback(0.0).at_least(0).doc("Rayleigh stiffness coefficient β."),
-                field("environment", Kind::number).unit("1/s").fallback(0.0).at_least(0).doc("Drag −c·m·v on every particle.")});
+                field("environment", Kind::number).unit("1/s").fallback(0.0).at_least(0).at_most(1e6).doc("Drag −c·m·v on every particle.")});
 
   Field integrator = field("integrator", Kind::object);
   integrator.doc("Time integration.")
@@ -181,7 +181,8 @@ Field build_schema() {
       field("materials", Kind::map).of(material).items(1, 1u << 20).required().doc("Named materials."),
       field("meshes", Kind::array).of(mesh).items(1, 1u << 16).required().doc("The bodies."),
       field("fixed", Kind::array).of(fix).fallback(nlohmann::json::array()).doc("Fixed particles."),
-      field("gravity", Kind::vec3).unit("m/s²").fallback({0.0, 0.0, -9.81}).doc("Gravity."),
+      field("gravity", Kind::vec3).unit("m/s²").fallback({0.0, 0.0, -9.81}).at_least(-1e6).at_most(1e6)
+          .doc("Gravity (each component within ±10⁶ m/s², 10⁵ g: beyond, the forces overflow the solver)."),
       damping,
       integrator,
       field("duration", Kind::number).unit("s").fallback(1.0).above(0).at_most(1e6).doc("Simulated time."),

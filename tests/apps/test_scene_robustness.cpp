@@ -135,6 +135,12 @@ TEST_CASE("a number too large for a double is refused with its key path, not as 
   j = minimal();
   j["materials"]["steel"]["density"] = 1e308;
   expect_refused(j, "materials.steel.density", "<= 100000");
+  j = minimal();
+  j["gravity"] = {0, 0, -1e308};
+  expect_refused(j, "gravity[2]", ">= -1000000");
+  j = minimal();
+  j["damping"] = {{"environment", 1e308}};
+  expect_refused(j, "damping.environment", "<= 1000000");
   // a key given twice would silently keep the last value
   expect_file_refused(R"({"duration": 1, "materials": {}, "duration": 2})", "duration", "appears twice");
   // syntax errors keep their line
