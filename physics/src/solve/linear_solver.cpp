@@ -54,14 +54,11 @@ Backend parse_backend(std::string_view name) {
 
 Backend default_backend(std::size_t nodes) {
   (void)nodes;
-#ifdef SEWN_HAVE_CHOLMOD
-  // docs/solvers.md: a factorization reused as a preconditioner beat block-Jacobi CG on every
-  // implicit case of bench/results/solve.md at up to 32³ cells; a cold direct solve per step
-  // never won.
-  return Backend::cholmod_pcg;
-#else
+  // Measured (docs/solvers.md, bench/solve): with Debian's reference BLAS under CHOLMOD, a
+  // factorization and its triangular solves cost more than block-Jacobi CG's iterations on
+  // every case from the 8×8×10 beam at h = 1 ms to the N = 8 cantilever at h = 10 ms (564
+  // iterations a step), in CPU time; so no size picks a CHOLMOD backend today.
   return Backend::jacobi;
-#endif
 }
 
 std::unique_ptr<LinearSolver> make_solver(Backend b, SolverOptions options, std::size_t nodes) {
