@@ -99,7 +99,10 @@ class Factorization {
       const auto r = static_cast<std::size_t>(ki[e]);
       const auto c = static_cast<std::size_t>(col_of_[e]);
       kx[e] = free_dof[r] * free_dof[c] * val[src_[e]];
-      if (r == c && free_dof[r] == 0.0) kx[e] = 1.0;
+      // Fixed axes, and free ones with a zero diagonal (a node left without mass or springs,
+      // e.g. removed by a piercing: in a semidefinite matrix its row is zero), get an identity
+      // row, so that they neither stop the factorization nor change the others' solution.
+      if (r == c && kx[e] == 0.0) kx[e] = 1.0;
     }
   }
 
@@ -122,18 +125,16 @@ class Factorization {
     valid_ = false;
     const bool ok = cholmod_factorize(K_, L_, &c_) && c_.status == CHOLMOD_OK;
     const std::size_t bad_pivot = ok ? nonpositive_pivot() : L_->minor;
+    if (!ok && c_.status != CHOLMOD_NOT_POSDEF)
+      throw SolverError(std::string(who) + ": CHOLMOD factorization failed (status " + std::to_string(c_.status) + ")", 0, 0);
     if (!ok || bad_pivot < L_->n) {
-      if (!ok && c_.status != CHOLMOD_NOT_POSDEF)
-        throw SolverError(std::string(who) + ": CHOLMOD factorization failed (status " + std::to_string(c_.status) + ")", 0, 0);
-      {
-        const std::size_t minor = bad_pivot;
-        const auto* perm = static_cast<const int*>(L_->Perm);
-        const std::size_t dof = (perm && minor < L_->n) ? static_cast<std::size_t>(perm[minor]) : minor;
-        throw SolverError(std::string(who) + ": the matrix is not positive definite on the free axes (Cholesky pivot " +
-                              std::to_string(minor) + " of " + std::to_string(L_->n) + " failed at node " +
-                              std::to_string(dof / 3) + ", axis " + "xyz"[dof % 3] + ")",
-                          0, 0);
-      }
+      // The pivot is counted in the fill-reducing order; Perm maps it back to the unknown.
+      const auto* perm = static_cast<const int*>(L_->Perm);
+      const std::size_t dof = (perm && bad_pivot < L_->n) ? static_cast<std::size_t>(perm[bad_pivot]) : bad_pivot;
+      throw SolverError(std::string(who) + ": the matrix is not positive definite on the free axes (Cholesky pivot " +
+                            std::to_string(bad_pivot) + " of " + std::to_string(L_->n) + " failed at node " +
+                            std::to_string(dof / 3) + ", axis " + "xyz"[dof % 3] + ")",
+                        0, 0);
     }
     if (keep_values) factored_.assign(static_cast<const double*>(K_->x), static_cast<const double*>(K_->x) + src_.size());
     valid_ = true;
