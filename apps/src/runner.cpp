@@ -384,7 +384,9 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   physics::SymplecticEulerOptions so;
   so.enforce_stable_step = !scene.allow_unstable;
   physics::ImplicitEulerOptions io_opt;
+  io_opt.solver = physics::solve::parse_backend(scene.solver);
   io_opt.cg_tolerance = scene.tolerance;
+  io_opt.cg_absolute_tolerance = scene.absolute_tolerance;
   io_opt.cg_max_iterations = static_cast<int>(scene.max_iterations);
   physics::SymplecticEuler semi(so);
   physics::LinearlyImplicitEuler implicit(io_opt);

@@ -1,5 +1,7 @@
 #include "sewn/apps/scene.hpp"
 
+#include "sewn/physics/errors.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -160,8 +162,12 @@ Field build_schema() {
       .members({field("type", Kind::string).one_of({"implicit", "semi-implicit"}).fallback("implicit")
                     .doc("Linearly implicit Euler (Baraff–Witkin, CG) or semi-implicit (symplectic) Euler."),
                 field("step", Kind::number).unit("s").fallback(1e-3).above(0).at_most(10).doc("Time step h."),
-                field("tolerance", Kind::number).fallback(1e-6).above(0).below(1).doc("CG relative residual (implicit)."),
-                field("max_iterations", Kind::integer).fallback(2000).at_least(1).at_most(1000000).doc("CG iteration limit (implicit); reaching it is an error."),
+                field("solver", Kind::string).one_of({"auto", "jacobi", "cholmod", "cholmod-pcg"}).fallback("auto")
+                    .doc("Linear solver (implicit), docs/solvers.md: `jacobi` block-Jacobi CG, `cholmod` sparse Cholesky, `cholmod-pcg` CG preconditioned by a reused Cholesky factorization; `auto` picks by model size. The CHOLMOD ones need SuiteSparse at build time."),
+                field("tolerance", Kind::number).fallback(physics::solve::default_tolerance).above(0).below(1).doc("Relative residual of the iterative solvers (implicit)."),
+                field("absolute_tolerance", Kind::number).unit("m/s").fallback(physics::solve::default_absolute_tolerance).at_least(0).at_most(1)
+                    .doc("Floor of the residual as a velocity error on every free axis (implicit): a body at rest stops there instead of chasing round-off. 0: none."),
+                field("max_iterations", Kind::integer).fallback(physics::solve::default_max_iterations).at_least(1).at_most(1000000).doc("Iteration limit of the iterative solvers (implicit); reaching it is an error."),
                 field("allow_unstable", Kind::boolean).fallback(false)
                     .doc("Run a semi-implicit step larger than the estimated stable bound (otherwise refused with the bound).")});
 
@@ -460,7 +466,14 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     Reader in(r["integrator"], *schema.member("integrator"));
     s.integrator = in.string("type");
     s.step = in.number("step");
+    s.solver = in.string("solver");
+    try {
+      (void)physics::solve::parse_backend(s.solver);  // a name this build lacks
+    } catch (const physics::InputError& e) {
+      throw SceneError(file, "integrator.solver", e.what());
+    }
     s.tolerance = in.number("tolerance");
+    s.absolute_tolerance = in.number("absolute_tolerance");
     s.max_iterations = static_cast<std::uint32_t>(in.integer("max_iterations"));
     s.allow_unstable = in.boolean("allow_unstable");
   }

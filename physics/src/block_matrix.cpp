@@ -1,6 +1,7 @@
 #include "sewn/physics/block_matrix.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <string>
 
 #include "sewn/physics/errors.hpp"
@@ -50,7 +51,10 @@ void BlockMatrix::build_pattern(Index n, std::span<const NodePair> pairs) {
     row_[i + 1] = static_cast<Index>(col_.size());
   }
   val_.assign(9 * col_.size(), 0.0);
-  ++version_;
+  // Unique across matrices, so that a solver caching an analysis per pattern cannot mistake
+  // another matrix's pattern for the one it analysed.
+  static std::atomic<std::uint64_t> patterns{0};
+  version_ = ++patterns;
 }
 
 Index BlockMatrix::find(Index i, Index j) const {

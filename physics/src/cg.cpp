@@ -1,5 +1,6 @@
 #include "sewn/physics/cg.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/LU>
@@ -144,7 +145,7 @@ inline __m256d precond_row(const double* pre, __m256d r) {
 // axes; its blocks are stored as symmetric ones (P's upper triangle: the inverse of a symmetric
 // block is symmetric up to round-off).
 CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
-                    std::span<const double> P, double b_norm, double tolerance, int max_iterations, CgWorkspace& ws) {
+                    std::span<const double> P, double b_norm, double stop, int max_iterations, CgWorkspace& ws) {
   const std::size_t n = b.size() / 3, n4 = 4 * n;
   for (auto* v : {&ws.r, &ws.z, &ws.p, &ws.q, &ws.x4, &ws.free4}) v->assign(n4, 0.0);
   ws.pre.resize(6 * n);
@@ -187,7 +188,7 @@ CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<co
   double rz = hsum(rz_acc);
   CgResult out;
   int it = 0;
-  while (r_norm > tolerance * b_norm && it < max_iterations) {
+  while (r_norm > stop && it < max_iterations) {
     const double pq = sym_multiply(ws, p, q, s, nodes);
     if (!(pq > 0.0)) {
       out.breakdown = true;
@@ -218,7 +219,7 @@ CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<co
     for (std::size_t a = 0; a < 3; ++a) x[3 * i + a] = xv[4 * i + a];
   out.iterations = it;
   out.relative_residual = r_norm / b_norm;
-  out.converged = !out.breakdown && std::isfinite(r_norm) && r_norm <= tolerance * b_norm;
+  out.converged = !out.breakdown && std::isfinite(r_norm) && r_norm <= stop;
   return out;
 }
 #endif
@@ -256,7 +257,7 @@ void block_jacobi_inverse(const BlockMatrix& A, std::span<const double> free_dof
 
 CgResult filtered_pcg(const BlockMatrix& A, std::span<const double> b, std::span<double> x,
                       std::span<const double> free_dof, std::span<const double> P, double tolerance,
-                      int max_iterations, CgWorkspace& ws) {
+                      int max_iterations, CgWorkspace& ws, double absolute_floor) {
   const std::size_t n3 = b.size();
   ws.resize(n3);
   std::span<double> r(ws.r), z(ws.z), p(ws.p), q(ws.q);
@@ -271,8 +272,10 @@ CgResult filtered_pcg(const BlockMatrix& A, std::span<const double> b, std::span
     return out;
   }
   const double b_norm = std::sqrt(b_norm2);
+  // The floor: near rest b is round-off, and a tolerance relative to it alone chases noise.
+  const double stop = std::max(tolerance * b_norm, absolute_floor);
 #ifdef SEWN_CG_AVX512
-  if (pack_symmetric(A, ws)) return pcg_packed(b, x, free_dof, P, b_norm, tolerance, max_iterations, ws);
+  if (pack_symmetric(A, ws)) return pcg_packed(b, x, free_dof, P, b_norm, stop, max_iterations, ws);
 #endif
   A.multiply(x, q);
   for (std::size_t k = 0; k < n3; ++k) r[k] = free_dof[k] * (b[k] - q[k]);
@@ -281,7 +284,7 @@ CgResult filtered_pcg(const BlockMatrix& A, std::span<const double> b, std::span
   for (std::size_t k = 0; k < n3; ++k) p[k] = z[k];
   double rz = dot(r, z);
   int it = 0;
-  while (r_norm > tolerance * b_norm && it < max_iterations) {
+  while (r_norm > stop && it < max_iterations) {
     A.multiply(p, q);
     for (std::size_t k = 0; k < n3; ++k) q[k] *= free_dof[k];
     const double pq = dot(p, q);
@@ -304,7 +307,7 @@ CgResult filtered_pcg(const BlockMatrix& A, std::span<const double> b, std::span
   }
   out.iterations = it;
   out.relative_residual = r_norm / b_norm;
-  out.converged = !out.breakdown && std::isfinite(r_norm) && r_norm <= tolerance * b_norm;
+  out.converged = !out.breakdown && std::isfinite(r_norm) && r_norm <= stop;
   return out;
 }
 

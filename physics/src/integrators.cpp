@@ -167,6 +167,7 @@ LinearlyImplicitEuler::LinearlyImplicitEuler(ImplicitEulerOptions options) : opt
 
 void LinearlyImplicitEuler::reset() {
   std::fill(dv_.begin(), dv_.end(), 0.0);
+  if (solver_) solver_->reset();
   watchdog_.reset();
 }
 
@@ -192,8 +193,19 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
     dv_.assign(n3, 0.0);
     kv_.assign(n3, 0.0);
     free_.assign(n3, 0.0);
-    precond_.assign(9 * std::size_t{n}, 0.0);
+    mass3_.assign(n3, 0.0);
   }
+  if (!solver_ || solver_asked_ != opt_.solver) {
+    solver_ = solve::make_solver(opt_.solver, {}, n);
+    solver_asked_ = opt_.solver;
+  }
+  solve::SolverOptions& so = solver_->options();
+  so.tolerance = opt_.cg_tolerance;
+  so.absolute_tolerance = opt_.cg_absolute_tolerance;
+  so.max_iterations = opt_.cg_max_iterations;
+  if (!(so.absolute_tolerance >= 0 && std::isfinite(so.absolute_tolerance)))
+    throw InputError("LinearlyImplicitEuler::step: cg_absolute_tolerance must be finite and >= 0, got " +
+                     fmt(so.absolute_tolerance));
   const bool watch = opt_.health.energy_check_interval > 0;
   if (watch) watchdog_.baseline_if_needed(sys);
 
@@ -217,7 +229,10 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
   const auto fixed = nodes.fixed_masks();
   for (Index i = 0; i < n; ++i) {
     A.block(A.diagonal(i)).diagonal().array() += mass[i];
-    for (int a = 0; a < 3; ++a) free_[3 * i + a] = ((fixed[i] >> a) & 1u) ? 0.0 : 1.0;
+    for (int a = 0; a < 3; ++a) {
+      free_[3 * i + a] = ((fixed[i] >> a) & 1u) ? 0.0 : 1.0;
+      mass3_[3 * i + a] = mass[i];
+    }
   }
 
   // 3) b = h (F₀ + h ∂F/∂P V₀); ΔV = 0 on fixed axes (their velocity is prescribed)
@@ -226,21 +241,27 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
     b_[k] = h * (f[k] + h * kv_[k]);
     if (!opt_.warm_start || free_[k] == 0.0) dv_[k] = 0.0;
   }
-  block_jacobi_inverse(A, free_, precond_);
-  const CgResult cg = filtered_pcg(A, b_, dv_, free_, precond_, opt_.cg_tolerance, opt_.cg_max_iterations, ws_);
-  rep.cg_iterations = cg.iterations;
-  rep.cg_relative_residual = cg.relative_residual;
-  rep.cg_converged = cg.converged;
-  if (!cg.converged && opt_.throw_on_cg_failure) {
+  solve::SolveReport sr;
+  try {
+    sr = solver_->solve(A, b_, dv_, free_, mass3_);
+  } catch (const SolverError& e) {
     std::fill(dv_.begin(), dv_.end(), 0.0);
-    throw SolverError("LinearlyImplicitEuler::step: CG stopped after " + std::to_string(cg.iterations) +
-                          " iterations at relative residual " + fmt(cg.relative_residual) + " (tolerance " +
-                          fmt(opt_.cg_tolerance) + ")" +
-                          (cg.breakdown ? "; breakdown: the matrix is not positive definite (compression with "
-                                          "clamp_compression = false?)"
-                                        : "") +
-                          "; the state is unchanged",
-                      cg.iterations, cg.relative_residual);
+    throw SolverError("LinearlyImplicitEuler::step " + std::to_string(steps_ + 1) + ": " + e.what() +
+                          " (compression with clamp_compression = false?); the state is unchanged",
+                      e.iterations(), e.residual());
+  }
+  rep.solve = sr;
+  rep.cg_iterations = sr.iterations;
+  rep.cg_relative_residual = sr.relative_residual;
+  rep.cg_converged = sr.converged;
+  if (!sr.converged && opt_.throw_on_cg_failure) {
+    std::fill(dv_.begin(), dv_.end(), 0.0);
+    throw SolverError("LinearlyImplicitEuler::step " + std::to_string(steps_ + 1) + ": the " +
+                          std::string(solve::to_string(sr.backend)) + " solve stopped after " +
+                          std::to_string(sr.iterations) + " iterations at relative residual " +
+                          fmt(sr.relative_residual) + " (tolerance " + fmt(opt_.cg_tolerance) + ", limit " +
+                          std::to_string(opt_.cg_max_iterations) + " iterations); the state is unchanged",
+                      sr.iterations, sr.relative_residual);
   }
 
   // 4) V₁ = V₀ + ΔV, P₁ = P₀ + h V₁

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "sewn/apps/scene.hpp"
+#include "sewn/physics/integrators.hpp"
 
 using namespace sewn::app;
 using nlohmann::json;
@@ -176,4 +177,24 @@ TEST_CASE("docs/scenes.md is the documentation generated from the schema") {
     CHECK(generated.find(key) != std::string::npos);
   CHECK(generated.find("| Pa |") != std::string::npos);
   CHECK(generated.find("kg/m³") != std::string::npos);
+}
+
+TEST_CASE("integrator.solver and the solver defaults: one iteration limit for the library and the tool") {
+  const Scene s = parse_scene(minimal(), "beam.json");
+  CHECK(s.solver == "auto");
+  // issue 17: the tool's defaults are the library's (they disagreed: 2000 against 1000)
+  const sewn::physics::ImplicitEulerOptions lib;
+  CHECK(s.max_iterations == static_cast<std::uint32_t>(lib.cg_max_iterations));
+  CHECK(s.tolerance == lib.cg_tolerance);
+  CHECK(s.absolute_tolerance == lib.cg_absolute_tolerance);
+  for (auto b : sewn::physics::solve::available_backends()) {
+    json j = minimal();
+    j["integrator"]["solver"] = std::string(sewn::physics::solve::to_string(b));
+    CHECK(parse_scene(j, "beam.json").solver == sewn::physics::solve::to_string(b));
+  }
+  json j = minimal();
+  j["integrator"] = json::parse(R"({"solver": "lu"})");
+  expect_error(j, "integrator.solver", "cholmod");
+  j["integrator"] = json::parse(R"({"absolute_tolerance": -1})");
+  expect_error(j, "integrator.absolute_tolerance", ">= 0");
 }

@@ -65,8 +65,11 @@ SymplecticEulerOptions unguarded(int energy_check_interval = 100) {
   return o;
 }
 
+// Block-Jacobi CG (the reference backend) with exactly this tolerance and limit, no floor.
 ImplicitEulerOptions cg_options(double tolerance, int max_iterations = 1000) {
   ImplicitEulerOptions o;
+  o.solver = solve::Backend::jacobi;
+  o.cg_absolute_tolerance = 0;
   o.cg_tolerance = tolerance;
   o.cg_max_iterations = max_iterations;
   return o;

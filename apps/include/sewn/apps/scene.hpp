@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "sewn/apps/schema.hpp"
+#include "sewn/physics/solve/linear_solver.hpp"
 
 namespace sewn::app {
 
@@ -83,8 +84,10 @@ struct Scene {
   double rayleigh_alpha = 0, rayleigh_beta = 0, environment_damping = 0;
   std::string integrator = "implicit";
   double step = 1e-3, duration = 1;
-  double tolerance = 1e-6;
-  std::uint32_t max_iterations = 2000;
+  std::string solver = "auto";
+  double tolerance = physics::solve::default_tolerance;
+  double absolute_tolerance = physics::solve::default_absolute_tolerance;
+  std::uint32_t max_iterations = physics::solve::default_max_iterations;
   bool allow_unstable = false;
   std::vector<CutSpec> cuts;
   std::uint32_t frames = 50;

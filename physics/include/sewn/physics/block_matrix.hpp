@@ -50,7 +50,8 @@ class BlockMatrix {
   void multiply(std::span<const double> x, std::span<double> y) const;
   /// The same matrix as an Eigen sparse matrix (3n×3n), for tests and direct solvers. O(blocks).
   [[nodiscard]] Eigen::SparseMatrix<double> to_sparse() const;
-  /// Changes whenever build_pattern() runs; terms compare it to know their cached slots are stale.
+  /// Changes whenever build_pattern() runs, unique across all matrices (0: never built); terms
+  /// and solvers compare it to know their cached slots or analyses are stale.
   [[nodiscard]] std::uint64_t pattern_version() const { return version_; }
 
  private:

@@ -39,10 +39,10 @@ struct CgWorkspace {
 };
 
 /// Solves A x = b on the free axes with x fixed to its incoming values on the others (pass
-/// the warm start there too). Stops when the relative residual ≤ tolerance or after
-/// max_iterations. O(iterations · blocks).
+/// the warm start there too). Stops when ‖S(b - Ax)‖ ≤ max(tolerance · ‖Sb‖, absolute_floor)
+/// or after max_iterations. O(iterations · blocks).
 CgResult filtered_pcg(const BlockMatrix& A, std::span<const double> b, std::span<double> x,
                       std::span<const double> free_dof, std::span<const double> precond_inverse, double tolerance,
-                      int max_iterations, CgWorkspace& ws);
+                      int max_iterations, CgWorkspace& ws, double absolute_floor = 0.0);
 
 }  // namespace sewn::physics

@@ -3,7 +3,8 @@
 //   SymplecticEuler        V ← V + h M⁻¹F(P,V), then P ← P + h V (the seed's semi-implicit
 //                          scheme), refused above the stable-step bound unless opted out;
 //   LinearlyImplicitEuler  (M - h∂F/∂V - h²∂F/∂P) ΔV = h (F₀ + h ∂F/∂P V₀), V ← V + ΔV,
-//                          P ← P + h V, solved by block-Jacobi PCG with filtering.
+//                          P ← P + h V, solved with filtering by the solver layer
+//                          (solve/linear_solver.hpp: block-Jacobi PCG, CHOLMOD, CHOLMOD-PCG).
 // Fixed axes keep their velocity (0 unless prescribed: kinematic). Both check the state
 // before using it: a non-finite position, velocity or force stops the step with a
 // BlowupError naming the node, leaving the state as it was; an energy watchdog stops runs
@@ -12,10 +13,12 @@
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "sewn/physics/aligned.hpp"
 #include "sewn/physics/cg.hpp"
+#include "sewn/physics/solve/linear_solver.hpp"
 #include "sewn/physics/system.hpp"
 
 namespace sewn::physics {
@@ -34,11 +37,12 @@ struct HealthOptions {
   double energy_floor_fraction = 1e-6;
 };
 
-/// What a step did. Semi-implicit steps leave the CG fields at their defaults.
+/// What a step did. Semi-implicit steps leave the solver fields at their defaults.
 struct StepReport {
-  int cg_iterations = 0;
-  double cg_relative_residual = 0.0;
-  bool cg_converged = true;
+  int cg_iterations = 0;              ///< = solve.iterations
+  double cg_relative_residual = 0.0;  ///< = solve.relative_residual
+  bool cg_converged = true;           ///< = solve.converged
+  solve::SolveReport solve;           ///< the linear solve's full report (backend, factorizations, times)
   bool pattern_rebuilt = false;
   double stable_step = std::numeric_limits<double>::quiet_NaN();  ///< bound in force (semi-implicit)
 };
@@ -92,11 +96,17 @@ class SymplecticEuler {
 };
 
 struct ImplicitEulerOptions {
-  double cg_tolerance = 1e-6;   ///< relative residual ‖S(b - AΔV)‖/‖Sb‖
-  int cg_max_iterations = 1000;
+  /// The linear solver (solve/linear_solver.hpp); automatic picks by model size.
+  solve::Backend solver = solve::Backend::automatic;
+  double cg_tolerance = solve::default_tolerance;  ///< relative residual ‖S(b - AΔV)‖/‖Sb‖
+  /// Absolute floor of the residual as a velocity, m/s (solve::SolverOptions::absolute_tolerance):
+  /// a body at rest stops at it instead of chasing the round-off of a vanishing right-hand side.
+  double cg_absolute_tolerance = solve::default_absolute_tolerance;
+  int cg_max_iterations = solve::default_max_iterations;
   bool warm_start = true;       ///< start CG from the previous step's ΔV
-  /// Throw SolverError (state unchanged) when CG misses its tolerance; if false the step is
-  /// applied and StepReport::cg_converged is false.
+  /// Throw SolverError (state unchanged) when the solve misses its tolerance; if false the step
+  /// is applied and StepReport::cg_converged is false. A matrix that is not positive definite
+  /// always throws SolverError naming the step (state unchanged).
   bool throw_on_cg_failure = true;
   /// Simplifications of ∂F/∂x in the matrix (and in the ∂F/∂P·V₀ product, so the scheme is
   /// the linearised implicit Euler of that approximate Jacobian). CG needs a symmetric matrix.
@@ -107,20 +117,23 @@ struct ImplicitEulerOptions {
 class LinearlyImplicitEuler {
  public:
   explicit LinearlyImplicitEuler(ImplicitEulerOptions options = {});
-  /// Advances sys by h > 0 (Baraff-Witkin form). Throws InputError on a bad h or a term whose
-  /// matrix would not be symmetric, SolverError if CG misses its tolerance (unless opted
-  /// out: then check the report), BlowupError as SymplecticEuler. Cost: one force and one
-  /// Jacobian evaluation, CG iterations × one block-sparse product; no allocation once the
-  /// work arrays are sized (they are resized after topology changes).
+  /// Advances sys by h > 0 (Baraff-Witkin form). Throws InputError on a bad h, bad solver
+  /// options or a term whose matrix would not be symmetric, SolverError naming the step if the
+  /// matrix is not positive definite or the solve misses its tolerance (unless opted out:
+  /// then check the report), BlowupError as SymplecticEuler. Cost: one force and one Jacobian
+  /// evaluation and one solve (jacobi: iterations × one block-sparse product; cholmod-pcg:
+  /// iterations × (product + two triangular solves), plus a factorization when refreshed);
+  /// no allocation once the work arrays are sized (they are resized after topology changes).
   [[nodiscard]] StepReport step(System& sys, double h);
   [[nodiscard]] ImplicitEulerOptions& options() { return opt_; }
-  /// Forgets the warm start and the energy baseline.
+  /// Forgets the warm start, the solver's factorizations and the energy baseline.
   void reset();
 
  private:
   ImplicitEulerOptions opt_;
-  AlignedVector<double> b_, dv_, kv_, free_, precond_;
-  CgWorkspace ws_;
+  AlignedVector<double> b_, dv_, kv_, free_, mass3_;
+  std::unique_ptr<solve::LinearSolver> solver_;
+  solve::Backend solver_asked_ = solve::Backend::automatic;
   std::uint64_t steps_ = 0;
   EnergyWatchdog watchdog_;
 };

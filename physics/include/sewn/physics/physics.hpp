@@ -9,6 +9,7 @@
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/lattice.hpp"
 #include "sewn/physics/nodes.hpp"
+#include "sewn/physics/solve/linear_solver.hpp"
 #include "sewn/physics/springs.hpp"
 #include "sewn/physics/stiffness.hpp"
 #include "sewn/physics/system.hpp"

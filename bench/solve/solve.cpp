@@ -1,0 +1,208 @@
+// bench_solve: the solver layer's backends on the implicit step (issue 14).
+//
+//   solve/<case>/<backend>/ours   linearly implicit Euler steps with that backend
+//   solve/<case>/<backend>/peer   the same steps with block-Jacobi CG ("jacobi"), interleaved
+//
+// Each repetition starts from rest with a fresh solver and takes `steps` steps, so a backend's
+// factorizations and analyses are paid inside the time it reports (ms per step). Counters per
+// step: solver iterations, factorizations, and the solver's own analyse / factor / solve times.
+// "error" is the position error after `error_steps` steps against a direct solve whose every step
+// reached a relative residual below 1e-12, relative to that solve's displacement (once per case,
+// the same number in every repetition). Threads: the solver backends run on one thread here.
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "sewn/physics/integrators.hpp"
+#include "sewn/physics/mss_model.hpp"
+#include "sewn/physics/solve/linear_solver.hpp"
+#include "sewn_bench.hpp"
+
+namespace sewn::bench::solve_suite {
+
+namespace {
+
+using namespace sewn::physics;
+constexpr const char* suite = "solve";
+const MaterialParams paper_material{100e6, 0.3, 1000};
+
+struct Case {
+  std::string name;
+  std::function<std::unique_ptr<MssModel<3>>()> build;
+  double h;
+  int steps;        // per repetition
+  int error_steps;  // for the error column
+};
+
+std::unique_ptr<MssModel<3>> clamped(const IndexedMesh& mesh, int axis) {
+  auto m = std::make_unique<MssModel<3>>(mesh, std::vector<MaterialParams>{paper_material}, std::vector<std::uint32_t>{});
+  for (Index i = 0; i < m->nodes().size(); ++i)
+    if (m->rest_position(i)[axis] <= 1e-12) m->nodes().fix(i);
+  return m;
+}
+
+GridSpec cubes(double a) {
+  GridSpec g;
+  g.spacing = {a, a, a};
+  return g;
+}
+
+std::vector<Case> cases(Scale scale) {
+  std::vector<Case> c;
+  if (scale == Scale::smoke) {
+    c.push_back({"sofa/2x2x3/h1ms", [] { return clamped(hex_grid(2, 2, 3, cubes(0.0125)), 2); }, 1e-3, 3, 5});
+    c.push_back({"cantilever/N2/h10ms", [] { return clamped(hex_grid(20, 2, 2, cubes(0.05)), 0); }, 1e-2, 3, 5});
+    return c;
+  }
+  c.push_back({"sofa/8x8x10/h1ms", [] { return clamped(hex_grid(8, 8, 10, cubes(0.0125)), 2); }, 1e-3, 20, 100});
+  c.push_back({"tetbeam/5x7x9/h1ms", [] { return clamped(tet_grid(5, 7, 9, TetSplit::kuhn6, cubes(0.01)), 2); }, 1e-3,
+               20, 100});
+  // The cantilever of bench/results/mss.md: 1 m × 0.1 m × 0.1 m as 10N×N×N cubes, clamped at x = 0.
+  c.push_back({"cantilever/N8/h10ms", [] { return clamped(hex_grid(80, 8, 8, cubes(0.1 / 8)), 0); }, 1e-2, 10, 100});
+  if (scale == Scale::full) {
+    c.push_back({"cantilever/N16/h10ms", [] { return clamped(hex_grid(160, 16, 16, cubes(0.1 / 16)), 0); }, 1e-2, 3,
+                 10});
+    c.push_back({"scaleup/N16/h0.1ms", [] { return clamped(hex_grid(16, 16, 16, cubes(0.1 / 16)), 2); }, 1e-4, 10, 100});
+    c.push_back({"scaleup/N32/h0.01ms", [] { return clamped(hex_grid(32, 32, 32, cubes(0.1 / 32)), 2); }, 1e-5, 4, 10});
+  }
+  return c;
+}
+
+// One model per case, kept between benchmarks and reset to rest before each run.
+struct Kept {
+  std::unique_ptr<MssModel<3>> model;
+  std::vector<Eigen::Vector3d> x0, v0;
+  Eigen::VectorXd reference;  // positions after error_steps, tight direct solve
+  double reference_residual = 0;  // its worst relative residual
+  std::string error;          // a failed set-up check
+};
+
+Kept& kept(const Case& c) {
+  static std::map<std::string, Kept> all;
+  Kept& k = all[c.name];
+  if (!k.model) {
+    k.model = c.build();
+    for (Index i = 0; i < k.model->nodes().size(); ++i) {
+      k.x0.push_back(k.model->nodes().position(i));
+      k.v0.push_back(k.model->nodes().velocity(i));
+    }
+  }
+  return k;
+}
+
+void restore(Kept& k) {
+  for (Index i = 0; i < k.model->nodes().size(); ++i) {
+    k.model->nodes().set_position(i, k.x0[i]);
+    k.model->nodes().set_velocity(i, k.v0[i]);
+  }
+}
+
+ImplicitEulerOptions options_for(solve::Backend b, double tolerance, double floor) {
+  ImplicitEulerOptions o;
+  o.solver = b;
+  o.cg_tolerance = tolerance;
+  o.cg_absolute_tolerance = floor;
+  o.cg_max_iterations = solve::default_max_iterations;
+  o.health.energy_check_interval = 0;
+  return o;
+}
+
+Eigen::VectorXd positions(MssModel<3>& m) { return m.nodes().positions_flat(); }
+
+// Positions after c.error_steps steps with backend b at its default tolerances.
+Eigen::VectorXd run_for_error(Kept& k, const Case& c, solve::Backend b, double tolerance, double floor, bool tight) {
+  restore(k);
+  ImplicitEulerOptions o = options_for(b, tolerance, floor);
+  // 1e-12 is below the round-off floor ε‖A‖‖x‖/‖b‖ of the stiffest cases (the cantilever at
+  // h = 10 ms stops near 1e-11): the reference takes what refinement reaches, reported below.
+  o.throw_on_cg_failure = !tight;
+  LinearlyImplicitEuler ie(o);
+  for (int s = 0; s < c.error_steps; ++s) {
+    const StepReport r = ie.step(k.model->system(), c.h);
+    if (tight) k.reference_residual = std::max(k.reference_residual, r.solve.relative_residual);
+  }
+  if (tight && !(k.reference_residual < 1e-9))
+    throw std::runtime_error(c.name + ": the reference solve reached only " + std::to_string(k.reference_residual));
+  Eigen::VectorXd x = positions(*k.model);
+  restore(k);
+  return x;
+}
+
+double error_of(Kept& k, const Case& c, solve::Backend b) {
+  if (k.reference.size() == 0) {
+    const bool direct = solve::available(solve::Backend::cholmod);
+    k.reference = run_for_error(k, c, direct ? solve::Backend::cholmod : solve::Backend::jacobi, 1e-12, 0.0, true);
+  }
+  Eigen::VectorXd rest(k.reference.size());
+  for (std::size_t i = 0; i < k.x0.size(); ++i) rest.segment<3>(3 * Eigen::Index(i)) = k.x0[i];
+  const Eigen::VectorXd x = run_for_error(k, c, b, solve::default_tolerance, solve::default_absolute_tolerance, false);
+  return (x - k.reference).norm() / (k.reference - rest).norm();
+}
+
+void run(benchmark::State& st, const Case& c, solve::Backend b) {
+  Kept& k = kept(c);
+  if (!k.error.empty()) {
+    st.SkipWithError(k.error.c_str());
+    return;
+  }
+  double err = 0;
+  const std::string key = c.name + "/" + std::string(solve::to_string(b));
+  static std::map<std::string, double> errors;
+  try {
+    if (first_time(key)) errors[key] = error_of(k, c, b);
+    err = errors[key];
+  } catch (const std::exception& e) {
+    k.error = e.what();
+    st.SkipWithError(k.error.c_str());
+    return;
+  }
+  double iterations = 0, factorizations = 0, analyse = 0, factor = 0, solve_ms = 0;
+  std::unique_ptr<LinearlyImplicitEuler> ie;
+  int s = 0;
+  for (auto _ : st) {
+    if (s % c.steps == 0) {
+      const Untimed untimed(st);
+      restore(k);
+      ie = std::make_unique<LinearlyImplicitEuler>(options_for(b, solve::default_tolerance, solve::default_absolute_tolerance));
+    }
+    const StepReport r = ie->step(k.model->system(), c.h);
+    iterations += r.solve.iterations;
+    factorizations += r.solve.factorizations;
+    analyse += r.solve.analyse_ms;
+    factor += r.solve.factor_ms;
+    solve_ms += r.solve.solve_ms;
+    ++s;
+  }
+  restore(k);
+  using C = benchmark::Counter;
+  st.counters["iterations"] = C(iterations, C::kAvgIterations);
+  st.counters["factorizations"] = C(factorizations, C::kAvgIterations);
+  st.counters["analyse ms"] = C(analyse, C::kAvgIterations);
+  st.counters["factor ms"] = C(factor, C::kAvgIterations);
+  st.counters["solve ms"] = C(solve_ms, C::kAvgIterations);
+  st.counters["error after " + std::to_string(c.error_steps) + " steps"] = err;
+  st.counters["reference residual"] = k.reference_residual;
+}
+
+void register_all() {
+  for (const Case& c : cases(scale())) {
+    for (solve::Backend b : solve::available_backends()) {
+      if (b == solve::Backend::jacobi) continue;
+      const std::string name = c.name + "/" + std::string(solve::to_string(b));
+      ours(suite, name, [c, b](benchmark::State& st) { run(st, c, b); })->Iterations(c.steps);
+      peer(suite, name, "jacobi", [c](benchmark::State& st) { run(st, c, solve::Backend::jacobi); })->Iterations(c.steps);
+    }
+  }
+}
+
+const Registration registration(&register_all);
+
+}  // namespace
+
+}  // namespace sewn::bench::solve_suite

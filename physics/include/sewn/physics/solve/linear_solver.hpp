@@ -1,0 +1,117 @@
+#pragma once
+// The solver layer: every implicit integrator solves its symmetric positive definite systems
+// A x = b, assembled on the 3×3 block pattern (BlockMatrix), through one LinearSolver.
+//
+// How an integrator uses it (the linearly implicit Euler does exactly this, a Newton iteration
+// does it once per iteration):
+//   1. assemble A into sys.matrix() (the pattern is reused until the topology changes);
+//   2. free_dof[k] = 1 on free axes, 0 on fixed ones;
+//   3. put the prescribed values of the fixed axes (and a warm start on the free ones) in x;
+//   4. report = solver.solve(A, b, x, free_dof).
+// Fixed axes are filtered (PHYSICS_NOTES §1.5): x keeps its values there and the free axes
+// solve S(b - A x) = 0, S = diag(free_dof). A solver keeps what it can reuse between calls
+// (a symbolic analysis while A's pattern_version() is unchanged, a numeric factorization while
+// it is accurate enough); a new pattern (a cut, a refinement) is noticed by itself.
+//
+// Backends (which exist in this build: available_backends()):
+//   jacobi       block-Jacobi preconditioned CG, the reference: no set-up, O(iterations · blocks);
+//   cholmod      sparse Cholesky (SuiteSparse CHOLMOD): symbolic analysis once per pattern,
+//                numeric factorization whenever A's values changed, two triangular solves, and
+//                up to 3 refinement passes (reported as iterations) while the residual misses
+//                the tolerance (ill-conditioned matrices);
+//   cholmod-pcg  CG preconditioned by a CHOLMOD factorization of a recent A, kept across steps
+//                (and Newton iterations) while CG needs few iterations, refreshed when they grow.
+// Backend::automatic picks by model size (default_backend(), measured: docs/solvers.md; today
+// jacobi at every size).
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sewn/physics/block_matrix.hpp"
+
+namespace sewn::physics::solve {
+
+enum class Backend { automatic, jacobi, cholmod, cholmod_pcg };
+
+/// "auto", "jacobi", "cholmod", "cholmod-pcg". O(1).
+[[nodiscard]] std::string_view to_string(Backend b);
+/// The inverse of to_string; throws InputError listing the names (and saying which are not
+/// built in) for any other name. O(1).
+[[nodiscard]] Backend parse_backend(std::string_view name);
+/// The backends built in (jacobi always; the CHOLMOD ones when SuiteSparse was found). O(1).
+[[nodiscard]] std::vector<Backend> available_backends();
+[[nodiscard]] bool available(Backend b);
+
+/// The CG iteration limit of the library and of the tool: the cantilever of bench/results/mss.md
+/// at N = 16, h = 10 ms needs up to ~1300 block-Jacobi iterations a step, so 1000 failed there.
+inline constexpr int default_max_iterations = 5000;
+/// The relative residual every iterative solve stops at by default.
+inline constexpr double default_tolerance = 1e-6;
+/// The absolute floor of the residual, as a velocity (m/s, see SolverOptions).
+inline constexpr double default_absolute_tolerance = 1e-9;
+
+struct SolverOptions {
+  /// Iterative backends stop when ‖S(b - Ax)‖ ≤ max(tolerance · ‖Sb‖, floor).
+  double tolerance = default_tolerance;
+  /// floor = absolute_tolerance · ‖S m‖, m the diagonal of A's mass part as passed in
+  /// `mass_scale` (see solve()), i.e. the residual of a velocity error of absolute_tolerance
+  /// m/s on every free axis. A body at rest has a right-hand side made of round-off, and a
+  /// tolerance relative to it alone would chase that round-off; the floor stops there. 0: none.
+  double absolute_tolerance = default_absolute_tolerance;
+  int max_iterations = default_max_iterations;
+  /// cholmod-pcg: the factorization is refreshed before the next solve once a solve needed more
+  /// than this many iterations (and at once, with a retry, if CG fails with a stale factor).
+  int refresh_iterations = 12;
+};
+
+/// What one solve cost. Times are wall-clock milliseconds spent inside the solver.
+struct SolveReport {
+  Backend backend = Backend::jacobi;
+  int symbolic_analyses = 0;  ///< 0 or 1 in this solve
+  int factorizations = 0;     ///< numeric factorizations in this solve (0 when one was reused)
+  int iterations = 0;         ///< CG iterations (0 for a direct solve)
+  double relative_residual = 0.0;  ///< ‖S(b - Ax)‖ / ‖Sb‖ (0 if Sb = 0)
+  double residual = 0.0;           ///< ‖S(b - Ax)‖
+  bool converged = false;
+  double analyse_ms = 0.0, factor_ms = 0.0, solve_ms = 0.0;
+};
+
+class LinearSolver {
+ public:
+  virtual ~LinearSolver() = default;
+  [[nodiscard]] virtual Backend backend() const = 0;
+  [[nodiscard]] SolverOptions& options() { return opt_; }
+  [[nodiscard]] const SolverOptions& options() const { return opt_; }
+
+  /// Solves the filtered system described above. A must be symmetric (blocks (i,j) = (j,i)ᵀ)
+  /// and positive definite on the free axes. b, x, free_dof: 3·A.size() values; mass_scale:
+  /// per-axis masses for the absolute floor (empty: the floor is not applied). Returns the
+  /// report; converged = false if an iterative backend ran out of iterations (x then holds its
+  /// last iterate). Throws SolverError if A is found not positive definite on the free axes:
+  /// the CHOLMOD backends always find it, naming the node and axis of the failed pivot, with x
+  /// unchanged; jacobi finds a negative diagonal entry (named, x unchanged) or a CG breakdown
+  /// (x holds an iterate), but CG may also converge on an indefinite matrix without noticing.
+  /// Throws InputError on sizes that do not match. Cost: see the backend list above. Not
+  /// thread-safe per instance.
+  virtual SolveReport solve(const BlockMatrix& A, std::span<const double> b, std::span<double> x,
+                            std::span<const double> free_dof, std::span<const double> mass_scale = {}) = 0;
+  /// Forgets every factorization and analysis (the next solve starts afresh). O(1).
+  virtual void reset() {}
+
+ protected:
+  explicit LinearSolver(SolverOptions o) : opt_(o) {}
+  SolverOptions opt_;
+};
+
+/// The backend `automatic` resolves to for a model of this many nodes (measured, docs/solvers.md).
+[[nodiscard]] Backend default_backend(std::size_t nodes);
+
+/// A solver of backend b (automatic: default_backend(nodes)). Throws InputError if b is not
+/// built in. O(1); the first solve allocates.
+[[nodiscard]] std::unique_ptr<LinearSolver> make_solver(Backend b, SolverOptions options = {}, std::size_t nodes = 0);
+
+}  // namespace sewn::physics::solve

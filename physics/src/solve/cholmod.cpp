@@ -1,0 +1,400 @@
+// The CHOLMOD backends: a sparse Cholesky solve, and CG preconditioned by a factorization kept
+// across solves. Both factor the filtered matrix K = S A S + (I - S): fixed axes become
+// identity rows and columns. K's scalar pattern is that of A's blocks whatever the mask, so
+// the symbolic analysis depends on A's pattern only and survives a change of fixed axes.
+
+#include <cholmod.h>
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "backends.hpp"
+#include "sewn/physics/aligned.hpp"
+#include "sewn/physics/errors.hpp"
+
+namespace sewn::physics::solve::detail {
+
+namespace {
+
+// Eight partial sums in a fixed order (deterministic; see cg.cpp).
+double dot(const double* __restrict x, const double* __restrict y, std::size_t n) {
+  double part[8] = {};
+  const std::size_t n8 = n - n % 8;
+  for (std::size_t k = 0; k < n8; k += 8)
+    for (std::size_t q = 0; q < 8; ++q) part[q] += x[k + q] * y[k + q];
+  double s = ((part[0] + part[1]) + (part[2] + part[3])) + ((part[4] + part[5]) + (part[6] + part[7]));
+  for (std::size_t k = n8; k < n; ++k) s += x[k] * y[k];
+  return s;
+}
+
+// One CHOLMOD workspace, the filtered matrix in its upper-triangular CSC form, and its factor.
+class Factorization {
+ public:
+  Factorization() {
+    cholmod_start(&c_);
+    c_.print = 0;  // failures are reported by our exceptions, not on stderr
+    // LLᵀ: a simplicial LDLᵀ would succeed on an indefinite matrix (only a zero pivot stops
+    // it), and indefiniteness is what must be reported.
+    c_.final_ll = 1;
+  }
+  ~Factorization() {
+    free_factor();
+    if (K_) cholmod_free_sparse(&K_, &c_);
+    if (X_) cholmod_free_dense(&X_, &c_);
+    if (Y_) cholmod_free_dense(&Y_, &c_);
+    if (E_) cholmod_free_dense(&E_, &c_);
+    cholmod_finish(&c_);
+  }
+  Factorization(const Factorization&) = delete;
+  Factorization& operator=(const Factorization&) = delete;
+
+  /// Rebuilds K's pattern if A's changed; returns true then (the analysis is stale). O(blocks · log).
+  bool sync_pattern(const BlockMatrix& A) {
+    if (K_ && pattern_ == A.pattern_version()) return false;
+    free_factor();
+    if (K_) cholmod_free_sparse(&K_, &c_);
+    const Index nb = A.size();
+    const std::size_t n = 3 * std::size_t{nb};
+    const auto rows = A.row_offsets();
+    const auto cols = A.columns();
+    std::vector<int> p(n + 1, 0), i;
+    src_.clear();
+    i.reserve(9 * std::size_t{A.num_blocks()} / 2 + n);
+    src_.reserve(i.capacity());
+    // Column 3bj+c holds rows 3bi+a for the blocks (bi, bj), bi ≤ bj, ascending; the value
+    // A(bi,bj)(a,c) sits in that block's column-major storage at 3c + a.
+    for (Index bj = 0; bj < nb; ++bj) {
+      for (int c = 0; c < 3; ++c) {
+        for (Index k = rows[bj]; k < rows[bj + 1]; ++k) {
+          const Index bi = cols[k];
+          if (bi > bj) break;
+          const Index slot = A.find(bi, bj);
+          for (int a = 0; a < 3 && (bi < bj || a <= c); ++a) {
+            i.push_back(static_cast<int>(3 * bi + static_cast<Index>(a)));
+            src_.push_back(9 * std::size_t{slot} + 3 * static_cast<std::size_t>(c) + static_cast<std::size_t>(a));
+          }
+        }
+        p[3 * std::size_t{bj} + static_cast<std::size_t>(c) + 1] = static_cast<int>(i.size());
+      }
+    }
+    K_ = cholmod_allocate_sparse(n, n, i.size(), 1, 1, 1, CHOLMOD_REAL, &c_);
+    if (!K_) throw SolverError("cholmod: out of memory for a matrix of " + std::to_string(i.size()) + " entries", 0, 0);
+    std::memcpy(K_->p, p.data(), p.size() * sizeof(int));
+    std::memcpy(K_->i, i.data(), i.size() * sizeof(int));
+    col_of_.resize(i.size());
+    for (std::size_t col = 0; col < n; ++col)
+      for (int e = p[col]; e < p[col + 1]; ++e) col_of_[static_cast<std::size_t>(e)] = static_cast<int>(col);
+    pattern_ = A.pattern_version();
+    return true;
+  }
+
+  /// K's values from A and the mask. O(entries).
+  void fill_values(const BlockMatrix& A, std::span<const double> free_dof) {
+    const double* val = A.num_blocks() ? A.block(0).data() : nullptr;
+    auto* kx = static_cast<double*>(K_->x);
+    const auto* ki = static_cast<const int*>(K_->i);
+    for (std::size_t e = 0; e < src_.size(); ++e) {
+      const auto r = static_cast<std::size_t>(ki[e]);
+      const auto c = static_cast<std::size_t>(col_of_[e]);
+      kx[e] = free_dof[r] * free_dof[c] * val[src_[e]];
+      // Fixed axes, and free ones with a zero diagonal (a node left without mass or springs,
+      // e.g. removed by a piercing: in a semidefinite matrix its row is zero), get an identity
+      // row, so that they neither stop the factorization nor change the others' solution.
+      if (r == c && kx[e] == 0.0) kx[e] = 1.0;
+    }
+  }
+
+  /// True if K's values equal those last factored (then the factor is exact for K). O(entries).
+  [[nodiscard]] bool factor_matches_values() const {
+    return valid_ && factored_.size() == src_.size() &&
+           std::equal(factored_.begin(), factored_.end(), static_cast<const double*>(K_->x));
+  }
+
+  /// Symbolic analysis (fill-reducing ordering, elimination tree). Milliseconds.
+  void analyse() {
+    free_factor();
+    L_ = cholmod_analyze(K_, &c_);
+    if (!L_) throw SolverError("cholmod: symbolic analysis failed (status " + std::to_string(c_.status) + ")", 0, 0);
+  }
+
+  /// Numeric factorization of K's current values; throws SolverError naming the node and axis
+  /// where a pivot was not positive.
+  void factorize(const char* who, bool keep_values) {
+    valid_ = false;
+    const bool ok = cholmod_factorize(K_, L_, &c_) && c_.status == CHOLMOD_OK;
+    const std::size_t bad_pivot = ok ? nonpositive_pivot() : L_->minor;
+    if (!ok && c_.status != CHOLMOD_NOT_POSDEF)
+      throw SolverError(std::string(who) + ": CHOLMOD factorization failed (status " + std::to_string(c_.status) + ")", 0, 0);
+    if (!ok || bad_pivot < L_->n) {
+      // The pivot is counted in the fill-reducing order; Perm maps it back to the unknown.
+      const auto* perm = static_cast<const int*>(L_->Perm);
+      const std::size_t dof = (perm && bad_pivot < L_->n) ? static_cast<std::size_t>(perm[bad_pivot]) : bad_pivot;
+      throw SolverError(std::string(who) + ": the matrix is not positive definite on the free axes (Cholesky pivot " +
+                            std::to_string(bad_pivot) + " of " + std::to_string(L_->n) + " failed at node " +
+                            std::to_string(dof / 3) + ", axis " + "xyz"[dof % 3] + ")",
+                        0, 0);
+    }
+    if (keep_values) factored_.assign(static_cast<const double*>(K_->x), static_cast<const double*>(K_->x) + src_.size());
+    valid_ = true;
+  }
+
+  [[nodiscard]] bool valid() const { return valid_; }
+  /// True once analyse() ran on the current pattern (sync_pattern() drops it).
+  [[nodiscard]] bool analysed() const { return L_ != nullptr; }
+  void invalidate() { valid_ = false; }
+  void forget() {
+    free_factor();
+    if (K_) cholmod_free_sparse(&K_, &c_);
+    pattern_ = 0;
+  }
+
+  /// out = K⁻¹ rhs (3n values each; may alias). Two triangular solves, no allocation once sized.
+  void solve(std::span<const double> rhs, std::span<double> out) {
+    cholmod_dense B{};
+    B.nrow = rhs.size();
+    B.ncol = 1;
+    B.nzmax = rhs.size();
+    B.d = rhs.size();
+    B.x = const_cast<double*>(rhs.data());  // read only by cholmod_solve2
+    B.xtype = CHOLMOD_REAL;
+    B.dtype = CHOLMOD_DOUBLE;
+    if (!cholmod_solve2(CHOLMOD_A, L_, &B, nullptr, &X_, nullptr, &Y_, &E_, &c_))
+      throw SolverError("cholmod: triangular solve failed (status " + std::to_string(c_.status) + ")", 0, 0);
+    std::copy_n(static_cast<const double*>(X_->x), out.size(), out.data());
+  }
+
+ private:
+  // A simplicial LDLᵀ factor (if CHOLMOD left one despite final_ll) with a pivot d_j ≤ 0: j, else n.
+  [[nodiscard]] std::size_t nonpositive_pivot() const {
+    if (L_->is_super || L_->is_ll) return L_->n;
+    const auto* lp = static_cast<const int*>(L_->p);
+    const auto* lx = static_cast<const double*>(L_->x);
+    for (std::size_t j = 0; j < L_->n; ++j)
+      if (!(lx[lp[j]] > 0.0)) return j;
+    return L_->n;
+  }
+  void free_factor() {
+    if (L_) cholmod_free_factor(&L_, &c_);
+    valid_ = false;
+  }
+
+  cholmod_common c_{};
+  cholmod_sparse* K_ = nullptr;
+  cholmod_factor* L_ = nullptr;
+  cholmod_dense *X_ = nullptr, *Y_ = nullptr, *E_ = nullptr;
+  std::uint64_t pattern_ = 0;
+  std::vector<std::size_t> src_;  // per entry of K: its index in A's value array
+  std::vector<int> col_of_;       // per entry of K: its column
+  std::vector<double> factored_;  // K's values when last factored (direct backend)
+  bool valid_ = false;
+};
+
+// r = S(b - A x̃), x̃ = x on the fixed axes and 0 on the free ones: what the free axes must solve.
+void filtered_rhs(const BlockMatrix& A, std::span<const double> b, std::span<const double> x,
+                  std::span<const double> free_dof, AlignedVector<double>& xt, AlignedVector<double>& r) {
+  const std::size_t n3 = b.size();
+  xt.resize(n3);
+  r.resize(n3);
+  bool any_fixed_value = false;
+  for (std::size_t k = 0; k < n3; ++k) {
+    xt[k] = free_dof[k] == 0.0 ? x[k] : 0.0;
+    any_fixed_value |= xt[k] != 0.0;
+  }
+  if (any_fixed_value) A.multiply(xt, r);
+  else std::fill(r.begin(), r.end(), 0.0);
+  for (std::size_t k = 0; k < n3; ++k) r[k] = free_dof[k] * (b[k] - r[k]);
+}
+
+// ‖S(b - Ax)‖ and ‖Sb‖; r = S(b - Ax).
+std::pair<double, double> residual(const BlockMatrix& A, std::span<const double> b, std::span<const double> x,
+                                   std::span<const double> free_dof, AlignedVector<double>& tmp, AlignedVector<double>& r) {
+  tmp.resize(b.size());
+  r.resize(b.size());
+  A.multiply(x, tmp);
+  double rr = 0, bb = 0;
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    r[k] = free_dof[k] * (b[k] - tmp[k]);
+    rr += r[k] * r[k];
+    bb += free_dof[k] * b[k] * b[k];
+  }
+  return {std::sqrt(rr), std::sqrt(bb)};
+}
+
+class CholmodDirect final : public LinearSolver {
+ public:
+  static constexpr int max_refinements = 3;
+  explicit CholmodDirect(SolverOptions o) : LinearSolver(o) {}
+  [[nodiscard]] Backend backend() const override { return Backend::cholmod; }
+  void reset() override { f_.forget(); }
+
+  SolveReport solve(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
+                    std::span<const double> mass_scale) override {
+    check_sizes("cholmod solve", A, b, x, free_dof, mass_scale);
+    SolveReport rep;
+    rep.backend = Backend::cholmod;
+    auto t = Clock::now();
+    f_.sync_pattern(A);
+    f_.fill_values(A, free_dof);
+    if (!f_.analysed()) {
+      f_.analyse();
+      rep.symbolic_analyses = 1;
+      rep.analyse_ms = ms_since(t);
+      t = Clock::now();
+    }
+    if (!f_.factor_matches_values()) {
+      f_.factorize("cholmod solve", true);
+      rep.factorizations = 1;
+      rep.factor_ms = ms_since(t);
+      t = Clock::now();
+    }
+    filtered_rhs(A, b, x, free_dof, xt_, r_);
+    f_.solve(r_, r_);
+    for (std::size_t k = 0; k < x.size(); ++k)
+      if (free_dof[k] != 0.0) x[k] = r_[k];
+    // Iterative refinement: an ill-conditioned matrix (large steps on stiff, slender meshes)
+    // leaves a residual of cond·ε after one solve; each refinement costs two triangular solves.
+    const double floor = absolute_floor(opt_, free_dof, mass_scale);
+    for (int pass = 0;; ++pass) {
+      const auto [res, bn] = residual(A, b, x, free_dof, xt_, r_);
+      rep.residual = res;
+      rep.relative_residual = bn > 0 ? res / bn : 0.0;
+      rep.converged = std::isfinite(res) && (res <= opt_.tolerance * bn || res <= floor);
+      if (rep.converged || pass == max_refinements || !std::isfinite(res)) break;
+      f_.solve(r_, r_);
+      for (std::size_t k = 0; k < x.size(); ++k) x[k] += free_dof[k] * r_[k];
+      ++rep.iterations;
+    }
+    rep.solve_ms = ms_since(t);
+    return rep;
+  }
+
+ private:
+  Factorization f_;
+  AlignedVector<double> xt_, r_;
+};
+
+class CholmodPcg final : public LinearSolver {
+ public:
+  explicit CholmodPcg(SolverOptions o) : LinearSolver(o) {}
+  [[nodiscard]] Backend backend() const override { return Backend::cholmod_pcg; }
+  void reset() override {
+    f_.forget();
+    stale_ = false;
+  }
+
+  SolveReport solve(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
+                    std::span<const double> mass_scale) override {
+    check_sizes("cholmod-pcg solve", A, b, x, free_dof, mass_scale);
+    SolveReport rep;
+    rep.backend = Backend::cholmod_pcg;
+    const double floor = absolute_floor(opt_, free_dof, mass_scale);
+    if (f_.sync_pattern(A) || !f_.valid() || stale_) refresh(A, free_dof, rep);
+    x0_.assign(x.begin(), x.end());
+    auto t = Clock::now();
+    bool ok = pcg(A, b, x, free_dof, floor, rep);
+    rep.solve_ms += ms_since(t);
+    if (!ok && rep.factorizations == 0) {
+      // The kept factor no longer preconditions well enough: refresh it and start over.
+      std::copy(x0_.begin(), x0_.end(), x.begin());
+      refresh(A, free_dof, rep);
+      const int before = rep.iterations;
+      t = Clock::now();
+      ok = pcg(A, b, x, free_dof, floor, rep);
+      rep.iterations += before;
+      rep.solve_ms += ms_since(t);
+    }
+    stale_ = rep.iterations > opt_.refresh_iterations;
+    if (breakdown_)
+      throw SolverError("cholmod-pcg solve: CG broke down (pᵀAp ≤ 0) with a fresh factorization: the matrix is not "
+                        "positive definite on the free axes",
+                        rep.iterations, rep.relative_residual);
+    return rep;
+  }
+
+ private:
+  void refresh(const BlockMatrix& A, std::span<const double> free_dof, SolveReport& rep) {
+    auto t = Clock::now();
+    if (!f_.analysed()) {
+      f_.analyse();
+      rep.symbolic_analyses = 1;
+      rep.analyse_ms += ms_since(t);
+      t = Clock::now();
+    }
+    f_.fill_values(A, free_dof);
+    f_.factorize("cholmod-pcg solve", false);
+    ++rep.factorizations;
+    rep.factor_ms += ms_since(t);
+    stale_ = false;
+  }
+
+  // Filtered PCG (PHYSICS_NOTES §1.5) with z = S K⁻¹ r. Returns converged; sets breakdown_.
+  bool pcg(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
+           double floor, SolveReport& rep) {
+    const std::size_t n3 = b.size();
+    for (auto* v : {&r_, &z_, &p_, &q_}) v->resize(n3);
+    breakdown_ = false;
+    double bb = 0;
+    for (std::size_t k = 0; k < n3; ++k) bb += free_dof[k] * b[k] * b[k];
+    const double b_norm = std::sqrt(bb);
+    rep.iterations = 0;
+    if (bb == 0.0) {
+      for (std::size_t k = 0; k < n3; ++k)
+        if (free_dof[k] != 0.0) x[k] = 0.0;
+      rep.residual = rep.relative_residual = 0.0;
+      return rep.converged = true;
+    }
+    const double stop = std::max(opt_.tolerance * b_norm, floor);
+    A.multiply(x, q_);
+    for (std::size_t k = 0; k < n3; ++k) r_[k] = free_dof[k] * (b[k] - q_[k]);
+    double r_norm = std::sqrt(dot(r_.data(), r_.data(), n3));
+    auto precondition = [&] {
+      f_.solve(r_, z_);
+      for (std::size_t k = 0; k < n3; ++k) z_[k] *= free_dof[k];
+    };
+    if (r_norm > stop) precondition();
+    std::copy(z_.begin(), z_.end(), p_.begin());
+    double rz = dot(r_.data(), z_.data(), n3);
+    int it = 0;
+    while (r_norm > stop && it < opt_.max_iterations) {
+      A.multiply(p_, q_);
+      for (std::size_t k = 0; k < n3; ++k) q_[k] *= free_dof[k];
+      const double pq = dot(p_.data(), q_.data(), n3);
+      if (!(pq > 0.0)) {
+        breakdown_ = rep.factorizations > 0;  // with a stale factor: retried after a refresh
+        break;
+      }
+      const double alpha = rz / pq;
+      for (std::size_t k = 0; k < n3; ++k) {
+        x[k] += alpha * p_[k];
+        r_[k] -= alpha * q_[k];
+      }
+      ++it;
+      r_norm = std::sqrt(dot(r_.data(), r_.data(), n3));
+      if (r_norm <= stop) break;
+      precondition();
+      const double rz_new = dot(r_.data(), z_.data(), n3);
+      const double beta = rz_new / rz;
+      rz = rz_new;
+      for (std::size_t k = 0; k < n3; ++k) p_[k] = z_[k] + beta * p_[k];
+    }
+    rep.iterations = it;
+    rep.residual = r_norm;
+    rep.relative_residual = r_norm / b_norm;
+    rep.converged = std::isfinite(r_norm) && r_norm <= stop;
+    return rep.converged;
+  }
+
+  Factorization f_;
+  bool stale_ = false, breakdown_ = false;
+  AlignedVector<double> r_, z_, p_, q_;
+  std::vector<double> x0_;
+};
+
+}  // namespace
+
+std::unique_ptr<LinearSolver> make_cholmod(SolverOptions o) { return std::make_unique<CholmodDirect>(o); }
+std::unique_ptr<LinearSolver> make_cholmod_pcg(SolverOptions o) { return std::make_unique<CholmodPcg>(o); }
+
+}  // namespace sewn::physics::solve::detail

@@ -1,0 +1,102 @@
+#include "sewn/physics/solve/linear_solver.hpp"
+
+#include <string>
+
+#include "backends.hpp"
+#include "sewn/physics/errors.hpp"
+
+namespace sewn::physics::solve {
+
+std::string_view to_string(Backend b) {
+  switch (b) {
+    case Backend::automatic: return "auto";
+    case Backend::jacobi: return "jacobi";
+    case Backend::cholmod: return "cholmod";
+    case Backend::cholmod_pcg: return "cholmod-pcg";
+  }
+  return "?";
+}
+
+bool available(Backend b) {
+#ifdef SEWN_HAVE_CHOLMOD
+  (void)b;
+  return true;
+#else
+  return b == Backend::automatic || b == Backend::jacobi;
+#endif
+}
+
+std::vector<Backend> available_backends() {
+  std::vector<Backend> out;
+  for (Backend b : {Backend::jacobi, Backend::cholmod, Backend::cholmod_pcg})
+    if (available(b)) out.push_back(b);
+  return out;
+}
+
+namespace {
+std::string built_in_list() {
+  std::string s;
+  for (Backend b : available_backends()) s += (s.empty() ? "" : ", ") + std::string(to_string(b));
+  return s;
+}
+}  // namespace
+
+Backend parse_backend(std::string_view name) {
+  for (Backend b : {Backend::automatic, Backend::jacobi, Backend::cholmod, Backend::cholmod_pcg}) {
+    if (name != to_string(b)) continue;
+    if (!available(b))
+      throw InputError("solver '" + std::string(name) + "' is not built in (SuiteSparse CHOLMOD was not found at build time); built in: auto, " +
+                       built_in_list());
+    return b;
+  }
+  throw InputError("unknown solver '" + std::string(name) + "'; expected one of auto, " + built_in_list());
+}
+
+Backend default_backend(std::size_t nodes) {
+  (void)nodes;
+  // Measured (docs/solvers.md, bench/solve): with Debian's reference BLAS under CHOLMOD, a
+  // factorization and its triangular solves cost more than block-Jacobi CG's iterations on
+  // every case from the 8×8×10 beam at h = 1 ms to the N = 8 cantilever at h = 10 ms (564
+  // iterations a step), in CPU time; so no size picks a CHOLMOD backend today.
+  return Backend::jacobi;
+}
+
+std::unique_ptr<LinearSolver> make_solver(Backend b, SolverOptions options, std::size_t nodes) {
+  if (!(options.tolerance > 0 && options.tolerance < 1))
+    throw InputError("solver tolerance must be in (0, 1), got " + std::to_string(options.tolerance));
+  if (!(options.absolute_tolerance >= 0 && std::isfinite(options.absolute_tolerance)))
+    throw InputError("solver absolute_tolerance must be finite and >= 0, got " + std::to_string(options.absolute_tolerance));
+  if (options.max_iterations < 1)
+    throw InputError("solver max_iterations must be >= 1, got " + std::to_string(options.max_iterations));
+  if (b == Backend::automatic) b = default_backend(nodes);
+  (void)parse_backend(to_string(b));  // throws if not built in
+  switch (b) {
+#ifdef SEWN_HAVE_CHOLMOD
+    case Backend::cholmod: return detail::make_cholmod(options);
+    case Backend::cholmod_pcg: return detail::make_cholmod_pcg(options);
+#endif
+    default: return detail::make_jacobi(options);
+  }
+}
+
+namespace detail {
+
+void check_sizes(const char* who, const BlockMatrix& A, std::span<const double> b, std::span<const double> x,
+                 std::span<const double> free_dof, std::span<const double> mass_scale) {
+  const std::size_t n3 = 3 * std::size_t{A.size()};
+  if (b.size() != n3 || x.size() != n3 || free_dof.size() != n3 || (!mass_scale.empty() && mass_scale.size() != n3))
+    throw InputError(std::string(who) + ": sizes do not match the matrix of " + std::to_string(A.size()) +
+                     " nodes (expected " + std::to_string(n3) + " values; b " + std::to_string(b.size()) + ", x " +
+                     std::to_string(x.size()) + ", free_dof " + std::to_string(free_dof.size()) + ", mass_scale " +
+                     std::to_string(mass_scale.size()) + ")");
+}
+
+double absolute_floor(const SolverOptions& o, std::span<const double> free_dof, std::span<const double> mass_scale) {
+  if (mass_scale.empty() || o.absolute_tolerance == 0.0) return 0.0;
+  double s = 0;
+  for (std::size_t k = 0; k < mass_scale.size(); ++k) s += free_dof[k] * mass_scale[k] * mass_scale[k];
+  return o.absolute_tolerance * std::sqrt(s);
+}
+
+}  // namespace detail
+}  // namespace sewn::physics::solve
