@@ -11,11 +11,14 @@
 #include <map>
 #include <set>
 
+#include <Eigen/Geometry>
+
 #include "sewn/io/cleanup.hpp"
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/read.hpp"
 #include "sewn/io/render.hpp"
 #include "sewn/io/write.hpp"
+#include "sewn/physics/integrate/energy_ledger.hpp"
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/refine/cut.hpp"
@@ -193,6 +196,31 @@ std::string format_seconds(double s) {
   return buf;
 }
 
+// The particles a selector picks: those of tagged cells, listed mesh points, or those whose
+// rest position lies in the region. Throws SceneError (at `path`) for a point of no cell or an
+// empty selection.
+std::set<Index> selected_nodes(const Selector& where, const IndexedMesh& mesh, const physics::MssModel<3>& model,
+                               const std::string& file, const std::string& path) {
+  std::set<Index> nodes;
+  if (where.type == Selector::Type::tag) {
+    for (std::uint32_t c = 0; c < mesh.num_cells(); ++c)
+      if (mesh.tags[c] == where.tag)
+        for (std::uint32_t q : mesh.cell(c)) nodes.insert(model.node_of_point(q));
+  } else if (where.type == Selector::Type::points) {
+    for (std::uint32_t q : where.points) {
+      if (q >= mesh.num_points() || model.node_of_point(q) == physics::invalid_index)
+        throw SceneError(file, path + ".indices",
+                         "point " + std::to_string(q) + " is not a point of any cell (" + std::to_string(mesh.num_points()) + " points)");
+      nodes.insert(model.node_of_point(q));
+    }
+  } else {
+    for (Index i = 0; i < model.nodes().size(); ++i)
+      if (where.contains(to_vec3(model.rest_position(i)))) nodes.insert(i);
+  }
+  if (nodes.empty()) throw SceneError(file, path, "selects no particle");
+  return nodes;
+}
+
 }  // namespace
 
 Assembly assemble(const Scene& scene) {
@@ -237,7 +265,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   mo.source = scene.file;
   auto model = std::make_unique<physics::MssModel<3>>(assembly.mesh, materials, assembly.material_of_cell, mo);
 
-  // 2) fixed particles
+  // 2) fixed particles, then initial velocities of the free axes
   const IndexedMesh& mesh = assembly.mesh;
   for (std::size_t k = 0; k < scene.fixed.size(); ++k) {
     const FixSpec& fix = scene.fixed[k];
@@ -245,24 +273,20 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     if (fix.axes[0]) axes |= physics::axis_x;
     if (fix.axes[1]) axes |= physics::axis_y;
     if (fix.axes[2]) axes |= physics::axis_z;
-    std::set<Index> nodes;
-    if (fix.where.type == Selector::Type::tag) {
-      for (std::uint32_t c = 0; c < mesh.num_cells(); ++c)
-        if (mesh.tags[c] == fix.where.tag)
-          for (std::uint32_t q : mesh.cell(c)) nodes.insert(model->node_of_point(q));
-    } else if (fix.where.type == Selector::Type::points) {
-      for (std::uint32_t q : fix.where.points) {
-        if (q >= mesh.num_points() || model->node_of_point(q) == physics::invalid_index)
-          throw SceneError(scene.file, "fixed[" + std::to_string(k) + "].where.indices",
-                           "point " + std::to_string(q) + " is not a point of any cell (" + std::to_string(mesh.num_points()) + " points)");
-        nodes.insert(model->node_of_point(q));
-      }
-    } else {
-      for (Index i = 0; i < model->nodes().size(); ++i)
-        if (fix.where.contains(to_vec3(model->rest_position(i)))) nodes.insert(i);
+    for (Index i : selected_nodes(fix.where, mesh, *model, scene.file, "fixed[" + std::to_string(k) + "].where"))
+      model->nodes().fix(i, axes);
+  }
+  for (std::size_t k = 0; k < scene.velocities.size(); ++k) {
+    const VelocitySpec& vel = scene.velocities[k];
+    const Vec3d linear(vel.linear[0], vel.linear[1], vel.linear[2]), angular(vel.angular[0], vel.angular[1], vel.angular[2]),
+        center(vel.center[0], vel.center[1], vel.center[2]);
+    for (Index i : selected_nodes(vel.where, mesh, *model, scene.file, "velocities[" + std::to_string(k) + "].where")) {
+      Vec3d v = linear + angular.cross(model->rest_position(i) - center);
+      // a velocity on a fixed axis would make it kinematic: fixed stays fixed
+      for (int a = 0; a < 3; ++a)
+        if ((model->nodes().fixed(i) >> a) & 1u) v[a] = 0;
+      model->nodes().set_velocity(i, v);
     }
-    if (nodes.empty()) throw SceneError(scene.file, "fixed[" + std::to_string(k) + "].where", "selects no particle");
-    for (Index i : nodes) model->nodes().fix(i, axes);
   }
 
   // 3) time line: steps, frames and scheduled cuts
@@ -288,10 +312,15 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   if (scene.write_csv) {
     sum.csv = sum.out / "frames.csv";
     csv = std::make_unique<io::CsvWriter>(
-        sum.csv, std::vector<std::string>{"frame", "time", "kinetic_energy", "potential_energy", "elastic_energy",
-                                          "particles", "springs", "elements", "steps", "ms_per_step",
+        sum.csv, std::vector<std::string>{"frame", "time", "kinetic_energy", "elastic_energy", "gravity_energy",
+                                          "total_energy", "external_work", "dissipated", "energy_rises", "particles", "springs", "elements", "steps", "ms_per_step",
                                           "cg_iterations_mean", "cg_iterations_max", "cuts", "faces_cut"});
   }
+  // Energy balance of every frame; each implicit step is checked for energy it created (the
+  // semi-implicit scheme's plain energy oscillates by design: its divergence is the
+  // integrator's watchdog's business).
+  physics::EnergyLedger ledger(scene.energy_rise_tolerance);
+  ledger.start(model->system());
   std::uint32_t frame = 0;
   double frame_ms = 0, frame_cg_sum = 0;
   int frame_cg_max = 0;
@@ -314,8 +343,9 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     }
     if (csv) {
       const auto elements = std::count_if(model->elements().begin(), model->elements().end(), [](const auto& e) { return e.alive; });
-      csv->row({static_cast<double>(frame), t, sys.kinetic_energy(), sys.potential_energy(),
-                sys.potential_energy(physics::EnergyKind::internal), static_cast<double>(model->nodes().num_alive()),
+      const physics::EnergyBalance e = ledger.balance(sys);
+      csv->row({static_cast<double>(frame), t, e.kinetic, e.elastic, e.external_potential, e.total, e.external_work,
+                e.dissipated, static_cast<double>(ledger.rises()), static_cast<double>(model->nodes().num_alive()),
                 static_cast<double>(model->springs().num_alive()), static_cast<double>(elements),
                 static_cast<double>(frame_steps), frame_steps ? frame_ms / static_cast<double>(frame_steps) : 0.0,
                 frame_steps ? frame_cg_sum / static_cast<double>(frame_steps) : 0.0, static_cast<double>(frame_cg_max),
@@ -380,6 +410,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
       }
       sum.faces_cut += rep.facets;
       ++sum.cuts;
+      ledger.rebase(model->system());
     }
     int cg = 0;
     if (use_implicit)
@@ -391,6 +422,18 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     frame_cg_sum += cg;
     frame_cg_max = std::max(frame_cg_max, cg);
     ++frame_steps;
+    if (use_implicit)
+      if (const auto rise = ledger.after_step(model->system(), s + 1); rise && ledger.rises() == 1) {
+        char msg[400];
+        std::snprintf(msg, sizeof msg,
+                      "step %llu (t = %.6g s) raised the total energy from %.6g J to %.6g J (+%.3g %% of the %.6g J in "
+                      "motion) with no external work to supply it: the integrator created energy (the linearised "
+                      "implicit step does on fast rotations; a smaller step or integrator.type \"midpoint\" avoids it)",
+                      static_cast<unsigned long long>(s + 1), static_cast<double>(s + 1) * h, rise->before, rise->after,
+                      100 * (rise->after - rise->before) / rise->moved, rise->moved);
+        sum.first_energy_rise = msg;
+        if (!options.quiet) std::fprintf(stderr, "%ssewn: warning: %s\n", bar ? "\n" : "", msg);
+      }
     sum.kinetic_max = std::max(sum.kinetic_max, model->system().kinetic_energy());
     // frame f is written after step round(f · steps / frames)
     const auto due = static_cast<std::uint64_t>(std::llround(static_cast<double>(frame) * static_cast<double>(steps) / frames));
@@ -412,6 +455,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   sum.simulated = static_cast<double>(steps) * h;
   sum.ms_per_step = steps ? sum.wall * 1e3 / static_cast<double>(steps) : 0;
   sum.kinetic_end = model->system().kinetic_energy();
+  sum.energy_rises = ledger.rises();
 
   // 6) the picture of the last frame
   if (scene.write_picture) {

@@ -98,6 +98,13 @@ Field build_schema() {
       .members({selector_schema("where", "Particles to fix.").required(),
                 field("axes", Kind::string).one_of({"xyz", "x", "y", "z", "xy", "xz", "yz"}).fallback("xyz").doc("Axes held.")});
 
+  Field velocity = field("velocity", Kind::object);
+  velocity.doc("An initial velocity v = linear + angular × (x − center) for the particles in `where` (x: rest position): a uniform motion plus a rigid rotation about the axis through `center` along `angular`. Fixed axes keep their zero velocity; where entries overlap, later ones win.")
+      .members({selector_schema("where", "Particles to set in motion.").required(),
+                field("linear", Kind::vec3).unit("m/s").fallback({0.0, 0.0, 0.0}).doc("Uniform velocity."),
+                field("angular", Kind::vec3).unit("rad/s").fallback({0.0, 0.0, 0.0}).doc("Angular velocity ω (axis direction times rate)."),
+                field("center", Kind::vec3).unit("m").fallback({0.0, 0.0, 0.0}).doc("A point of the rotation axis.")});
+
   Field cut = field("cut", Kind::object);
   cut.doc("A topological cut applied between two steps (3-unsew of faces between volumes; 2-unsew of edges between 2D cells).")
       .select_by("type");
@@ -125,7 +132,15 @@ Field build_schema() {
                 field("width", Kind::integer).fallback(1280).at_least(64).at_most(8192).unit("px").doc("Width."),
                 field("height", Kind::integer).fallback(800).at_least(64).at_most(8192).unit("px").doc("Height.")});
   Field output = field("output", Kind::object);
-  output.doc("What is written to the output folder (`--out`, default `out/<name>/`).")
+  output.doc("What is written to the output folder (`--out`, default `out/<name>/`).\n\n"
+             "`frames.csv` has one row per frame. Its energies (J) add up: `total_energy` = `kinetic_energy` + "
+             "`elastic_energy` + `gravity_energy` (the springs' and gravity's potentials); `external_work` is the work "
+             "gravity has done since the start (its potential then minus now) and `dissipated` the energy lost since "
+             "the start (total then minus now: damping plus the integrator's numerical dissipation; negative when the "
+             "scheme created energy), so that kinetic + elastic = their start value + `external_work` − `dissipated`. "
+             "`energy_rises` counts the implicit steps so far that created energy (see `integrator.energy_rise_tolerance`). "
+             "Then: `particles`, `springs`, `elements` alive; `steps` in the frame, `ms_per_step` (stepping only), "
+             "`cg_iterations_mean` and `_max` per step (implicit), `cuts` applied and `faces_cut` so far.")
       .fallback(nlohmann::json::object())
       .members({field("frames", Kind::integer).fallback(50).at_least(1).at_most(100000).doc("Output frames over the run (a ParaView .vtu each, plus frame 0)."),
                 field("vtu", Kind::boolean).fallback(true).doc("Write the ParaView series (.vtu per frame + .pvd)."),
@@ -150,7 +165,9 @@ Field build_schema() {
                 field("tolerance", Kind::number).fallback(1e-6).above(0).below(1).doc("CG relative residual (implicit)."),
                 field("max_iterations", Kind::integer).fallback(2000).at_least(1).at_most(1000000).doc("CG iteration limit (implicit); reaching it is an error."),
                 field("allow_unstable", Kind::boolean).fallback(false)
-                    .doc("Run a semi-implicit step larger than the estimated stable bound (otherwise refused with the bound).")});
+                    .doc("Run a semi-implicit step larger than the estimated stable bound (otherwise refused with the bound)."),
+                field("energy_rise_tolerance", Kind::number).fallback(1e-4).above(0).below(1)
+                    .doc("An implicit step whose total energy (kinetic + elastic + gravity) rises by more than this fraction of the energy in motion is reported: a warning at the first, a count in frames.csv (`energy_rises`).")});
 
   Field root = field("scene", Kind::object);
   root.doc("A scene file is one JSON object. Lengths in metres, times in seconds, SI units throughout.");
@@ -160,6 +177,7 @@ Field build_schema() {
       field("materials", Kind::map).of(material).items(1, 1u << 20).required().doc("Named materials."),
       field("meshes", Kind::array).of(mesh).items(1, 1u << 16).required().doc("The bodies."),
       field("fixed", Kind::array).of(fix).fallback(nlohmann::json::array()).doc("Fixed particles."),
+      field("velocities", Kind::array).of(velocity).fallback(nlohmann::json::array()).doc("Initial velocities (default: at rest)."),
       field("gravity", Kind::vec3).unit("m/s²").fallback({0.0, 0.0, -9.81}).doc("Gravity."),
       damping,
       integrator,
@@ -326,6 +344,12 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     Reader fr(fj, fix_schema);
     s.fixed.push_back({read_selector(fj.at("where"), *fix_schema.member("where")), read_axes(fr.string("axes"))});
   }
+  const Field& velocity_schema = *schema.member("velocities")->element_;
+  for (const auto& vj : r["velocities"]) {
+    Reader vr(vj, velocity_schema);
+    s.velocities.push_back({read_selector(vj.at("where"), *velocity_schema.member("where")), vr.vec3("linear"),
+                            vr.vec3("angular"), vr.vec3("center")});
+  }
   s.gravity = r.vec3("gravity");
   {
     Reader d(r["damping"], *schema.member("damping"));
@@ -341,6 +365,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     s.tolerance = in.number("tolerance");
     s.max_iterations = static_cast<std::uint32_t>(in.integer("max_iterations"));
     s.allow_unstable = in.boolean("allow_unstable");
+    s.energy_rise_tolerance = in.number("energy_rise_tolerance");
   }
   s.duration = r.number("duration");
   if (s.step > s.duration) throw SceneError(file, "integrator.step", "is longer than the whole run (duration " + std::to_string(s.duration) + " s)");

@@ -111,7 +111,8 @@ TEST_CASE("the default scene runs to the end and its energies behave physically"
     REQUIRE(it != header.end());
     return static_cast<std::size_t>(it - header.begin());
   };
-  const std::size_t ke = col("kinetic_energy"), pe = col("potential_energy"), cuts = col("cuts"), particles = col("particles");
+  const std::size_t ke = col("kinetic_energy"), el = col("elastic_energy"), gr = col("gravity_energy"), total = col("total_energy"),
+                    work = col("external_work"), lost = col("dissipated"), cuts = col("cuts"), particles = col("particles");
   double ke_max = 0;
   for (const auto& r : rows) ke_max = std::max(ke_max, r[ke]);
   CHECK(ke_max > 0);
@@ -121,10 +122,19 @@ TEST_CASE("the default scene runs to the end and its energies behave physically"
   // stiffness (split springs keep their stretch), so kinetic + potential never rises; allowance:
   // the CG tolerance (1e-6 relative per step) on the energy moved in a frame
   for (std::size_t f = 1; f < rows.size(); ++f) {
-    const double before = rows[f - 1][ke] + rows[f - 1][pe], after = rows[f][ke] + rows[f][pe];
+    const double before = rows[f - 1][total], after = rows[f][total];
     CAPTURE(f);
     CHECK(after <= before + 1e-6 * ke_max);
   }
+  // the columns add up: the total is its three parts, and kinetic + elastic is its start value
+  // plus the work of gravity minus what was dissipated (to the CSV's printed precision)
+  for (const auto& r : rows) {
+    const double scale = std::abs(r[total]) + std::abs(r[gr]) + std::abs(r[work]);
+    CHECK(r[total] == doctest::Approx(r[ke] + r[el] + r[gr]).epsilon(1e-9).scale(scale));
+    CHECK(r[ke] + r[el] == doctest::Approx(rows[0][ke] + rows[0][el] + r[work] - r[lost]).epsilon(1e-9).scale(scale));
+    CHECK(r[lost] >= -1e-6 * ke_max);  // implicit Euler and drag only remove energy
+  }
+  CHECK(rows.back()[col("energy_rises")] == 0.0);
   // the cut happened once, at the start of the first step from 0.6 s (so after the 0.6 s frame),
   // and duplicated particles
   for (const auto& r : rows) CHECK(r[cuts] == (r[col("time")] <= 0.6 + 1e-9 ? 0.0 : 1.0));

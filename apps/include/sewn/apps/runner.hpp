@@ -45,6 +45,8 @@ struct RunSummary {
   double wall = 0;                  ///< s, stepping and cuts (output excluded)
   double ms_per_step = 0;
   double kinetic_start = 0, kinetic_end = 0, kinetic_max = 0;  ///< J
+  std::uint64_t energy_rises = 0;   ///< implicit steps that created energy (see physics::EnergyLedger)
+  std::string first_energy_rise;    ///< the warning printed for the first of them ("" if none)
   std::filesystem::path out, pvd, csv, picture;
 };
 

@@ -61,6 +61,13 @@ struct FixSpec {
   std::array<bool, 3> axes{true, true, true};
 };
 
+/// Initial velocity of the free axes of the particles in `where` (at their rest positions x):
+/// v = linear + angular × (x − center), a uniform motion plus a rigid rotation.
+struct VelocitySpec {
+  Selector where;
+  Vec3 linear{0, 0, 0}, angular{0, 0, 0}, center{0, 0, 0};
+};
+
 struct CutSpec {
   std::string type;  // plane, faces, particles, pierce
   double time = 0;
@@ -78,6 +85,7 @@ struct Scene {
   std::map<std::string, MaterialSpec> materials;
   std::vector<MeshSpec> meshes;
   std::vector<FixSpec> fixed;
+  std::vector<VelocitySpec> velocities;  // later entries win
   Vec3 gravity{0, 0, -9.81};
   std::string damping = "viscous";
   double rayleigh_alpha = 0, rayleigh_beta = 0, environment_damping = 0;
@@ -86,6 +94,7 @@ struct Scene {
   double tolerance = 1e-6;
   std::uint32_t max_iterations = 2000;
   bool allow_unstable = false;
+  double energy_rise_tolerance = 1e-4;  // relative, see physics::EnergyLedger
   std::vector<CutSpec> cuts;
   std::uint32_t frames = 50;
   bool write_vtu = true, write_csv = true, write_picture = true;
