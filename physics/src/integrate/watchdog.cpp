@@ -30,6 +30,7 @@ bool EnergyWatchdog::baseline_if_needed(const System& sys) {
   internal0_ = sys.kinetic_energy() + sys.potential_energy(EnergyKind::internal);
   external0_ = sys.potential_energy(EnergyKind::external);
   speed_at_check_ = max_abs_component(sys.nodes().v());
+  peak_speed_ = 0;
   version_ = v;
   has_baseline_ = true;
   return true;
@@ -41,8 +42,12 @@ std::optional<EnergyBlowup> EnergyWatchdog::after_step(const System& sys, const 
   const bool periodic = step % static_cast<std::uint64_t>(opt.energy_check_interval) == 0;
   // `!(a <= b)` so that a NaN speed triggers too
   const bool triggered = opt.speed_trigger > 0 && !(max_speed <= opt.speed_trigger * speed_at_check_);
+  peak_speed_ = std::max(peak_speed_, max_speed);
   if (!periodic && !triggered) return std::nullopt;
-  speed_at_check_ = max_speed;
+  // The reference is the peak since the last check, not the speed now: an oscillating speed
+  // checked at a trough would otherwise trigger again at every crest.
+  speed_at_check_ = std::isnan(max_speed) ? max_speed : peak_speed_;
+  peak_speed_ = 0;
   return check(sys, opt, step);
 }
 

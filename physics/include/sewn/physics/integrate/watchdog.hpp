@@ -20,7 +20,8 @@ struct HealthOptions {
   /// Each check costs about one force evaluation.
   int energy_check_interval = 100;
   /// A check also runs after any step whose largest |velocity component| exceeds this factor
-  /// times its value at the last check (√2: the fastest node's kinetic energy doubled). The
+  /// times its peak over the steps up to the last check (√2: the fastest node's kinetic energy
+  /// doubled). The
   /// per-step cost is one max-reduction inside the integrator's update loop. 0 disables it.
   double speed_trigger = 1.4142135623730951;
   /// Blow-up when E_kin + E_internal > factor · (E_kin + E_internal at the baseline + work of
@@ -56,7 +57,8 @@ class EnergyWatchdog {
  private:
   bool has_baseline_ = false;
   double internal0_ = 0, external0_ = 0;
-  double speed_at_check_ = 0;
+  double speed_at_check_ = 0;  // the largest speed up to the last check
+  double peak_speed_ = 0;      // the largest speed since
   std::uint64_t version_ = 0;
 };
 
