@@ -19,6 +19,7 @@
 #include "sewn/io/render.hpp"
 #include "sewn/io/write.hpp"
 #include "sewn/physics/integrate/energy_ledger.hpp"
+#include "sewn/physics/integrate/implicit_midpoint.hpp"
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/refine/cut.hpp"
@@ -365,7 +366,11 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   io_opt.cg_max_iterations = static_cast<int>(scene.max_iterations);
   physics::SymplecticEuler semi(so);
   physics::LinearlyImplicitEuler implicit(io_opt);
-  const bool use_implicit = scene.integrator == "implicit";
+  physics::ImplicitMidpointOptions mid_opt;
+  mid_opt.cg_max_iterations = static_cast<int>(scene.max_iterations);
+  physics::ImplicitMidpoint midpoint(mid_opt);
+  const bool use_midpoint = scene.integrator == "midpoint";
+  const bool use_implicit = scene.integrator == "implicit" || use_midpoint;
   const bool bar = !options.quiet && options.progress && isatty(STDERR_FILENO);
   sum.kinetic_start = model->system().kinetic_energy();
   write_frame(0.0);
@@ -413,7 +418,9 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
       ledger.rebase(model->system());
     }
     int cg = 0;
-    if (use_implicit)
+    if (use_midpoint)
+      cg = midpoint.step(model->system(), h).cg_iterations;
+    else if (use_implicit)
       cg = implicit.step(model->system(), h).cg_iterations;
     else
       (void)semi.step(model->system(), h);

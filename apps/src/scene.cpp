@@ -159,8 +159,8 @@ Field build_schema() {
   Field integrator = field("integrator", Kind::object);
   integrator.doc("Time integration.")
       .fallback(nlohmann::json::object())
-      .members({field("type", Kind::string).one_of({"implicit", "semi-implicit"}).fallback("implicit")
-                    .doc("Linearly implicit Euler (Baraff–Witkin, CG) or semi-implicit (symplectic) Euler."),
+      .members({field("type", Kind::string).one_of({"implicit", "semi-implicit", "midpoint"}).fallback("implicit")
+                    .doc("Linearly implicit Euler (Baraff–Witkin, CG: one solve per step, dissipative, loses angular momentum on fast rotations), semi-implicit (symplectic) Euler (explicit: below the stable step only), or the implicit midpoint rule with discrete-gradient springs solved by Newton and CG (keeps linear and angular momentum and the energy of free bodies to round-off at any step it converges at; several solves per step). See docs/integrators.md."),
                 field("step", Kind::number).unit("s").fallback(1e-3).above(0).at_most(10).doc("Time step h."),
                 field("tolerance", Kind::number).fallback(1e-6).above(0).below(1).doc("CG relative residual (implicit)."),
                 field("max_iterations", Kind::integer).fallback(2000).at_least(1).at_most(1000000).doc("CG iteration limit (implicit); reaching it is an error."),
