@@ -10,6 +10,8 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <stdexcept>
+#include <string>
 
 #include <Eigen/Geometry>
 
@@ -22,6 +24,7 @@
 #include "sewn/physics/integrate/implicit_midpoint.hpp"
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
+#include "sewn/physics/solids/inversion.hpp"
 #include "sewn/refine/cut.hpp"
 
 namespace sewn::app {
@@ -314,7 +317,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     sum.csv = sum.out / "frames.csv";
     csv = std::make_unique<io::CsvWriter>(
         sum.csv, std::vector<std::string>{"frame", "time", "kinetic_energy", "elastic_energy", "gravity_energy",
-                                          "total_energy", "external_work", "dissipated", "energy_rises", "particles", "springs", "elements", "steps", "ms_per_step",
+                                          "total_energy", "external_work", "dissipated", "energy_rises", "inverted", "particles", "springs", "elements", "steps", "ms_per_step",
                                           "cg_iterations_mean", "cg_iterations_max", "cuts", "faces_cut"});
   }
   // Energy balance of every frame; each implicit step is checked for energy it created (the
@@ -326,9 +329,28 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   double frame_ms = 0, frame_cg_sum = 0;
   int frame_cg_max = 0;
   std::uint64_t frame_steps = 0;
+  // Inverted elements: counted at every frame, and at every step when the scene stops at the
+  // first; the first seen is reported once.
+  physics::Index inverted_now = 0;
+  auto check_inversion = [&](std::uint64_t step) {
+    const physics::InversionCount c = physics::count_inverted(*model);
+    inverted_now = c.elements;
+    sum.inverted_max = std::max<std::uint64_t>(sum.inverted_max, c.elements);
+    if (c.elements == 0 || !sum.first_inversion.empty()) return;
+    char msg[300];
+    std::snprintf(msg, sizeof msg, "element %u (mesh cell %u) is inverted at step %llu (t = %.6g s)%s", c.first, c.first_cell,
+                  static_cast<unsigned long long>(step), static_cast<double>(step) * scene.step,
+                  c.elements > 1 ? (", with " + std::to_string(c.elements - 1) + " more").c_str() : "");
+    sum.first_inversion = msg;
+    if (scene.stop_on_inversion)
+      throw std::runtime_error(std::string(msg) + "; stopped there (integrator.stop_on_inversion)");
+    if (!options.quiet) std::fprintf(stderr, "\nsewn: warning: %s\n", msg);
+  };
+  std::uint64_t steps_done = 0;
   auto write_frame = [&](double t) {
     physics::System& sys = model->system();
     sys.compute_forces();
+    check_inversion(steps_done);
     if (pvd) {
       snap.take(*model);
       char name[32];
@@ -346,7 +368,8 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
       const auto elements = std::count_if(model->elements().begin(), model->elements().end(), [](const auto& e) { return e.alive; });
       const physics::EnergyBalance e = ledger.balance(sys);
       csv->row({static_cast<double>(frame), t, e.kinetic, e.elastic, e.external_potential, e.total, e.external_work,
-                e.dissipated, static_cast<double>(ledger.rises()), static_cast<double>(model->nodes().num_alive()),
+                e.dissipated, static_cast<double>(ledger.rises()), static_cast<double>(inverted_now),
+                static_cast<double>(model->nodes().num_alive()),
                 static_cast<double>(model->springs().num_alive()), static_cast<double>(elements),
                 static_cast<double>(frame_steps), frame_steps ? frame_ms / static_cast<double>(frame_steps) : 0.0,
                 frame_steps ? frame_cg_sum / static_cast<double>(frame_steps) : 0.0, static_cast<double>(frame_cg_max),
@@ -429,6 +452,8 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     frame_cg_sum += cg;
     frame_cg_max = std::max(frame_cg_max, cg);
     ++frame_steps;
+    steps_done = s + 1;
+    if (scene.stop_on_inversion) check_inversion(s + 1);
     if (use_implicit)
       if (const auto rise = ledger.after_step(model->system(), s + 1); rise && ledger.rises() == 1) {
         char msg[400];

@@ -138,7 +138,8 @@ Field build_schema() {
              "gravity has done since the start (its potential then minus now) and `dissipated` the energy lost since "
              "the start (total then minus now: damping plus the integrator's numerical dissipation; negative when the "
              "scheme created energy), so that kinetic + elastic = their start value + `external_work` − `dissipated`. "
-             "`energy_rises` counts the implicit steps so far that created energy (see `integrator.energy_rise_tolerance`). "
+             "`energy_rises` counts the implicit steps so far that created energy (see `integrator.energy_rise_tolerance`), "
+             "`inverted` the hexahedra and tetrahedra inverted in the frame (see `integrator.stop_on_inversion`). "
              "Then: `particles`, `springs`, `elements` alive; `steps` in the frame, `ms_per_step` (stepping only), "
              "`cg_iterations_mean` and `_max` per step (implicit), `cuts` applied and `faces_cut` so far.")
       .fallback(nlohmann::json::object())
@@ -167,7 +168,9 @@ Field build_schema() {
                 field("allow_unstable", Kind::boolean).fallback(false)
                     .doc("Run a semi-implicit step larger than the estimated stable bound (otherwise refused with the bound)."),
                 field("energy_rise_tolerance", Kind::number).fallback(1e-4).above(0).below(1)
-                    .doc("An implicit step whose total energy (kinetic + elastic + gravity) rises by more than this fraction of the energy in motion is reported: a warning at the first, a count in frames.csv (`energy_rises`).")});
+                    .doc("An implicit step whose total energy (kinetic + elastic + gravity) rises by more than this fraction of the energy in motion is reported: a warning at the first, a count in frames.csv (`energy_rises`)."),
+                field("stop_on_inversion", Kind::boolean).fallback(false)
+                    .doc("Check for inverted hexahedra and tetrahedra (a corner's signed volume opposite to its rest sign) after every step and stop the run (exit 1) at the first, naming it; otherwise they are counted at every frame (`inverted` in frames.csv) and the first seen is a warning.")});
 
   Field root = field("scene", Kind::object);
   root.doc("A scene file is one JSON object. Lengths in metres, times in seconds, SI units throughout.");
@@ -366,6 +369,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     s.max_iterations = static_cast<std::uint32_t>(in.integer("max_iterations"));
     s.allow_unstable = in.boolean("allow_unstable");
     s.energy_rise_tolerance = in.number("energy_rise_tolerance");
+    s.stop_on_inversion = in.boolean("stop_on_inversion");
   }
   s.duration = r.number("duration");
   if (s.step > s.duration) throw SceneError(file, "integrator.step", "is longer than the whole run (duration " + std::to_string(s.duration) + " s)");

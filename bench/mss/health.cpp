@@ -8,6 +8,7 @@
 // the release and sag of the beam under gravity.
 //
 //   mss/watchdog/sofa_8x8x10/semi_implicit/{ours,peer}
+//   mss/inversion_count/sofa_8x8x10/{ours,peer}   counting inverted elements / one step
 
 #include <benchmark/benchmark.h>
 
@@ -17,6 +18,7 @@
 #include "model.hpp"
 #include "ours.hpp"
 #include "sewn_bench.hpp"
+#include "sewn/physics/solids/inversion.hpp"
 
 namespace sewn::bench::mss {
 
@@ -67,7 +69,29 @@ void run(benchmark::State& st, bool watch) {
   st.counters["_h"] = w.h;
 }
 
+// What counting inverted elements costs, against one semi-implicit step of the same mesh at
+// rest (the peer): the ratio is the count's cost in steps.
+void inversion(benchmark::State& st, bool count) {
+  Watched& w = beam();
+  w.model->restore();
+  physics::SymplecticEulerOptions o;
+  o.enforce_stable_step = false;
+  o.health.energy_check_interval = 0;
+  physics::SymplecticEuler se(o);
+  for (auto _ : st) {
+    if (count) {
+      benchmark::DoNotOptimize(physics::count_inverted(w.model->model()).elements);
+    } else {
+      (void)se.step(w.model->system(), w.h);  // below the bound: stable, no restart needed
+    }
+  }
+  w.model->restore();
+}
+
 void register_watchdog() {
+  const std::string inv = scale() == Scale::smoke ? "inversion_count/sofa_2x2x3" : "inversion_count/sofa_8x8x10";
+  ours("mss", inv, [](benchmark::State& st) { inversion(st, true); })->Unit(benchmark::kMicrosecond);
+  peer("mss", inv, "one semi-implicit step", [](benchmark::State& st) { inversion(st, false); })->Unit(benchmark::kMicrosecond);
   const std::string name = scale() == Scale::smoke ? "watchdog/sofa_2x2x3/semi_implicit" : "watchdog/sofa_8x8x10/semi_implicit";
   ours("mss", name, [](benchmark::State& st) { run(st, true); })->Unit(benchmark::kMicrosecond);
   peer("mss", name, "no energy checks", [](benchmark::State& st) { run(st, false); })->Unit(benchmark::kMicrosecond);

@@ -323,3 +323,29 @@ TEST_CASE("a spinning cube: the linearly implicit step's energy rise is reported
   const double e0 = column(header, rows.front(), "total_energy");
   CHECK(std::abs(column(header, rows.back(), "dissipated")) <= 1e-9 * e0);
 }
+
+TEST_CASE("inverted elements: counted per frame with the first reported, or the run stopped at the first") {
+  // a 2x2x6 column of 5 cm cubes on the ground, its lower half 10^6 times softer than the top
+  const std::string soft_column = R"({"materials": {"soft": {"young": 1e3, "density": 1000}, "stiff": {"young": 1e9, "density": 1000}},
+  "meshes": [{"type": "hex_grid", "cells": [2, 2, 6], "size": [0.1, 0.1, 0.3], "material": "stiff",
+              "regions": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 0.15]}, "material": "soft"}]}],
+  "fixed": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 0.001]}}],
+  "integrator": {"type": "implicit", "step": 0.001, "max_iterations": 10000)";
+  const std::string rest = R"(}, "duration": 0.5, "output": {"frames": 10, "vtu": false, "picture": {"enabled": false}}})";
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  const RunSummary s = run_text(soft_column + rest, "column", header, rows);
+  double most = 0;
+  for (const auto& r : rows) most = std::max(most, column(header, r, "inverted"));
+  MESSAGE("soft/stiff column: at most " << most << " of 24 hexahedra inverted in a frame; " << s.first_inversion);
+  CHECK(most > 0);
+  CHECK(static_cast<double>(s.inverted_max) == most);
+  CHECK(s.first_inversion.find("mesh cell") != std::string::npos);
+  CHECK(column(header, rows.front(), "inverted") == 0.0);
+  const fs::path scene = scratch("column_stop.json");
+  write(scene, soft_column + R"(, "stop_on_inversion": true)" + rest);
+  RunOptions opt;
+  opt.quiet = true;
+  opt.out = scratch("column_stop");
+  CHECK_THROWS_WITH(run(load_scene(scene.string()), opt), doctest::Contains("inverted at step"));
+}

@@ -47,12 +47,15 @@ struct RunSummary {
   double kinetic_start = 0, kinetic_end = 0, kinetic_max = 0;  ///< J
   std::uint64_t energy_rises = 0;   ///< implicit steps that created energy (see physics::EnergyLedger)
   std::string first_energy_rise;    ///< the warning printed for the first of them ("" if none)
+  std::uint64_t inverted_max = 0;   ///< most inverted hexahedra and tetrahedra seen at once (frames, or steps if checked)
+  std::string first_inversion;      ///< the first inverted element seen, with step and time ("" if none)
   std::filesystem::path out, pvd, csv, picture;
 };
 
 /// Runs the scene to its end. Throws SceneError / io errors / physics::InputError for bad input
 /// (exit 2), physics::StabilityError when a semi-implicit step is above its stable bound
-/// (exit 2: choose a smaller step), physics::BlowupError / SolverError when the run fails (exit 1).
+/// (exit 2: choose a smaller step), physics::BlowupError / SolverError when the run fails (exit 1),
+/// std::runtime_error naming the element at the first inversion if the scene stops there (exit 1).
 RunSummary run(const Scene& scene, const RunOptions& options);
 
 }  // namespace sewn::app

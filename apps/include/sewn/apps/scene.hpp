@@ -95,6 +95,7 @@ struct Scene {
   std::uint32_t max_iterations = 2000;
   bool allow_unstable = false;
   double energy_rise_tolerance = 1e-4;  // relative, see physics::EnergyLedger
+  bool stop_on_inversion = false;       // check every step, stop at the first inverted element
   std::vector<CutSpec> cuts;
   std::uint32_t frames = 50;
   bool write_vtu = true, write_csv = true, write_picture = true;
