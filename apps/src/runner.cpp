@@ -268,6 +268,18 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   mo.environment = scene.environment_damping;
   mo.source = scene.file;
   auto model = std::make_unique<physics::MssModel<3>>(assembly.mesh, materials, assembly.material_of_cell, mo);
+  RunSummary sum;
+
+  // A policy that altered stiffnesses is said so: the body is stiffer than the material.
+  sum.clamped_cells = static_cast<std::uint64_t>(
+      std::count_if(model->elements().begin(), model->elements().end(), [](const auto& e) { return e.alive && e.clamped; }));
+  if (sum.clamped_cells > 0 && !options.quiet)
+    std::fprintf(stderr,
+                 "sewn: warning: %llu cells are too elongated for Baudet's stiffness and had their negative edge "
+                 "stiffnesses clamped to 0 (materials' elongated = \"clamp\"): the body is too stiff in bending, by "
+                 "4.8x at 2.5:1, 66x at 5:1 and 860x at 10:1 on a 1 m cantilever (issue 17's measurements); refine "
+                 "the mesh towards cubes for a faithful answer\n",
+                 static_cast<unsigned long long>(sum.clamped_cells));
 
   // 2) fixed particles, then initial velocities of the free axes
   const IndexedMesh& mesh = assembly.mesh;
@@ -303,7 +315,6 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   std::stable_sort(cuts.begin(), cuts.end());
 
   // 4) outputs
-  RunSummary sum;
   sum.out = options.out.empty() ? std::filesystem::path("out") / scene.name : options.out;
   std::filesystem::create_directories(sum.out);
   Snapshot snap;

@@ -186,6 +186,7 @@ Element MssModel<D>::make_element(const IndexedMesh& mesh, std::uint32_t c, std:
                              std::to_string(len[1]) + " x " + std::to_string(len[2]) + " m: " + describe(s) +
                              "); refine the mesh, or choose the clamp policy for its material");
           s = clamp_edges(s, 0.0);
+          el.clamped = true;
         }
         for (int e = 0; e < 12; ++e) el.edge_k[static_cast<std::size_t>(e)] = s.edge[static_cast<std::size_t>(e / 4)];
         el.diagonal_k = s.diagonal;
@@ -212,6 +213,7 @@ Element MssModel<D>::make_element(const IndexedMesh& mesh, std::uint32_t c, std:
             throw InputError("too elongated for Baudet's stiffness (" + std::to_string(lx) + " x " + std::to_string(ly) +
                              " m: " + describe(s) + "); refine the mesh, or choose the clamp policy for its material");
           s = clamp_edges(s, 0.0);
+          el.clamped = true;
         }
         for (int e = 0; e < 4; ++e) el.edge_k[static_cast<std::size_t>(e)] = s.edge[static_cast<std::size_t>(e / 2)];
         el.diagonal_k = s.diagonal;

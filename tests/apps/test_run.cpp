@@ -349,3 +349,21 @@ TEST_CASE("inverted elements: counted per frame with the first reported, or the 
   opt.out = scratch("column_stop");
   CHECK_THROWS_WITH(run(load_scene(scene.string()), opt), doctest::Contains("inverted at step"));
 }
+
+TEST_CASE("the clamp policy for elongated cells is announced with the number of cells it altered") {
+  const auto beam = [](const std::string& policy) {
+    return R"({"materials": {"m": {"young": 100e6, "density": 1000)" + policy + R"(}},
+  "meshes": [{"type": "hex_grid", "cells": [4, 2, 2], "size": [1.0, 0.1, 0.1], "material": "m"}],
+  "fixed": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [0.001, 1, 1]}}],
+  "duration": 0.002, "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})";
+  };
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  const RunSummary s = run_text(beam(R"(, "elongated": "clamp")"), "clamped", header, rows);
+  CHECK(s.clamped_cells == 16);  // 5:1 boxes: every cell
+  const RunSummary cubes = run_text(R"({"materials": {"m": {"young": 100e6, "density": 1000, "elongated": "clamp"}},
+  "meshes": [{"type": "hex_grid", "cells": [10, 1, 1], "size": [1.0, 0.1, 0.1], "material": "m"}],
+  "duration": 0.002, "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})", "cubes", header, rows);
+  CHECK(cubes.clamped_cells == 0);
+  expect_run_error<sewn::physics::InputError>(beam(""), "too elongated");
+}

@@ -47,6 +47,7 @@ struct RunSummary {
   double kinetic_start = 0, kinetic_end = 0, kinetic_max = 0;  ///< J
   std::uint64_t energy_rises = 0;   ///< implicit steps that created energy (see physics::EnergyLedger)
   std::string first_energy_rise;    ///< the warning printed for the first of them ("" if none)
+  std::uint64_t clamped_cells = 0;   ///< cells whose stiffness the `clamp` policy altered (a warning says so)
   std::uint64_t inverted_max = 0;   ///< most inverted hexahedra and tetrahedra seen at once (frames, or steps if checked)
   std::string first_inversion;      ///< the first inverted element seen, with step and time ("" if none)
   std::filesystem::path out, pvd, csv, picture;
