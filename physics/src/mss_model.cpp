@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Geometry>
+
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/stiffness.hpp"
 
@@ -171,6 +173,10 @@ Element MssModel<D>::make_element(const IndexedMesh& mesh, std::uint32_t c, std:
   el.mesh_cell = c;
   el.dart = dart;
   const std::string name = options_.source + ": cell " + std::to_string(c);
+  // A rest state must be the right way out: inversion is measured against it (solids/inversion.hpp).
+  static const std::string mirrored =
+      "is inside out (a mirror image): its vertex order gives a negative volume; list its vertices in VTK "
+      "order (counter-clockwise seen from outside, for the first face of a hexahedron)";
   try {
     switch (mesh.types[c]) {
       case CellType::hexahedron: {
@@ -193,7 +199,12 @@ Element MssModel<D>::make_element(const IndexedMesh& mesh, std::uint32_t c, std:
         // volume of the six tetrahedra of the Kuhn split: exact for planar faces
         static constexpr int kuhn[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6},
                                            {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
-        for (const auto& t : kuhn) el.measure += tet_volume(p(t[0]), p(t[1]), p(t[2]), p(t[3]));
+        double oriented = 0;
+        for (const auto& t : kuhn) {
+          el.measure += tet_volume(p(t[0]), p(t[1]), p(t[2]), p(t[3]));
+          oriented += (p(t[1]) - p(t[0])).dot((p(t[2]) - p(t[0])).cross(p(t[3]) - p(t[0])));
+        }
+        if (oriented < 0) throw InputError(mirrored);
         break;
       }
       case CellType::tetrahedron: {
@@ -201,6 +212,7 @@ Element MssModel<D>::make_element(const IndexedMesh& mesh, std::uint32_t c, std:
         const auto k = van_gelder_tet(mat.young, p(0), p(1), p(2), p(3));
         std::copy(k.begin(), k.end(), el.edge_k.begin());
         el.measure = tet_volume(p(0), p(1), p(2), p(3));
+        if ((p(1) - p(0)).dot((p(2) - p(0)).cross(p(3) - p(0))) < 0) throw InputError(mirrored);
         break;
       }
       case CellType::quad: {

@@ -61,3 +61,15 @@ TEST_CASE("a region 10^6 times softer than the block it carries turns inside out
                                                                                               << " inverted");
   CHECK(most > 0);
 }
+
+TEST_CASE("a mirror-image rest mesh is refused, naming the cell") {
+  for (bool tets : {false, true}) {
+    CAPTURE(tets);
+    const GridSpec g{{0.1, 0.1, 0.1}, {}};
+    IndexedMesh mesh = tets ? tet_grid(2, 1, 1, TetSplit::kuhn6, g) : hex_grid(2, 1, 1, g);
+    CHECK_NOTHROW(MssModel<3>(mesh, {{1e6, 0.3, 1000}}, {}));
+    for (auto& q : mesh.points) q[0] = -q[0];
+    CHECK_THROWS_WITH_AS(MssModel<3>(mesh, {{1e6, 0.3, 1000}}, {}), doctest::Contains("cell 0 "), InputError);
+    CHECK_THROWS_WITH_AS(MssModel<3>(mesh, {{1e6, 0.3, 1000}}, {}), doctest::Contains("inside out"), InputError);
+  }
+}
