@@ -328,7 +328,8 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     sum.csv = sum.out / "frames.csv";
     csv = std::make_unique<io::CsvWriter>(
         sum.csv, std::vector<std::string>{"frame", "time", "kinetic_energy", "elastic_energy", "gravity_energy",
-                                          "total_energy", "external_work", "dissipated", "energy_rises", "inverted", "particles", "springs", "elements", "steps", "ms_per_step",
+                                          "total_energy", "external_work", "dissipated", "energy_rises", "inverted",
+                                          "particles", "springs", "elements", "steps", "ms_per_step",
                                           "cg_iterations_mean", "cg_iterations_max", "cuts", "faces_cut"});
   }
   // Energy balance of every frame; each implicit step is checked for energy it created (the
