@@ -344,8 +344,9 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   // Inverted elements: counted at every frame, and at every step when the scene stops at the
   // first; the first seen is reported once.
   physics::Index inverted_now = 0;
+  physics::InversionMonitor inversions;
   auto check_inversion = [&](std::uint64_t step) {
-    const physics::InversionCount c = physics::count_inverted(*model);
+    const physics::InversionCount c = inversions.count(*model);
     inverted_now = c.elements;
     sum.inverted_max = std::max<std::uint64_t>(sum.inverted_max, c.elements);
     if (c.elements == 0 || !sum.first_inversion.empty()) return;

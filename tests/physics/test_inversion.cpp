@@ -28,6 +28,10 @@ TEST_CASE("inverted elements: none under a rigid rotation, all under a reflectio
     CHECK(count_inverted(m).elements == 0);
     for (Index i = 0; i < n.size(); ++i) n.set_position(i, m.rest_position(i).cwiseProduct(Vector3d(-1, 1, 1)));
     CHECK(count_inverted(m).elements == m.num_live_elements());
+    InversionMonitor monitor;  // the same, with corners kept between calls
+    CHECK(monitor.count(m).elements == m.num_live_elements());
+    for (Index i = 0; i < n.size(); ++i) n.set_position(i, R * m.rest_position(i));
+    CHECK(monitor.count(m).elements == 0);
     // the corner node at the origin pushed through the opposite faces of its one element
     for (Index i = 0; i < n.size(); ++i) n.set_position(i, m.rest_position(i));
     const Index corner = m.node_of_point(0);

@@ -7,6 +7,7 @@
 // position. Quads, triangles and segments have no orientation in 3D and are not counted.
 
 #include <cstdint>
+#include <vector>
 
 #include "sewn/physics/mss_model.hpp"
 
@@ -18,8 +19,25 @@ struct InversionCount {
   std::uint32_t first_cell = 0;      ///< its mesh cell
 };
 
-/// Counts the inverted elements at the current positions. O(live 3D elements); allocates one
-/// small vector per element (element_nodes()), so call it per frame or per step, not per force.
+/// Counts inverted elements, keeping every corner's nodes and rest sign between calls.
+class InversionMonitor {
+ public:
+  /// The count at the current positions: one signed volume per corner of the live hexahedra and
+  /// tetrahedra. When the model changed since the last call (System::version(): a cut, an
+  /// edit), the corners are first read again from the map, O(elements) with an allocation each.
+  [[nodiscard]] InversionCount count(const MssModel<3>& model);
+
+ private:
+  struct Corner {
+    Index o, a, b, c;   // the corner and its three neighbours
+    bool rest_positive;
+    Index element;
+  };
+  std::vector<Corner> corners_;  // grouped by element, in element order
+  std::uint64_t version_ = ~std::uint64_t{0};
+};
+
+/// One count with a fresh monitor (reads every element from the map: use a monitor to repeat).
 [[nodiscard]] InversionCount count_inverted(const MssModel<3>& model);
 
 }  // namespace sewn::physics
