@@ -41,9 +41,10 @@ constexpr const char* run_usage = R"(usage: sewn run [SCENE.json] [--out DIR] [-
 Runs a scene (docs/scenes.md) and writes, in DIR (default out/<scene name>/):
   <name>.pvd + frame_NNNNN.vtu   the ParaView series (cells with material and refinement level;
                                  per point velocity, force, displacement, fixed flags)
-  frames.csv                     per frame: time, kinetic/potential/elastic energy, particle,
-                                 spring and element counts, ms per step, CG iterations, cuts
-                                 applied and faces they unsewed
+  frames.csv                     per frame: time, kinetic/elastic/gravity/total energy, work of
+                                 gravity, energy dissipated, steps that created energy, inverted
+                                 elements, particle, spring and element counts, ms per step, CG
+                                 iterations, cuts applied and faces they unsewed (docs/scenes.md)
   <name>.png                     a picture of the last frame
   --frames N   number of output frames (overrides the scene's output.frames)
   --until T    stop at simulated time T seconds, if that is before the scene's end; cuts

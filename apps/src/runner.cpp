@@ -12,14 +12,21 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Geometry>
 
 #include "sewn/io/cleanup.hpp"
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/read.hpp"
 #include "sewn/io/render.hpp"
 #include "sewn/io/write.hpp"
+#include "sewn/physics/integrate/energy_ledger.hpp"
+#include "sewn/physics/integrate/implicit_midpoint.hpp"
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
+#include "sewn/physics/solids/inversion.hpp"
 #include "sewn/refine/cut.hpp"
 
 namespace sewn::app {
@@ -240,6 +247,31 @@ std::string format_seconds(double s) {
   return buf;
 }
 
+// The particles a selector picks: those of tagged cells, listed mesh points, or those whose
+// rest position lies in the region. Throws SceneError (at `path`) for a point of no cell or an
+// empty selection.
+std::set<Index> selected_nodes(const Selector& where, const IndexedMesh& mesh, const physics::MssModel<3>& model,
+                               const std::string& file, const std::string& path) {
+  std::set<Index> nodes;
+  if (where.type == Selector::Type::tag) {
+    for (std::uint32_t c = 0; c < mesh.num_cells(); ++c)
+      if (mesh.tags[c] == where.tag)
+        for (std::uint32_t q : mesh.cell(c)) nodes.insert(model.node_of_point(q));
+  } else if (where.type == Selector::Type::points) {
+    for (std::uint32_t q : where.points) {
+      if (q >= mesh.num_points() || model.node_of_point(q) == physics::invalid_index)
+        throw SceneError(file, path + ".indices",
+                         "point " + std::to_string(q) + " is not a point of any cell (" + std::to_string(mesh.num_points()) + " points)");
+      nodes.insert(model.node_of_point(q));
+    }
+  } else {
+    for (Index i = 0; i < model.nodes().size(); ++i)
+      if (where.contains(to_vec3(model.rest_position(i)))) nodes.insert(i);
+  }
+  if (nodes.empty()) throw SceneError(file, path, "selects no particle");
+  return nodes;
+}
+
 }  // namespace
 
 Assembly assemble(const Scene& scene) {
@@ -288,7 +320,18 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   mo.source = scene.file;
   auto model = std::make_unique<physics::MssModel<3>>(assembly.mesh, materials, assembly.material_of_cell, mo);
 
-  // 2) fixed particles
+  // A policy that altered stiffnesses is said so: the body is stiffer than the material.
+  sum.clamped_cells = static_cast<std::uint64_t>(
+      std::count_if(model->elements().begin(), model->elements().end(), [](const auto& e) { return e.alive && e.clamped; }));
+  if (sum.clamped_cells > 0 && !options.quiet)
+    std::fprintf(stderr,
+                 "sewn: warning: %llu cells are too elongated for Baudet's stiffness and had their negative edge "
+                 "stiffnesses clamped to 0 (materials' elongated = \"clamp\"): the body is too stiff in bending, by "
+                 "4.8x at 2.5:1, 66x at 5:1 and 860x at 10:1 on a 1 m cantilever (issue 17's measurements); refine "
+                 "the mesh towards cubes for a faithful answer\n",
+                 static_cast<unsigned long long>(sum.clamped_cells));
+
+  // 2) fixed particles, then initial velocities of the free axes
   const IndexedMesh& mesh = assembly.mesh;
   for (std::size_t k = 0; k < scene.fixed.size(); ++k) {
     const FixSpec& fix = scene.fixed[k];
@@ -296,24 +339,20 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     if (fix.axes[0]) axes |= physics::axis_x;
     if (fix.axes[1]) axes |= physics::axis_y;
     if (fix.axes[2]) axes |= physics::axis_z;
-    std::set<Index> nodes;
-    if (fix.where.type == Selector::Type::tag) {
-      for (std::uint32_t c = 0; c < mesh.num_cells(); ++c)
-        if (mesh.tags[c] == fix.where.tag)
-          for (std::uint32_t q : mesh.cell(c)) nodes.insert(model->node_of_point(q));
-    } else if (fix.where.type == Selector::Type::points) {
-      for (std::uint32_t q : fix.where.points) {
-        if (q >= mesh.num_points() || model->node_of_point(q) == physics::invalid_index)
-          throw SceneError(scene.file, "fixed[" + std::to_string(k) + "].where.indices",
-                           "point " + std::to_string(q) + " is not a point of any cell (" + std::to_string(mesh.num_points()) + " points)");
-        nodes.insert(model->node_of_point(q));
-      }
-    } else {
-      for (Index i = 0; i < model->nodes().size(); ++i)
-        if (fix.where.contains(to_vec3(model->rest_position(i)))) nodes.insert(i);
+    for (Index i : selected_nodes(fix.where, mesh, *model, scene.file, "fixed[" + std::to_string(k) + "].where"))
+      model->nodes().fix(i, axes);
+  }
+  for (std::size_t k = 0; k < scene.velocities.size(); ++k) {
+    const VelocitySpec& vel = scene.velocities[k];
+    const Vec3d linear(vel.linear[0], vel.linear[1], vel.linear[2]), angular(vel.angular[0], vel.angular[1], vel.angular[2]),
+        center(vel.center[0], vel.center[1], vel.center[2]);
+    for (Index i : selected_nodes(vel.where, mesh, *model, scene.file, "velocities[" + std::to_string(k) + "].where")) {
+      Vec3d v = linear + angular.cross(model->rest_position(i) - center);
+      // a velocity on a fixed axis would make it kinematic: fixed stays fixed
+      for (int a = 0; a < 3; ++a)
+        if ((model->nodes().fixed(i) >> a) & 1u) v[a] = 0;
+      model->nodes().set_velocity(i, v);
     }
-    if (nodes.empty()) throw SceneError(scene.file, "fixed[" + std::to_string(k) + "].where", "selects no particle");
-    for (Index i : nodes) model->nodes().fix(i, axes);
   }
 
   // 3) time line: steps, frames and scheduled cuts
@@ -337,18 +376,44 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     sum.csv = sum.out / "frames.csv";
     writing([&] {
       csv = std::make_unique<io::CsvWriter>(
-          sum.csv, std::vector<std::string>{"frame", "time", "kinetic_energy", "potential_energy", "elastic_energy",
+          sum.csv, std::vector<std::string>{"frame", "time", "kinetic_energy", "elastic_energy", "gravity_energy",
+                                            "total_energy", "external_work", "dissipated", "energy_rises", "inverted",
                                             "particles", "springs", "elements", "steps", "ms_per_step",
                                             "cg_iterations_mean", "cg_iterations_max", "cuts", "faces_cut"});
     });
   }
+  // Energy balance of every frame; each implicit step is checked for energy it created (the
+  // semi-implicit scheme's plain energy oscillates by design: its divergence is the
+  // integrator's watchdog's business).
+  physics::EnergyLedger ledger(scene.energy_rise_tolerance);
+  ledger.start(model->system());
   std::uint32_t frame = 0;
   double frame_ms = 0, frame_cg_sum = 0;
   int frame_cg_max = 0;
   std::uint64_t frame_steps = 0;
+  // Inverted elements: counted at every frame, and at every step when the scene stops at the
+  // first; the first seen is reported once.
+  physics::Index inverted_now = 0;
+  physics::InversionMonitor inversions;
+  auto check_inversion = [&](std::uint64_t step) {
+    const physics::InversionCount c = inversions.count(*model);
+    inverted_now = c.elements;
+    sum.inverted_max = std::max<std::uint64_t>(sum.inverted_max, c.elements);
+    if (c.elements == 0 || !sum.first_inversion.empty()) return;
+    char msg[300];
+    std::snprintf(msg, sizeof msg, "element %u (mesh cell %u) is inverted at step %llu (t = %.6g s)%s", c.first, c.first_cell,
+                  static_cast<unsigned long long>(step), static_cast<double>(step) * scene.step,
+                  c.elements > 1 ? (", with " + std::to_string(c.elements - 1) + " more").c_str() : "");
+    sum.first_inversion = msg;
+    if (scene.stop_on_inversion)
+      throw std::runtime_error(std::string(msg) + "; stopped there (integrator.stop_on_inversion)");
+    if (!options.quiet) std::fprintf(stderr, "\nsewn: warning: %s\n", msg);
+  };
+  std::uint64_t steps_done = 0;
   auto write_frame = [&](double t) {
     physics::System& sys = model->system();
     sys.compute_forces();
+    check_inversion(steps_done);
     if (pvd) {
       snap.take(*model);
       char name[32];
@@ -367,8 +432,10 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     }
     if (csv) {
       const auto elements = std::count_if(model->elements().begin(), model->elements().end(), [](const auto& e) { return e.alive; });
-      writing([&] { csv->row({static_cast<double>(frame), t, sys.kinetic_energy(), sys.potential_energy(),
-                sys.potential_energy(physics::EnergyKind::internal), static_cast<double>(model->nodes().num_alive()),
+      const physics::EnergyBalance e = ledger.balance(sys);
+      writing([&] { csv->row({static_cast<double>(frame), t, e.kinetic, e.elastic, e.external_potential, e.total, e.external_work,
+                e.dissipated, static_cast<double>(ledger.rises()), static_cast<double>(inverted_now),
+                static_cast<double>(model->nodes().num_alive()),
                 static_cast<double>(model->springs().num_alive()), static_cast<double>(elements),
                 static_cast<double>(frame_steps), frame_steps ? frame_ms / static_cast<double>(frame_steps) : 0.0,
                 frame_steps ? frame_cg_sum / static_cast<double>(frame_steps) : 0.0, static_cast<double>(frame_cg_max),
@@ -390,7 +457,11 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   io_opt.cg_max_iterations = static_cast<int>(scene.max_iterations);
   physics::SymplecticEuler semi(so);
   physics::LinearlyImplicitEuler implicit(io_opt);
-  const bool use_implicit = scene.integrator == "implicit";
+  physics::ImplicitMidpointOptions mid_opt;
+  mid_opt.cg_max_iterations = static_cast<int>(scene.max_iterations);
+  physics::ImplicitMidpoint midpoint(mid_opt);
+  const bool use_midpoint = scene.integrator == "midpoint";
+  const bool use_implicit = scene.integrator == "implicit" || use_midpoint;
   const bool bar = !options.quiet && options.progress && isatty(STDERR_FILENO);
   sum.kinetic_start = model->system().kinetic_energy();
   write_frame(0.0);
@@ -435,9 +506,12 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
       }
       sum.faces_cut += rep.facets;
       ++sum.cuts;
+      ledger.rebase(model->system());
     }
     int cg = 0;
-    if (use_implicit)
+    if (use_midpoint)
+      cg = midpoint.step(model->system(), h).cg_iterations;
+    else if (use_implicit)
       cg = implicit.step(model->system(), h).cg_iterations;
     else
       step_semi_implicit(semi, model->system(), h, t, scene);
@@ -446,6 +520,20 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     frame_cg_sum += cg;
     frame_cg_max = std::max(frame_cg_max, cg);
     ++frame_steps;
+    steps_done = s + 1;
+    if (scene.stop_on_inversion) check_inversion(s + 1);
+    if (use_implicit)
+      if (const auto rise = ledger.after_step(model->system(), s + 1); rise && ledger.rises() == 1) {
+        char msg[400];
+        std::snprintf(msg, sizeof msg,
+                      "step %llu (t = %.6g s) raised the total energy from %.6g J to %.6g J (+%.3g %% of the %.6g J in "
+                      "motion) with no external work to supply it: the integrator created energy (the linearised "
+                      "implicit step does on fast rotations; a smaller step or integrator.type \"midpoint\" avoids it)",
+                      static_cast<unsigned long long>(s + 1), static_cast<double>(s + 1) * h, rise->before, rise->after,
+                      100 * (rise->after - rise->before) / rise->moved, rise->moved);
+        sum.first_energy_rise = msg;
+        if (!options.quiet) std::fprintf(stderr, "%ssewn: warning: %s\n", bar ? "\n" : "", msg);
+      }
     sum.kinetic_max = std::max(sum.kinetic_max, model->system().kinetic_energy());
     // frame f is written after step round(f · steps / frames)
     const auto due = static_cast<std::uint64_t>(std::llround(static_cast<double>(frame) * static_cast<double>(steps) / frames));
@@ -468,6 +556,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   sum.ms_per_step = steps ? sum.wall * 1e3 / static_cast<double>(steps) : 0;
   sum.kinetic_end = model->system().kinetic_energy();
   if (csv) writing([&] { csv->flush(); });
+  sum.energy_rises = ledger.rises();
 
   // 6) the picture of the last frame
   if (scene.write_picture) {

@@ -51,7 +51,7 @@ Field build_schema() {
       field("thickness", Kind::number).unit("m").fallback(1.0).above(0).doc("Thickness of 2D cells (membranes): scales their mass and stiffness."),
       field("area", Kind::number).unit("m²").fallback(1e-4).above(0).doc("Cross-section of 1D cells (polylines): axial spring k = E·area/length."),
       field("elongated", Kind::string).one_of({"refuse", "clamp"}).fallback("refuse")
-          .doc("Baudet's edge stiffness turns negative for boxes longer than ~1.5× their width: refuse such an element (naming it), or clamp the edge stiffness to a small positive fraction of the diagonal's (documented in PHYSICS_NOTES §1.2 handling)."),
+          .doc("Baudet's edge stiffness turns negative for boxes longer than ~1.5× their width: refuse such an element (naming it), or clamp the negative edge stiffnesses to 0, the diagonals then carrying the load along the long axis. Clamping makes the body too stiff in bending (on a 1 m cantilever: 4.8× at 2.5:1, 66× at 5:1, 860× at 10:1); the run prints a warning with the number of clamped cells."),
   });
 
   Field mesh = field("mesh", Kind::object);
@@ -113,6 +113,13 @@ Field build_schema() {
       .members({selector_schema("where", "Particles to fix.").required(),
                 field("axes", Kind::string).one_of({"xyz", "x", "y", "z", "xy", "xz", "yz"}).fallback("xyz").doc("Axes held.")});
 
+  Field velocity = field("velocity", Kind::object);
+  velocity.doc("An initial velocity v = linear + angular × (x − center) for the particles in `where` (x: rest position): a uniform motion plus a rigid rotation about the axis through `center` along `angular`. Fixed axes keep their zero velocity; where entries overlap, later ones win.")
+      .members({selector_schema("where", "Particles to set in motion.").required(),
+                field("linear", Kind::vec3).unit("m/s").fallback({0.0, 0.0, 0.0}).doc("Uniform velocity."),
+                field("angular", Kind::vec3).unit("rad/s").fallback({0.0, 0.0, 0.0}).doc("Angular velocity ω (axis direction times rate)."),
+                field("center", Kind::vec3).unit("m").fallback({0.0, 0.0, 0.0}).doc("A point of the rotation axis.")});
+
   Field cut = field("cut", Kind::object);
   cut.doc("A topological cut applied between two steps (3-unsew of faces between volumes; 2-unsew of edges between 2D cells).")
       .select_by("type");
@@ -140,7 +147,16 @@ Field build_schema() {
                 field("width", Kind::integer).fallback(1280).at_least(io::min_render_width).at_most(8192).unit("px").doc("Width."),
                 field("height", Kind::integer).fallback(800).at_least(io::min_render_height).at_most(8192).unit("px").doc("Height.")});
   Field output = field("output", Kind::object);
-  output.doc("What is written to the output folder (`--out`, default `out/<name>/`).")
+  output.doc("What is written to the output folder (`--out`, default `out/<name>/`).\n\n"
+             "`frames.csv` has one row per frame. Its energies (J) add up: `total_energy` = `kinetic_energy` + "
+             "`elastic_energy` + `gravity_energy` (the springs' and gravity's potentials); `external_work` is the work "
+             "gravity has done since the start (its potential then minus now) and `dissipated` the energy lost since "
+             "the start (total then minus now: damping plus the integrator's numerical dissipation; negative when the "
+             "scheme created energy), so that kinetic + elastic = their start value + `external_work` − `dissipated`. "
+             "`energy_rises` counts the implicit steps so far that created energy (see `integrator.energy_rise_tolerance`), "
+             "`inverted` the hexahedra and tetrahedra inverted in the frame (see `integrator.stop_on_inversion`). "
+             "Then: `particles`, `springs`, `elements` alive; `steps` in the frame, `ms_per_step` (stepping only), "
+             "`cg_iterations_mean` and `_max` per step (implicit), `cuts` applied and `faces_cut` so far.")
       .fallback(nlohmann::json::object())
       .members({field("frames", Kind::integer).fallback(50).at_least(1).at_most(100000).doc("Output frames over the run (a ParaView .vtu each, plus frame 0)."),
                 field("vtu", Kind::boolean).fallback(true).doc("Write the ParaView series (.vtu per frame + .pvd)."),
@@ -159,8 +175,8 @@ Field build_schema() {
   Field integrator = field("integrator", Kind::object);
   integrator.doc("Time integration.")
       .fallback(nlohmann::json::object())
-      .members({field("type", Kind::string).one_of({"implicit", "semi-implicit"}).fallback("implicit")
-                    .doc("Linearly implicit Euler (Baraff–Witkin, CG) or semi-implicit (symplectic) Euler."),
+      .members({field("type", Kind::string).one_of({"implicit", "semi-implicit", "midpoint"}).fallback("implicit")
+                    .doc("Linearly implicit Euler (Baraff–Witkin, CG: one solve per step, dissipative, loses angular momentum on fast rotations), semi-implicit (symplectic) Euler (explicit: below the stable step only), or the implicit midpoint rule with discrete-gradient springs solved by Newton and CG (keeps linear and angular momentum and the energy of free bodies to round-off at any step it converges at; several solves per step). See docs/integrators.md."),
                 field("step", Kind::number).unit("s").fallback(1e-3).above(0).at_most(10).doc("Time step h."),
                 field("solver", Kind::string).one_of({"auto", "jacobi", "cholmod", "cholmod-pcg"}).fallback("auto")
                     .doc("Linear solver (implicit), docs/solvers.md: `jacobi` block-Jacobi CG, `cholmod` sparse Cholesky, `cholmod-pcg` CG preconditioned by a reused Cholesky factorization; `auto` picks by model size. The CHOLMOD ones need SuiteSparse at build time."),
@@ -169,7 +185,11 @@ Field build_schema() {
                     .doc("Floor of the residual as a velocity error on every free axis (implicit): a body at rest stops there instead of chasing round-off. 0: none."),
                 field("max_iterations", Kind::integer).fallback(physics::solve::default_max_iterations).at_least(1).at_most(1000000).doc("Iteration limit of the iterative solvers (implicit); reaching it is an error."),
                 field("allow_unstable", Kind::boolean).fallback(false)
-                    .doc("Run a semi-implicit step larger than the estimated stable bound (otherwise refused with the bound).")});
+                    .doc("Run a semi-implicit step larger than the estimated stable bound (otherwise refused with the bound)."),
+                field("energy_rise_tolerance", Kind::number).fallback(1e-4).above(0).below(1)
+                    .doc("An implicit step whose total energy (kinetic + elastic + gravity) rises by more than this fraction of the energy in motion is reported: a warning at the first, a count in frames.csv (`energy_rises`)."),
+                field("stop_on_inversion", Kind::boolean).fallback(false)
+                    .doc("Check for inverted hexahedra and tetrahedra (a corner's signed volume opposite to its rest sign) after every step and stop the run (exit 1) at the first, naming it; otherwise they are counted at every frame (`inverted` in frames.csv) and the first seen is a warning.")});
 
   Field limits = field("limits", Kind::object);
   limits.doc("Bounds on what a scene may ask for, checked when it is read, before anything is built: a scene over them is refused with the estimate, and runs only if it raises the limit here.")
@@ -187,6 +207,7 @@ Field build_schema() {
       field("materials", Kind::map).of(material).items(1, 1u << 20).required().doc("Named materials."),
       field("meshes", Kind::array).of(mesh).items(1, 1u << 16).required().doc("The bodies."),
       field("fixed", Kind::array).of(fix).fallback(nlohmann::json::array()).doc("Fixed particles."),
+      field("velocities", Kind::array).of(velocity).fallback(nlohmann::json::array()).doc("Initial velocities (default: at rest)."),
       field("gravity", Kind::vec3).unit("m/s²").fallback({0.0, 0.0, -9.81}).at_least(-1e6).at_most(1e6)
           .doc("Gravity (each component within ±10⁶ m/s², 10⁵ g: beyond, the forces overflow the solver)."),
       damping,
@@ -454,6 +475,12 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     Reader fr(fj, fix_schema);
     s.fixed.push_back({read_selector(fj.at("where"), *fix_schema.member("where")), read_axes(fr.string("axes"))});
   }
+  const Field& velocity_schema = *schema.member("velocities")->element_;
+  for (const auto& vj : r["velocities"]) {
+    Reader vr(vj, velocity_schema);
+    s.velocities.push_back({read_selector(vj.at("where"), *velocity_schema.member("where")), vr.vec3("linear"),
+                            vr.vec3("angular"), vr.vec3("center")});
+  }
   s.gravity = r.vec3("gravity");
   {
     Reader d(r["damping"], *schema.member("damping"));
@@ -476,6 +503,8 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     s.absolute_tolerance = in.number("absolute_tolerance");
     s.max_iterations = static_cast<std::uint32_t>(in.integer("max_iterations"));
     s.allow_unstable = in.boolean("allow_unstable");
+    s.energy_rise_tolerance = in.number("energy_rise_tolerance");
+    s.stop_on_inversion = in.boolean("stop_on_inversion");
   }
   s.duration = r.number("duration");
   if (s.step > s.duration) throw SceneError(file, "integrator.step", "is longer than the whole run (duration " + std::to_string(s.duration) + " s)");

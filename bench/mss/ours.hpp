@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "model.hpp"
+#include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/physics.hpp"
 
 namespace sewn::bench::mss {
@@ -22,6 +23,8 @@ class Ours {
   ~Ours();
 
   [[nodiscard]] physics::System& system();
+  /// The model on the map behind the system.
+  [[nodiscard]] const physics::MssModel<3>& model() const;
   /// The node of mesh point p.
   [[nodiscard]] physics::Index node(std::uint32_t p) const;
   [[nodiscard]] Counts counts() const;

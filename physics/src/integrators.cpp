@@ -31,6 +31,10 @@ inline std::uint64_t inf_or_nan(double x) {
   return static_cast<std::uint64_t>((std::bit_cast<std::uint64_t>(x) & exponent) == exponent);
 }
 
+// |x| as its bit pattern: ordered like |x| for non-negative doubles, NaN above infinity, and
+// an integer max-reduction vectorises where a floating-point one would need -ffast-math.
+inline std::uint64_t abs_bits(double x) { return std::bit_cast<std::uint64_t>(x) & std::uint64_t{0x7fffffffffffffff}; }
+
 // True if every value of the equally long arrays is finite, in one pass.
 template <class... Spans>
 bool all_finite(std::span<const double> a, Spans... more) {
@@ -68,43 +72,6 @@ void check_finite(const NodeTable& nodes, const char* who) {
 
 }  // namespace
 
-// ------------------------------------------------------------------ EnergyWatchdog
-
-void EnergyWatchdog::baseline_if_needed(const System& sys) {
-  const std::uint64_t v = sys.version();
-  if (has_baseline_ && v == version_) return;
-  internal0_ = sys.kinetic_energy() + sys.potential_energy(EnergyKind::internal);
-  external0_ = sys.potential_energy(EnergyKind::external);
-  version_ = v;
-  has_baseline_ = true;
-}
-
-void EnergyWatchdog::check(const System& sys, const HealthOptions& opt, std::uint64_t step) const {
-  if (!has_baseline_) return;
-  const double internal = sys.kinetic_energy() + sys.potential_energy(EnergyKind::internal);
-  const double work = external0_ - sys.potential_energy(EnergyKind::external);
-  const double budget = internal0_ + std::max(0.0, work);
-  const double floor = opt.energy_floor_fraction * sys.energy_scale();
-  if (internal <= opt.energy_growth_factor * budget + floor) return;
-  const NodeTable& nodes = sys.nodes();
-  Index fastest = invalid_index;
-  double vmax = -1;
-  for (Index i = 0; i < nodes.size(); ++i) {
-    const auto v = nodes.v().subspan(3 * std::size_t{i}, 3);
-    const double s = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    if (s > vmax || (std::isnan(s) && fastest == invalid_index)) {
-      vmax = s;
-      fastest = i;
-    }
-  }
-  throw BlowupError("energy blow-up after step " + std::to_string(step) + ": kinetic + internal energy " + fmt(internal) +
-                        " exceeds " + fmt(opt.energy_growth_factor) + " x its budget " + fmt(budget) +
-                        " (baseline energy plus work of external fields) + floor " + fmt(floor) + "; fastest node " +
-                        std::to_string(fastest) + " has speed " + fmt(vmax) +
-                        ". The time step is probably too large for the scheme.",
-                    fastest, "energy");
-}
-
 // ------------------------------------------------------------------ SymplecticEuler
 
 SymplecticEuler::SymplecticEuler(SymplecticEulerOptions options) : opt_(options) {}
@@ -137,27 +104,39 @@ StepReport SymplecticEuler::step(System& sys, double h) {
     }
   }
   const bool watch = opt_.health.energy_check_interval > 0;
-  if (watch) watchdog_.baseline_if_needed(sys);
+  // an unguarded run still needs the bound to suggest a step if it diverges
+  if (watch && watchdog_.baseline_if_needed(sys) && !opt_.enforce_stable_step) bound_ = sys.stable_step();
   sys.compute_forces();
   NodeTable& nodes = sys.nodes();
   if (opt_.health.check_finite) check_finite(nodes, "SymplecticEuler::step");
+  double max_speed = 0;
+  bool finite = true;  // else the next step's check names the value; energies of a NaN state mean nothing
   {
     const std::size_t n3 = nodes.x().size();
     double* __restrict x = nodes.x().data();
     double* __restrict v = nodes.v().data();
     const double* __restrict f = nodes.f().data();
     const double* __restrict im = nodes.inverse_mass_dof().data();
-    std::uint64_t bad = 0;
+    std::uint64_t bad = 0, speed = 0;
     for (std::size_t k = 0; k < n3; ++k) {
       v[k] += h * im[k] * f[k];
       x[k] += h * v[k];
       bad |= inf_or_nan(v[k]) | inf_or_nan(x[k]);
+      speed = std::max(speed, abs_bits(v[k]));
     }
     if (bad == 0) nodes.mark_state_finite();
+    finite = bad == 0;
+    max_speed = std::bit_cast<double>(speed);
   }
   ++steps_;
-  if (watch && steps_ % static_cast<std::uint64_t>(opt_.health.energy_check_interval) == 0)
-    watchdog_.check(sys, opt_.health, steps_);
+  if (watch && finite)
+    if (auto blowup = watchdog_.after_step(sys, opt_.health, steps_, max_speed)) {
+      const double suggested = 0.9 * bound_.h_max;
+      throw BlowupError("SymplecticEuler::step: " + blowup->message + ". The step h = " + fmt(h) +
+                            " s is too large for the scheme: the stable-step bound at the start was " +
+                            fmt(bound_.h_max) + " s; suggested step " + fmt(suggested) + " s",
+                        blowup->node, "energy", steps_, suggested);
+    }
   return rep;
 }
 
@@ -265,21 +244,34 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
   }
 
   // 4) V₁ = V₀ + ΔV, P₁ = P₀ + h V₁
+  double max_speed = 0;
+  bool finite = true;  // else the next step's check names the value; energies of a NaN state mean nothing
   {
     double* __restrict x = nodes.x().data();
     double* __restrict v = nodes.v().data();
     const double* __restrict dv = dv_.data();
-    std::uint64_t bad = 0;
+    std::uint64_t bad = 0, speed = 0;
     for (std::size_t k = 0; k < n3; ++k) {
       v[k] += dv[k];
       x[k] += h * v[k];
       bad |= inf_or_nan(v[k]) | inf_or_nan(x[k]);
+      speed = std::max(speed, abs_bits(v[k]));
     }
     if (bad == 0) nodes.mark_state_finite();
+    finite = bad == 0;
+    max_speed = std::bit_cast<double>(speed);
   }
   ++steps_;
-  if (watch && steps_ % static_cast<std::uint64_t>(opt_.health.energy_check_interval) == 0)
-    watchdog_.check(sys, opt_.health, steps_);
+  if (watch && finite)
+    if (auto blowup = watchdog_.after_step(sys, opt_.health, steps_, max_speed)) {
+      // No stability bound exists for this scheme; its energy grows when the linearisation
+      // fails (fast rotation, large strain), which a smaller step makes smaller.
+      const double suggested = h / 10;
+      throw BlowupError("LinearlyImplicitEuler::step: " + blowup->message + ". The linearised step failed at h = " +
+                            fmt(h) + " s; suggested step " + fmt(suggested) +
+                            " s, or the momentum-conserving integrator for fast rotations",
+                        blowup->node, "energy", steps_, suggested);
+    }
   return rep;
 }
 

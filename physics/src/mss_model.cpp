@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <Eigen/Geometry>
+
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/stiffness.hpp"
 
@@ -180,6 +182,10 @@ Element MssModel<D>::make_element(const IndexedMesh& mesh, std::uint32_t c, std:
   el.mesh_cell = c;
   el.dart = dart;
   const std::string name = options_.source + ": cell " + std::to_string(c);
+  // A rest state must be the right way out: inversion is measured against it (solids/inversion.hpp).
+  static const std::string mirrored =
+      "is inside out (a mirror image): its vertex order gives a negative volume; list its vertices in VTK "
+      "order (counter-clockwise seen from outside, for the first face of a hexahedron)";
   try {
     switch (mesh.types[c]) {
       case CellType::hexahedron: {
@@ -195,13 +201,19 @@ Element MssModel<D>::make_element(const IndexedMesh& mesh, std::uint32_t c, std:
                              std::to_string(len[1]) + " x " + std::to_string(len[2]) + " m: " + describe(s) +
                              "); refine the mesh, or choose the clamp policy for its material");
           s = clamp_edges(s, 0.0);
+          el.clamped = true;
         }
         for (int e = 0; e < 12; ++e) el.edge_k[static_cast<std::size_t>(e)] = s.edge[static_cast<std::size_t>(e / 4)];
         el.diagonal_k = s.diagonal;
         // volume of the six tetrahedra of the Kuhn split: exact for planar faces
         static constexpr int kuhn[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6},
                                            {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
-        for (const auto& t : kuhn) el.measure += tet_volume(p(t[0]), p(t[1]), p(t[2]), p(t[3]));
+        double oriented = 0;
+        for (const auto& t : kuhn) {
+          el.measure += tet_volume(p(t[0]), p(t[1]), p(t[2]), p(t[3]));
+          oriented += (p(t[1]) - p(t[0])).dot((p(t[2]) - p(t[0])).cross(p(t[3]) - p(t[0])));
+        }
+        if (oriented < 0) throw InputError(mirrored);
         break;
       }
       case CellType::tetrahedron: {
@@ -209,6 +221,7 @@ Element MssModel<D>::make_element(const IndexedMesh& mesh, std::uint32_t c, std:
         const auto k = van_gelder_tet(mat.young, p(0), p(1), p(2), p(3));
         std::copy(k.begin(), k.end(), el.edge_k.begin());
         el.measure = tet_volume(p(0), p(1), p(2), p(3));
+        if ((p(1) - p(0)).dot((p(2) - p(0)).cross(p(3) - p(0))) < 0) throw InputError(mirrored);
         break;
       }
       case CellType::quad: {
@@ -221,6 +234,7 @@ Element MssModel<D>::make_element(const IndexedMesh& mesh, std::uint32_t c, std:
             throw InputError("too elongated for Baudet's stiffness (" + std::to_string(lx) + " x " + std::to_string(ly) +
                              " m: " + describe(s) + "); refine the mesh, or choose the clamp policy for its material");
           s = clamp_edges(s, 0.0);
+          el.clamped = true;
         }
         for (int e = 0; e < 4; ++e) el.edge_k[static_cast<std::size_t>(e)] = s.edge[static_cast<std::size_t>(e / 2)];
         el.diagonal_k = s.diagonal;

@@ -111,7 +111,8 @@ TEST_CASE("the default scene runs to the end and its energies behave physically"
     REQUIRE(it != header.end());
     return static_cast<std::size_t>(it - header.begin());
   };
-  const std::size_t ke = col("kinetic_energy"), pe = col("potential_energy"), cuts = col("cuts"), particles = col("particles");
+  const std::size_t ke = col("kinetic_energy"), el = col("elastic_energy"), gr = col("gravity_energy"), total = col("total_energy"),
+                    work = col("external_work"), lost = col("dissipated"), cuts = col("cuts"), particles = col("particles");
   double ke_max = 0;
   for (const auto& r : rows) ke_max = std::max(ke_max, r[ke]);
   CHECK(ke_max > 0);
@@ -121,10 +122,19 @@ TEST_CASE("the default scene runs to the end and its energies behave physically"
   // stiffness (split springs keep their stretch), so kinetic + potential never rises; allowance:
   // the CG tolerance (1e-6 relative per step) on the energy moved in a frame
   for (std::size_t f = 1; f < rows.size(); ++f) {
-    const double before = rows[f - 1][ke] + rows[f - 1][pe], after = rows[f][ke] + rows[f][pe];
+    const double before = rows[f - 1][total], after = rows[f][total];
     CAPTURE(f);
     CHECK(after <= before + 1e-6 * ke_max);
   }
+  // the columns add up: the total is its three parts, and kinetic + elastic is its start value
+  // plus the work of gravity minus what was dissipated (to the CSV's printed precision)
+  for (const auto& r : rows) {
+    const double scale = std::abs(r[total]) + std::abs(r[gr]) + std::abs(r[work]);
+    CHECK(r[total] == doctest::Approx(r[ke] + r[el] + r[gr]).epsilon(1e-9).scale(scale));
+    CHECK(r[ke] + r[el] == doctest::Approx(rows[0][ke] + rows[0][el] + r[work] - r[lost]).epsilon(1e-9).scale(scale));
+    CHECK(r[lost] >= -1e-6 * ke_max);  // implicit Euler and drag only remove energy
+  }
+  CHECK(rows.back()[col("energy_rises")] == 0.0);
   // the cut happened once, at the start of the first step from 0.6 s (so after the 0.6 s frame),
   // and duplicated particles
   for (const auto& r : rows) CHECK(r[cuts] == (r[col("time")] <= 0.6 + 1e-9 ? 0.0 : 1.0));
@@ -236,4 +246,125 @@ TEST_CASE("the sewn binary: exit codes and messages") {
                    "integrator": {"type": "semi-implicit", "step": 0.001, "allow_unstable": true}, "duration": 10})");
   CHECK(run_binary("run --quiet --out " + scratch("nan").string() + " " + scene.string(), err) == 1);
   CHECK(err.find("the run failed") != std::string::npos);
+}
+
+namespace {
+
+// A free 10 cm cube of 4³ hexahedra about the origin, weightless and undamped, with the given
+// integrator, step and "velocities" entries; 5 frames.
+std::string spin_scene(const std::string& integrator, double step, double duration, const std::string& velocities) {
+  return R"({"materials": {"rubber": {"young": 1e6, "density": 1000}},
+  "meshes": [{"type": "hex_grid", "cells": [4, 4, 4], "size": [0.1, 0.1, 0.1], "origin": [-0.05, -0.05, -0.05], "material": "rubber"}],
+  "gravity": [0, 0, 0], "damping": {"model": "none"},
+  "integrator": {"type": ")" + integrator + R"(", "step": )" + std::to_string(step) + R"(},
+  "duration": )" + std::to_string(duration) + R"(, "velocities": )" + velocities + R"(,
+  "output": {"frames": 5, "vtu": false, "picture": {"enabled": false}}})";
+}
+
+RunSummary run_text(const std::string& text, const std::string& name, std::vector<std::string>& header,
+                    std::vector<std::vector<double>>& rows) {
+  const fs::path scene = scratch(name + ".json");
+  write(scene, text);
+  RunOptions opt;
+  opt.quiet = true;
+  opt.out = scratch(name);
+  const RunSummary s = run(load_scene(scene.string()), opt);
+  rows = read_csv(s.csv, header);
+  return s;
+}
+
+double column(const std::vector<std::string>& header, const std::vector<double>& row, const std::string& name) {
+  const auto it = std::find(header.begin(), header.end(), name);
+  REQUIRE(it != header.end());
+  return row[static_cast<std::size_t>(it - header.begin())];
+}
+
+}  // namespace
+
+TEST_CASE("scene velocities: a uniform drift and a rigid spin, fixed axes left at rest") {
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  // uniform: the kinetic energy is ½ M v² with M = ρV = 1 kg, whatever the lumping
+  run_text(spin_scene("semi-implicit", 1e-5, 1e-4, R"([{"where": {"type": "all"}, "linear": [0.3, 0.4, 0]}])"), "drift",
+           header, rows);
+  CHECK(column(header, rows[0], "kinetic_energy") == doctest::Approx(0.5 * 1.0 * 0.25).epsilon(1e-12));
+  // a spin about z through the centre on the lower half only: ½ Σ m ω² (x² + y²) over the
+  // particles with z <= 0, each of mass ρ a³/8 per incident cell (a = 2.5 cm)
+  run_text(spin_scene("semi-implicit", 1e-5, 1e-4,
+                      R"([{"where": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 0]}, "angular": [0, 0, 10]}])"),
+           "spin_half", header, rows);
+  const double a = 0.025, m_cell = 1000 * a * a * a / 8;
+  double expected = 0;
+  for (int i = 0; i <= 4; ++i)
+    for (int j = 0; j <= 4; ++j)
+      for (int k = 0; k <= 2; ++k) {
+        const auto cells = [](int q) { return (q == 0 || q == 4) ? 1 : 2; };
+        const double m = m_cell * cells(i) * cells(j) * cells(k);
+        const double x = -0.05 + a * i, y = -0.05 + a * j;
+        expected += 0.5 * m * 100 * (x * x + y * y);
+      }
+  CHECK(column(header, rows[0], "kinetic_energy") == doctest::Approx(expected).epsilon(1e-12));
+  // an empty selection is named
+  expect_run_error<SceneError>(spin_scene("implicit", 1e-3, 1e-2, R"([{"where": {"type": "box", "min": [5, 5, 5], "max": [6, 6, 6]}}])"),
+                   "velocities[0].where");
+}
+
+TEST_CASE("a spinning cube: the linearly implicit step's energy rise is reported, the midpoint rule creates none") {
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  const std::string spin100 = R"([{"where": {"type": "all"}, "angular": [0, 0, 100]}])";
+  const RunSummary fast = run_text(spin_scene("implicit", 0.01, 0.05, spin100), "spin100", header, rows);
+  CHECK(fast.energy_rises >= 1);
+  CHECK(fast.first_energy_rise.find("step 1 ") != std::string::npos);
+  CHECK(column(header, rows.back(), "energy_rises") == static_cast<double>(fast.energy_rises));
+  CHECK(column(header, rows[1], "dissipated") < 0);  // frame 1, after step 1: energy was created
+  const std::string spin10 = R"([{"where": {"type": "all"}, "angular": [0, 0, 10]}])";
+  const RunSummary calm = run_text(spin_scene("midpoint", 0.01, 0.2, spin10), "spin10", header, rows);
+  CHECK(calm.energy_rises == 0);
+  const double e0 = column(header, rows.front(), "total_energy");
+  CHECK(std::abs(column(header, rows.back(), "dissipated")) <= 1e-9 * e0);
+}
+
+TEST_CASE("inverted elements: counted per frame with the first reported, or the run stopped at the first") {
+  // a 2x2x6 column of 5 cm cubes on the ground, its lower half 10^6 times softer than the top
+  const std::string soft_column = R"({"materials": {"soft": {"young": 1e3, "density": 1000}, "stiff": {"young": 1e9, "density": 1000}},
+  "meshes": [{"type": "hex_grid", "cells": [2, 2, 6], "size": [0.1, 0.1, 0.3], "material": "stiff",
+              "regions": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 0.15]}, "material": "soft"}]}],
+  "fixed": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 0.001]}}],
+  "integrator": {"type": "implicit", "step": 0.001, "max_iterations": 10000)";
+  const std::string rest = R"(}, "duration": 0.5, "output": {"frames": 10, "vtu": false, "picture": {"enabled": false}}})";
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  const RunSummary s = run_text(soft_column + rest, "column", header, rows);
+  double most = 0;
+  for (const auto& r : rows) most = std::max(most, column(header, r, "inverted"));
+  MESSAGE("soft/stiff column: at most " << most << " of 24 hexahedra inverted in a frame; " << s.first_inversion);
+  CHECK(most > 0);
+  CHECK(static_cast<double>(s.inverted_max) == most);
+  CHECK(s.first_inversion.find("mesh cell") != std::string::npos);
+  CHECK(column(header, rows.front(), "inverted") == 0.0);
+  const fs::path scene = scratch("column_stop.json");
+  write(scene, soft_column + R"(, "stop_on_inversion": true)" + rest);
+  RunOptions opt;
+  opt.quiet = true;
+  opt.out = scratch("column_stop");
+  CHECK_THROWS_WITH(run(load_scene(scene.string()), opt), doctest::Contains("inverted at step"));
+}
+
+TEST_CASE("the clamp policy for elongated cells is announced with the number of cells it altered") {
+  const auto beam = [](const std::string& policy) {
+    return R"({"materials": {"m": {"young": 100e6, "density": 1000)" + policy + R"(}},
+  "meshes": [{"type": "hex_grid", "cells": [4, 2, 2], "size": [1.0, 0.1, 0.1], "material": "m"}],
+  "fixed": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [0.001, 1, 1]}}],
+  "duration": 0.002, "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})";
+  };
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  const RunSummary s = run_text(beam(R"(, "elongated": "clamp")"), "clamped", header, rows);
+  CHECK(s.clamped_cells == 16);  // 5:1 boxes: every cell
+  const RunSummary cubes = run_text(R"({"materials": {"m": {"young": 100e6, "density": 1000, "elongated": "clamp"}},
+  "meshes": [{"type": "hex_grid", "cells": [10, 1, 1], "size": [1.0, 0.1, 0.1], "material": "m"}],
+  "duration": 0.002, "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})", "cubes", header, rows);
+  CHECK(cubes.clamped_cells == 0);
+  expect_run_error<sewn::physics::InputError>(beam(""), "too elongated");
 }

@@ -70,6 +70,11 @@ struct RunSummary {
   double wall = 0;                  ///< s, stepping and cuts (output excluded)
   double ms_per_step = 0;
   double kinetic_start = 0, kinetic_end = 0, kinetic_max = 0;  ///< J
+  std::uint64_t energy_rises = 0;   ///< implicit steps that created energy (see physics::EnergyLedger)
+  std::string first_energy_rise;    ///< the warning printed for the first of them ("" if none)
+  std::uint64_t clamped_cells = 0;   ///< cells whose stiffness the `clamp` policy altered (a warning says so)
+  std::uint64_t inverted_max = 0;   ///< most inverted hexahedra and tetrahedra seen at once (frames, or steps if checked)
+  std::string first_inversion;      ///< the first inverted element seen, with step and time ("" if none)
   std::filesystem::path out, pvd, csv, picture;
 };
 
@@ -78,7 +83,8 @@ struct RunSummary {
 /// bound (exit 2: choose a smaller step), physics::BlowupError / SolverError / OutputError when
 /// the run fails (exit 1). Every output file is replaced whole (written aside and renamed), the
 /// .pvd lists only frames whose .vtu is complete, and nothing is written outside the output
-/// folder.
+/// folder. Throws std::runtime_error naming the element at the first inversion if the scene
+/// stops there (exit 1).
 RunSummary run(const Scene& scene, const RunOptions& options);
 
 }  // namespace sewn::app

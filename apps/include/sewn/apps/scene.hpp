@@ -62,6 +62,13 @@ struct FixSpec {
   std::array<bool, 3> axes{true, true, true};
 };
 
+/// Initial velocity of the free axes of the particles in `where` (at their rest positions x):
+/// v = linear + angular × (x − center), a uniform motion plus a rigid rotation.
+struct VelocitySpec {
+  Selector where;
+  Vec3 linear{0, 0, 0}, angular{0, 0, 0}, center{0, 0, 0};
+};
+
 struct CutSpec {
   std::string type;  // plane, faces, particles, pierce
   double time = 0;
@@ -79,6 +86,7 @@ struct Scene {
   std::map<std::string, MaterialSpec> materials;
   std::vector<MeshSpec> meshes;
   std::vector<FixSpec> fixed;
+  std::vector<VelocitySpec> velocities;  // later entries win
   Vec3 gravity{0, 0, -9.81};
   std::string damping = "viscous";
   double rayleigh_alpha = 0, rayleigh_beta = 0, environment_damping = 0;
@@ -89,6 +97,8 @@ struct Scene {
   double absolute_tolerance = physics::solve::default_absolute_tolerance;
   std::uint32_t max_iterations = physics::solve::default_max_iterations;
   bool allow_unstable = false;
+  double energy_rise_tolerance = 1e-4;  // relative, see physics::EnergyLedger
+  bool stop_on_inversion = false;       // check every step, stop at the first inverted element
   std::vector<CutSpec> cuts;
   std::uint32_t frames = 50;
   bool write_vtu = true, write_csv = true, write_picture = true;

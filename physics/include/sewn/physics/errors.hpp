@@ -2,6 +2,8 @@
 // Exceptions of sewn::physics. Every message names what is wrong and where (function, node,
 // spring, value).
 
+#include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -29,17 +31,24 @@ class StabilityError : public std::runtime_error {
 };
 
 /// The state became non-finite or the energy grew beyond its budget. `node()` names the node
-/// (invalid_index if none applies), `quantity()` the offending quantity ("position", ...).
+/// (invalid_index if none applies), `quantity()` the offending quantity ("position", ...);
+/// an energy blow-up also gives the integrator's step count and a step to retry with (NaN
+/// when the integrator has none to suggest).
 class BlowupError : public std::runtime_error {
  public:
-  BlowupError(const std::string& what, Index node, std::string quantity)
-      : std::runtime_error(what), node_(node), quantity_(std::move(quantity)) {}
+  BlowupError(const std::string& what, Index node, std::string quantity, std::uint64_t step = 0,
+              double suggested_step = std::numeric_limits<double>::quiet_NaN())
+      : std::runtime_error(what), node_(node), quantity_(std::move(quantity)), step_(step), suggested_(suggested_step) {}
   [[nodiscard]] Index node() const { return node_; }
   [[nodiscard]] const std::string& quantity() const { return quantity_; }
+  [[nodiscard]] std::uint64_t step() const { return step_; }
+  [[nodiscard]] double suggested_step() const { return suggested_; }
 
  private:
   Index node_;
   std::string quantity_;
+  std::uint64_t step_;
+  double suggested_;
 };
 
 /// A linear solve did not reach its tolerance (or broke down on a matrix that is not positive

@@ -7,9 +7,10 @@
 //                          (solve/linear_solver.hpp: block-Jacobi PCG, CHOLMOD, CHOLMOD-PCG).
 // Fixed axes keep their velocity (0 unless prescribed: kinematic). Both check the state
 // before using it: a non-finite position, velocity or force stops the step with a
-// BlowupError naming the node, leaving the state as it was; an energy watchdog stops runs
-// whose kinetic + internal energy outgrows what the initial state and external fields can
-// supply.
+// BlowupError naming the node, leaving the state as it was; an energy watchdog
+// (integrate/watchdog.hpp) stops runs whose kinetic + internal energy outgrows what the
+// initial state and external fields can supply, within a few steps of a divergence's start,
+// with the step, the fastest node and a step to retry with.
 
 #include <cstdint>
 #include <limits>
@@ -19,23 +20,10 @@
 #include "sewn/physics/aligned.hpp"
 #include "sewn/physics/cg.hpp"
 #include "sewn/physics/solve/linear_solver.hpp"
+#include "sewn/physics/integrate/watchdog.hpp"
 #include "sewn/physics/system.hpp"
 
 namespace sewn::physics {
-
-struct HealthOptions {
-  /// Check positions, velocities and forces for NaN/Inf every step (one pass over 9n values).
-  bool check_finite = true;
-  /// Steps between energy checks (0: never). Each check costs about one force evaluation.
-  int energy_check_interval = 100;
-  /// Blow-up when E_kin + E_internal > factor · (E_kin + E_internal at the baseline + work of
-  /// external fields since) + floor. Symplectic Euler's plain energy legitimately swings by
-  /// up to 1/(1 - hω/2) near the limit, hence the generous default.
-  double energy_growth_factor = 100.0;
-  /// floor = fraction · System::energy_scale() (springs: Σ ½kl²), so that round-off noise
-  /// around a rest state is not reported.
-  double energy_floor_fraction = 1e-6;
-};
 
 /// What a step did. Semi-implicit steps leave the solver fields at their defaults.
 struct StepReport {
@@ -45,23 +33,6 @@ struct StepReport {
   solve::SolveReport solve;           ///< the linear solve's full report (backend, factorizations, times)
   bool pattern_rebuilt = false;
   double stable_step = std::numeric_limits<double>::quiet_NaN();  ///< bound in force (semi-implicit)
-};
-
-/// The energy watchdog shared by the integrators. Its baseline is taken before the first
-/// step and again whenever System::version() changes (a cut or an edit may legitimately
-/// change the energy).
-class EnergyWatchdog {
- public:
-  /// Takes a baseline if there is none or the system changed. O(1), else O(elements).
-  void baseline_if_needed(const System& sys);
-  /// Throws BlowupError naming the fastest node if the energy outgrew its budget. O(elements).
-  void check(const System& sys, const HealthOptions& opt, std::uint64_t step) const;
-  void reset() { has_baseline_ = false; }
-
- private:
-  bool has_baseline_ = false;
-  double internal0_ = 0, external0_ = 0;
-  std::uint64_t version_ = 0;
 };
 
 struct SymplecticEulerOptions {

@@ -87,6 +87,7 @@ struct Element {
   std::uint32_t mesh_cell = 0;  ///< index of the source mesh cell
   Dart dart;                    ///< the dart starting at its local vertex 0 (to 1, or to the last vertex if reversed)
   bool reversed = false;        ///< a 2D cell the builder reversed to orient its surface
+  bool clamped = false;         ///< its negative Baudet edge stiffnesses were clamped to 0 (ElongatedPolicy::clamp)
   double measure = 0;           ///< rest volume, area × thickness, or length × area
   std::array<double, 12> edge_k{};  ///< stiffness contribution to each local edge (see local_edges())
   double diagonal_k = 0;            ///< stiffness of each internal diagonal (hexahedra, quads)

@@ -7,6 +7,8 @@
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/force_term.hpp"
 #include "sewn/physics/integrators.hpp"
+#include "sewn/physics/integrate/energy_ledger.hpp"
+#include "sewn/physics/integrate/implicit_midpoint.hpp"
 #include "sewn/physics/lattice.hpp"
 #include "sewn/physics/nodes.hpp"
 #include "sewn/physics/solve/linear_solver.hpp"

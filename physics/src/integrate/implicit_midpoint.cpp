@@ -1,0 +1,205 @@
+#include "sewn/physics/integrate/implicit_midpoint.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "sewn/physics/errors.hpp"
+#include "sewn/physics/springs.hpp"
+
+namespace sewn::physics {
+
+namespace {
+
+std::string fmt(double v) {
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+
+double norm2(std::span<const double> a) {
+  double s = 0;
+  for (double x : a) s += x * x;
+  return std::sqrt(s);
+}
+
+}  // namespace
+
+ImplicitMidpoint::ImplicitMidpoint(ImplicitMidpointOptions options) : opt_(options) {}
+
+CgResult ImplicitMidpoint::solve(const BlockMatrix& A, std::span<const double> b, std::span<double> x) {
+  block_jacobi_inverse(A, free_, precond_);
+  return filtered_pcg(A, b, x, free_, precond_, opt_.cg_tolerance, opt_.cg_max_iterations, ws_);
+}
+
+void ImplicitMidpoint::discrete_gradient(System& sys, double h) const {
+  NodeTable& nodes = sys.nodes();
+  const auto xm = nodes.x();  // the midpoint state
+  const auto f = nodes.f();
+  for (const auto& t : sys.terms()) {
+    const auto* springs = dynamic_cast<const Springs*>(t.get());
+    if (!springs) continue;
+    for (Index s = 0; s < springs->size(); ++s) {
+      if (!springs->is_alive(s)) continue;
+      const std::size_t i = 3 * std::size_t{springs->node_i(s)}, j = 3 * std::size_t{springs->node_j(s)};
+      const double k = springs->stiffness(s), l = springs->rest_length(s);
+      double dm2 = 0, d02 = 0, d12 = 0, e[3];
+      for (int a = 0; a < 3; ++a) {
+        e[a] = xm[j + a] - xm[i + a];
+        const double e0 = x0_[j + a] - x0_[i + a];
+        const double e1 = e0 + h * (v0_[j + a] - v0_[i + a] + 0.5 * (dv_[j + a] - dv_[i + a]));
+        dm2 += e[a] * e[a];
+        d02 += e0 * e0;
+        d12 += e1 * e1;
+      }
+      const double dm = std::sqrt(dm2), d0 = std::sqrt(d02), d1 = std::sqrt(d12);
+      if (!(dm > 0 && d0 + d1 > 0)) continue;  // a spring of zero length has no direction either way
+      // (ψ(d₁) − ψ(d₀)) / ((d₁² − d₀²)/2) for ψ = ½k(d − l)², minus the midpoint's own k(1 − l/d̄)
+      const double c = k * (1 - 2 * l / (d0 + d1)) - k * (1 - l / dm);
+      for (int a = 0; a < 3; ++a) {
+        f[i + a] += c * e[a];
+        f[j + a] -= c * e[a];
+      }
+    }
+  }
+}
+
+void ImplicitMidpoint::restore(NodeTable& nodes) const {
+  std::copy(x0_.begin(), x0_.end(), nodes.x().begin());
+  std::copy(v0_.begin(), v0_.end(), nodes.v().begin());
+}
+
+StepReport ImplicitMidpoint::step(System& sys, double h) {
+  if (!(std::isfinite(h) && h > 0)) throw InputError("ImplicitMidpoint::step: time step must be finite and > 0, got " + fmt(h));
+  if (!(opt_.newton_tolerance > 0 && opt_.cg_tolerance > 0 && opt_.max_newton_iterations >= 1 && opt_.cg_max_iterations >= 1))
+    throw InputError("ImplicitMidpoint::step: tolerances must be > 0 and iteration limits >= 1");
+  for (const auto& t : sys.terms())
+    if (!t->jacobian_symmetric(opt_.jacobian))
+      throw InputError("ImplicitMidpoint::step: term '" + std::string(t->name()) +
+                       "' gives a non-symmetric matrix with these JacobianOptions (set drop_viscous_position_terms = "
+                       "true); CG needs a symmetric matrix");
+  StepReport rep;
+  rep.pattern_rebuilt = sys.refresh();
+  NodeTable& nodes = sys.nodes();
+  const Index n = nodes.size();
+  const std::size_t n3 = 3 * std::size_t{n};
+  if (dv_.size() != n3) {
+    for (auto* a : {&x0_, &v0_, &dv_, &r_, &delta_, &free_}) a->assign(n3, 0.0);
+    precond_.assign(9 * std::size_t{n}, 0.0);
+  }
+  const bool watch = opt_.health.energy_check_interval > 0;
+  if (watch) watchdog_.baseline_if_needed(sys);
+  {
+    const auto x = nodes.x(), v = nodes.v();
+    std::copy(x.begin(), x.end(), x0_.begin());
+    std::copy(v.begin(), v.end(), v0_.begin());
+  }
+  const auto mass = nodes.masses();
+  const auto fixed = nodes.fixed_masks();
+  for (Index i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a) free_[3 * i + a] = ((fixed[i] >> a) & 1u) ? 0.0 : 1.0;
+  double momentum = 0;  // ‖M v₀‖₂, part of the residual's scale
+  for (std::size_t k = 0; k < n3; ++k) momentum += (mass[k / 3] * v0_[k]) * (mass[k / 3] * v0_[k]);
+  momentum = std::sqrt(momentum);
+  std::fill(dv_.begin(), dv_.end(), 0.0);
+
+  newton_iterations_ = 0;
+  double residual = 0, scale = 0;
+  for (;;) {
+    // 1) the midpoint state and the residual r = h F(x̄, v̄) − M Δv (0 on fixed axes)
+    {
+      const auto x = nodes.x(), v = nodes.v();
+      for (std::size_t k = 0; k < n3; ++k) {
+        x[k] = x0_[k] + 0.5 * h * v0_[k] + 0.25 * h * dv_[k];
+        v[k] = v0_[k] + 0.5 * dv_[k];
+      }
+    }
+    sys.compute_forces();
+    if (opt_.discrete_gradient_springs) discrete_gradient(sys, h);
+    const auto f = nodes.f();
+    double hf = 0, mdv = 0;
+    bool finite = true;
+    for (std::size_t k = 0; k < n3; ++k) {
+      const double m_dv = mass[k / 3] * dv_[k];
+      r_[k] = free_[k] * (h * f[k] - m_dv);
+      hf += h * h * f[k] * f[k];
+      mdv += m_dv * m_dv;
+      finite = finite && std::isfinite(r_[k]);
+    }
+    if (!finite) {
+      restore(nodes);
+      throw BlowupError("ImplicitMidpoint::step: non-finite forces at the midpoint state after " +
+                            std::to_string(newton_iterations_) + " Newton iterations (h = " + fmt(h) +
+                            " s); the state is unchanged",
+                        invalid_index, "force", steps_ + 1, h / 10);
+    }
+    const double previous = residual;
+    residual = norm2(r_);
+    scale = momentum + std::sqrt(mdv) + std::sqrt(hf);
+    if (residual <= opt_.newton_tolerance * scale) break;
+    // Round-off floor: the residual sums forces that each carry their own rounding, so below
+    // some level a Newton step no longer shrinks it. Accept that level if it is small.
+    if (newton_iterations_ > 0 && residual > 0.5 * previous && residual <= opt_.stagnation_tolerance * scale) break;
+    if (newton_iterations_ == opt_.max_newton_iterations) {
+      restore(nodes);
+      throw SolverError("ImplicitMidpoint::step: Newton stopped after " + std::to_string(newton_iterations_) +
+                            " iterations at residual " + fmt(residual) + " (" + fmt(residual / scale) +
+                            " of the momentum and impulse in play, tolerance " + fmt(opt_.newton_tolerance) +
+                            "); try a smaller step; the state is unchanged",
+                        newton_iterations_, residual / scale);
+    }
+    // 2) the Newton matrix M − (h²/4)∂F/∂x − (h/2)∂F/∂v at the midpoint, and δ
+    BlockMatrix& A = sys.matrix();
+    A.set_zero();
+    JacobianRequest req;
+    req.matrix = &A;
+    req.cx = -0.25 * h * h;
+    req.cv = -0.5 * h;
+    req.options = opt_.jacobian;
+    sys.add_jacobians(req);
+    for (Index i = 0; i < n; ++i) A.block(A.diagonal(i)).diagonal().array() += mass[i];
+    std::fill(delta_.begin(), delta_.end(), 0.0);
+    const CgResult cg = solve(A, r_, delta_);
+    rep.cg_iterations += cg.iterations;
+    rep.cg_relative_residual = cg.relative_residual;
+    if (!cg.converged) {
+      restore(nodes);
+      throw SolverError("ImplicitMidpoint::step: CG stopped after " + std::to_string(cg.iterations) +
+                            " iterations at relative residual " + fmt(cg.relative_residual) + " (tolerance " +
+                            fmt(opt_.cg_tolerance) + ") in Newton iteration " + std::to_string(newton_iterations_ + 1) +
+                            (cg.breakdown ? "; breakdown: the matrix is not positive definite" : "") +
+                            "; the state is unchanged",
+                        cg.iterations, cg.relative_residual);
+    }
+    for (std::size_t k = 0; k < n3; ++k) dv_[k] += delta_[k];
+    ++newton_iterations_;
+  }
+
+  // 3) v₁ = v₀ + Δv, x₁ = x₀ + h (v₀ + v₁)/2; the forces array keeps F(x̄, v̄)
+  double max_speed = 0;
+  bool finite = true;
+  {
+    const auto x = nodes.x(), v = nodes.v();
+    for (std::size_t k = 0; k < n3; ++k) {
+      v[k] = v0_[k] + dv_[k];
+      x[k] = x0_[k] + h * (v0_[k] + 0.5 * dv_[k]);
+      max_speed = std::max(max_speed, std::abs(v[k]));
+      finite = finite && std::isfinite(x[k]) && std::isfinite(v[k]);
+    }
+  }
+  if (finite) nodes.mark_state_finite();
+  rep.cg_converged = true;
+  ++steps_;
+  if (watch && finite)
+    if (auto blowup = watchdog_.after_step(sys, opt_.health, steps_, max_speed)) {
+      const double suggested = h / 10;
+      throw BlowupError("ImplicitMidpoint::step: " + blowup->message + " at h = " + fmt(h) + " s; suggested step " +
+                            fmt(suggested) + " s",
+                        blowup->node, "energy", steps_, suggested);
+    }
+  return rep;
+}
+
+}  // namespace sewn::physics
