@@ -74,7 +74,8 @@ double energy_density(TetLaw law, const Eigen::Matrix3d& F, const Lame& m) {
   }
   const SnhParams p = snh(m);
   const double J = F.determinant();
-  return 0.5 * m.mu * (F.squaredNorm() - 3.0) + 0.5 * p.lambda * (J - p.alpha) * (J - p.alpha);
+  // The constant ½λ'(1 - α)² is taken off so that the rest state has zero energy.
+  return 0.5 * m.mu * (F.squaredNorm() - 3.0) + 0.5 * p.lambda * ((J - p.alpha) * (J - p.alpha) - (1.0 - p.alpha) * (1.0 - p.alpha));
 }
 
 Eigen::Matrix3d first_piola(TetLaw law, const Eigen::Matrix3d& F, const Lame& m) {

@@ -9,7 +9,7 @@
 // Laws (Ψ per unit rest volume):
 //   stvk                Ψ = μ E:E + ½λ (tr E)², E = ½(FᵀF - I). Zero energy at a reflection
 //                       and softening past s = 1/√3 in compression (§3.3): not inversion-safe.
-//   stable_neo_hookean  Ψ = ½μ (tr FᵀF - 3) + ½λ' (J - α)², J = det F, λ' = λ + μ,
+//   stable_neo_hookean  Ψ = ½μ (tr FᵀF - 3) + ½λ' ((J - α)² - (1 - α)²), J = det F, λ' = λ + μ,
 //                       α = 1 + μ/λ' (Smith, de Goes, Kim 2018, the form without the log term):
 //                       stress-free at F = I, the same linearisation as StVK (Lamé μ, λ),
 //                       finite and smooth through J = 0, with positive energy at a reflection,
