@@ -16,6 +16,7 @@
 #include "sewn/io/read.hpp"
 #include "sewn/io/render.hpp"
 #include "sewn/io/write.hpp"
+#include "sewn/physics/integrate/newton_euler.hpp"
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/refine/cut.hpp"
@@ -335,7 +336,14 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   io_opt.cg_max_iterations = static_cast<int>(scene.max_iterations);
   physics::SymplecticEuler semi(so);
   physics::LinearlyImplicitEuler implicit(io_opt);
+  physics::integrate::NewtonEulerOptions no;
+  no.velocity_tolerance = scene.newton_tolerance;
+  no.max_iterations = static_cast<int>(scene.newton_iterations);
+  no.cg_tolerance = scene.tolerance;
+  no.cg_max_iterations = static_cast<int>(scene.max_iterations);
+  physics::integrate::NewtonEuler newton(no);
   const bool use_implicit = scene.integrator == "implicit";
+  const bool use_newton = scene.integrator == "newton";
   const bool bar = !options.quiet && options.progress && isatty(STDERR_FILENO);
   sum.kinetic_start = model->system().kinetic_energy();
   write_frame(0.0);
@@ -384,6 +392,8 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     int cg = 0;
     if (use_implicit)
       cg = implicit.step(model->system(), h).cg_iterations;
+    else if (use_newton)
+      cg = newton.step(model->system(), h).linear_iterations;
     else
       (void)semi.step(model->system(), h);
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();

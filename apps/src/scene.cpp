@@ -144,11 +144,13 @@ Field build_schema() {
   Field integrator = field("integrator", Kind::object);
   integrator.doc("Time integration.")
       .fallback(nlohmann::json::object())
-      .members({field("type", Kind::string).one_of({"implicit", "semi-implicit"}).fallback("implicit")
-                    .doc("Linearly implicit Euler (Baraff–Witkin, CG) or semi-implicit (symplectic) Euler."),
+      .members({field("type", Kind::string).one_of({"implicit", "semi-implicit", "newton"}).fallback("implicit")
+                    .doc("Linearly implicit Euler (Baraff–Witkin, CG), semi-implicit (symplectic) Euler, or backward Euler by Newton on the incremental potential (PSD-projected Hessians, CG solves, Armijo line search; docs/elastic.md)."),
                 field("step", Kind::number).unit("s").fallback(1e-3).above(0).at_most(10).doc("Time step h."),
                 field("tolerance", Kind::number).fallback(1e-6).above(0).below(1).doc("CG relative residual (implicit)."),
                 field("max_iterations", Kind::integer).fallback(2000).at_least(1).at_most(1000000).doc("CG iteration limit (implicit); reaching it is an error."),
+                field("newton_tolerance", Kind::number).unit("m/s").fallback(1e-6).above(0).doc("Newton stops when the largest update divided by h is below it (newton)."),
+                field("newton_iterations", Kind::integer).fallback(50).at_least(1).at_most(10000).doc("Newton iteration limit per step (newton); reaching it is an error."),
                 field("allow_unstable", Kind::boolean).fallback(false)
                     .doc("Run a semi-implicit step larger than the estimated stable bound (otherwise refused with the bound).")});
 
@@ -340,6 +342,8 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     s.step = in.number("step");
     s.tolerance = in.number("tolerance");
     s.max_iterations = static_cast<std::uint32_t>(in.integer("max_iterations"));
+    s.newton_tolerance = in.number("newton_tolerance");
+    s.newton_iterations = static_cast<std::uint32_t>(in.integer("newton_iterations"));
     s.allow_unstable = in.boolean("allow_unstable");
   }
   s.duration = r.number("duration");

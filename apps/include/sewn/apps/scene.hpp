@@ -85,6 +85,8 @@ struct Scene {
   double step = 1e-3, duration = 1;
   double tolerance = 1e-6;
   std::uint32_t max_iterations = 2000;
+  double newton_tolerance = 1e-6;  // m/s, integrator "newton"
+  std::uint32_t newton_iterations = 50;
   bool allow_unstable = false;
   std::vector<CutSpec> cuts;
   std::uint32_t frames = 50;
