@@ -18,6 +18,7 @@
 #include "sewn/io/write.hpp"
 #include "sewn/physics/integrate/newton_euler.hpp"
 #include "sewn/physics/integrators.hpp"
+#include "sewn/physics/solids/tets.hpp"
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/refine/cut.hpp"
 
@@ -218,6 +219,41 @@ Assembly assemble(const Scene& scene) {
   return a;
 }
 
+namespace {
+
+// Replaces the springs by finite-element tetrahedra on the same nodes (masses stay the lumped
+// ones the model computed).
+void use_solid_model(const Scene& scene, const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh,
+                     physics::MssModel<3>& model) {
+  if (!scene.cuts.empty()) throw SceneError(scene.file, "cuts", "cutting is not supported with model \"solid\" yet");
+  if (scene.damping == "viscous")
+    throw SceneError(scene.file, "damping.model", "\"viscous\" is per-spring damping, which model \"solid\" has none of: use \"rayleigh\" (alpha) or \"none\"");
+  if (scene.damping == "rayleigh" && scene.rayleigh_beta != 0.0)
+    throw SceneError(scene.file, "damping.beta", "stiffness-proportional damping acts on springs, which model \"solid\" has none of: use alpha");
+  physics::Springs& springs = model.springs();
+  for (Index s = 0; s < springs.size(); ++s)
+    if (springs.is_alive(s)) springs.remove(s);
+  auto& tets = model.system().add<physics::solids::Tets>(scene.law == "stvk" ? physics::solids::TetLaw::stvk
+                                                                                  : physics::solids::TetLaw::stable_neo_hookean);
+  for (const auto& el : model.elements()) {
+    if (!el.alive) continue;
+    const auto cell = mesh.cell(el.mesh_cell);
+    if (el.kind != physics::ElementKind::tetrahedron || cell.size() != 4)
+      throw SceneError(scene.file, "model.type", "\"solid\" needs tetrahedra only, but mesh cell " + std::to_string(el.mesh_cell) +
+                                                     " has " + std::to_string(cell.size()) + " points (use a tet_grid or a tetrahedral mesh file)");
+    std::array<Index, 4> nodes{};
+    physics::solids::TetPositions X;
+    for (int a = 0; a < 4; ++a) {
+      nodes[a] = model.node_of_point(cell[a]);
+      X.col(a) = model.rest_position(nodes[a]);
+    }
+    const auto& mat = materials[el.material];
+    tets.add(nodes, X, mat.young, mat.poisson);
+  }
+}
+
+}  // namespace
+
 RunSummary run(const Scene& scene, const RunOptions& options) {
   // 1) the bodies and the model
   const Assembly assembly = assemble(scene);
@@ -238,8 +274,10 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   mo.source = scene.file;
   auto model = std::make_unique<physics::MssModel<3>>(assembly.mesh, materials, assembly.material_of_cell, mo);
 
-  // 2) fixed particles
   const IndexedMesh& mesh = assembly.mesh;
+  if (scene.model == "solid") use_solid_model(scene, materials, mesh, *model);
+
+  // 2) fixed particles
   for (std::size_t k = 0; k < scene.fixed.size(); ++k) {
     const FixSpec& fix = scene.fixed[k];
     physics::AxisMask axes = 0;

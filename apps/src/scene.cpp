@@ -141,6 +141,14 @@ Field build_schema() {
                 field("beta", Kind::number).unit("s").fallback(0.0).at_least(0).doc("Rayleigh stiffness coefficient β."),
                 field("environment", Kind::number).unit("1/s").fallback(0.0).at_least(0).doc("Drag −c·m·v on every particle.")});
 
+  Field model = field("model", Kind::object);
+  model.doc("What the bodies' elasticity is made of (docs/elastic.md).")
+      .fallback(nlohmann::json::object())
+      .members({field("type", Kind::string).one_of({"mass-spring", "solid"}).fallback("mass-spring")
+                    .doc("`mass-spring`: the 2013 paper's springs on the map's edges; `solid`: finite-element tetrahedra (tetrahedral meshes only, no cuts yet; damping from `rayleigh` α or `environment`, as spring damping does not apply)."),
+                field("law", Kind::string).one_of({"stvk", "stable_neo_hookean"}).fallback("stable_neo_hookean")
+                    .doc("`solid`: St. Venant–Kirchhoff, or the inversion-safe stable neo-Hookean (Smith et al. 2018).")});
+
   Field integrator = field("integrator", Kind::object);
   integrator.doc("Time integration.")
       .fallback(nlohmann::json::object())
@@ -163,6 +171,7 @@ Field build_schema() {
       field("meshes", Kind::array).of(mesh).items(1, 1u << 16).required().doc("The bodies."),
       field("fixed", Kind::array).of(fix).fallback(nlohmann::json::array()).doc("Fixed particles."),
       field("gravity", Kind::vec3).unit("m/s²").fallback({0.0, 0.0, -9.81}).doc("Gravity."),
+      model,
       damping,
       integrator,
       field("duration", Kind::number).unit("s").fallback(1.0).above(0).at_most(1e6).doc("Simulated time."),
@@ -335,6 +344,11 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     s.rayleigh_alpha = d.number("alpha");
     s.rayleigh_beta = d.number("beta");
     s.environment_damping = d.number("environment");
+  }
+  {
+    Reader m(r["model"], *schema.member("model"));
+    s.model = m.string("type");
+    s.law = m.string("law");
   }
   {
     Reader in(r["integrator"], *schema.member("integrator"));

@@ -79,6 +79,7 @@ struct Scene {
   std::vector<MeshSpec> meshes;
   std::vector<FixSpec> fixed;
   Vec3 gravity{0, 0, -9.81};
+  std::string model = "mass-spring", law = "stable_neo_hookean";  // model.type, model.law
   std::string damping = "viscous";
   double rayleigh_alpha = 0, rayleigh_beta = 0, environment_damping = 0;
   std::string integrator = "implicit";
