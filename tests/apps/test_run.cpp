@@ -244,7 +244,7 @@ TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped b
                "meshes": [{"type": ")" + mesh_type + R"(", "material": "m", "cells": [4, 1, 1], "size": [0.4, 0.1, 0.1]}],
                "fixed": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [0.001, 1, 1]}}],
                "model": {"type": "solid", "law": "stvk"}, "damping": )" + damping + R"(,
-               "integrator": {"type": "newton", "step": 0.005}, "duration": 0.1, "output": {"frames": 2, "picture": {"width": 64, "height": 48}})" +
+               "integrator": {"type": "newton", "step": 0.005}, "duration": 0.1, "output": {"frames": 2, "picture": {"width": 200, "height": 150}})" +
            extra + "}";
   };
   const std::string rayleigh = R"({"model": "rayleigh", "alpha": 1.0})";
