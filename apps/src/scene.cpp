@@ -144,8 +144,8 @@ Field build_schema() {
   Field model = field("model", Kind::object);
   model.doc("What the bodies' elasticity is made of (docs/elastic.md).")
       .fallback(nlohmann::json::object())
-      .members({field("type", Kind::string).one_of({"mass-spring", "solid"}).fallback("mass-spring")
-                    .doc("`mass-spring`: the 2013 paper's springs on the map's edges; `solid`: finite-element tetrahedra (tetrahedral meshes only, no cuts yet; damping from `rayleigh` α or `environment`, as spring damping does not apply)."),
+      .members({field("type", Kind::string).one_of({"mass-spring", "solid", "shell"}).fallback("mass-spring")
+                    .doc("`mass-spring`: the 2013 paper's springs on the map's edges; `solid`: finite-element tetrahedra (tetrahedral meshes only); `shell`: CST membranes with Green strain plus hinge bending with k_B = D/6 on the interior edges, thickness from the material (triangle meshes only). `solid` and `shell` take no cuts yet, and their damping comes from `rayleigh` α or `environment`, as spring damping does not apply."),
                 field("law", Kind::string).one_of({"stvk", "stable_neo_hookean"}).fallback("stable_neo_hookean")
                     .doc("`solid`: St. Venant–Kirchhoff, or the inversion-safe stable neo-Hookean (Smith et al. 2018).")});
 

@@ -270,6 +270,28 @@ TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped b
   SUBCASE("hexahedra") {
     expect_run_error<SceneError>(scene("hex_grid", rayleigh, ""), "needs tetrahedra only");
   }
+  SUBCASE("shell: membranes and hinges on a triangle mesh; a volume mesh is refused") {
+    std::string text = scene("tri_grid", rayleigh, "");
+    text.replace(text.find(R"("solid", "law": "stvk")"), 22, R"("shell")");
+    text.replace(text.find(R"("cells": [4, 1, 1], "size": [0.4, 0.1, 0.1])"), 43, R"("cells": [4, 1], "size": [0.4, 0.1])");
+    const fs::path file = scratch("shell.json");
+    write(file, text);
+    RunOptions opt;
+    opt.quiet = true;
+    opt.out = scratch("shell_out");
+    const RunSummary sum = run(load_scene(file.string()), opt);
+    std::vector<std::string> header;
+    const auto rows = read_csv(sum.csv, header);
+    const auto col = [&](const std::string& name) {
+      return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+    };
+    CHECK(rows.back()[col("springs")] == 0.0);
+    CHECK(rows.back()[col("elements")] == 8.0);
+    CHECK(rows.back()[col("elastic_energy")] > 0.0);
+    std::string hex = scene("tet_grid", rayleigh, "");
+    hex.replace(hex.find(R"("solid", "law": "stvk")"), 22, R"("shell")");
+    expect_run_error<SceneError>(hex, "needs triangles only");
+  }
   SUBCASE("per-spring damping") {
     expect_run_error<SceneError>(scene("tet_grid", R"({"model": "viscous"})", ""), "per-spring damping");
   }

@@ -38,6 +38,15 @@ Index Hinges::add(const std::array<Index, 4>& nodes, const HingePositions& X, do
 
 Index Hinges::add_interior_edges(std::span<const std::array<Index, 3>> triangles, std::span<const double> rest_x,
                                  double k_b) {
+  const std::vector<double> each(triangles.size(), k_b);
+  return add_interior_edges(triangles, rest_x, each);
+}
+
+Index Hinges::add_interior_edges(std::span<const std::array<Index, 3>> triangles, std::span<const double> rest_x,
+                                 std::span<const double> k_b_of_triangle) {
+  if (k_b_of_triangle.size() != triangles.size())
+    throw InputError("hinges: " + std::to_string(k_b_of_triangle.size()) + " stiffnesses for " +
+                     std::to_string(triangles.size()) + " triangles");
   // 1) every directed edge (from, to) with its triangle and opposite node, keyed by the
   //    undirected edge;
   struct Half {
@@ -73,7 +82,7 @@ Index Hinges::add_interior_edges(std::span<const std::array<Index, 3>> triangles
       HingePositions X;
       for (int c = 0; c < 4; ++c)
         for (int a = 0; a < 3; ++a) X(a, c) = rest_x[3 * std::size_t{nodes[c]} + a];
-      add(nodes, X, k_b);
+      add(nodes, X, 0.5 * (k_b_of_triangle[A.tri] + k_b_of_triangle[B.tri]));
       ++added;
     }
     i = j;

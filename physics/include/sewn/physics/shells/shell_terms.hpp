@@ -57,6 +57,10 @@ class Hinges final : public elements::StencilTerm<4> {
   /// O(T log T).
   Index add_interior_edges(std::span<const std::array<Index, 3>> triangles, std::span<const double> rest_x,
                            double k_b);
+  /// The same with a stiffness per triangle: a hinge gets the mean of its two triangles' k_b
+  /// (k_b_of_triangle.size() must equal triangles.size(), else InputError).
+  Index add_interior_edges(std::span<const std::array<Index, 3>> triangles, std::span<const double> rest_x,
+                           std::span<const double> k_b_of_triangle);
   [[nodiscard]] const HingeRest& rest(Index e) const { return rest_[e]; }
   [[nodiscard]] double stiffness(Index e) const { return k_[e]; }
 
