@@ -58,7 +58,13 @@ TetRest tet_rest(const TetPositions& X) {
     s << "tetrahedron: degenerate rest shape (volume " << volume << " m^3 for a longest edge of " << longest << " m)";
     throw InputError(s.str());
   }
-  return {Dm.inverse(), volume};
+  return {Dm, Dm.inverse(), volume};
+}
+
+Eigen::Matrix3d displacement_gradient(const TetPositions& x, const TetRest& rest) {
+  Eigen::Matrix3d dD;
+  for (int j = 0; j < 3; ++j) dD.col(j) = (x.col(j + 1) - x.col(0)) - rest.Dm.col(j);
+  return dD * rest.Dm_inv;
 }
 
 Eigen::Matrix3d deformation_gradient(const TetPositions& x, const TetRest& rest) {
@@ -67,15 +73,19 @@ Eigen::Matrix3d deformation_gradient(const TetPositions& x, const TetRest& rest)
   return Ds * rest.Dm_inv;
 }
 
-double energy_density(TetLaw law, const Eigen::Matrix3d& F, const Lame& m) {
+double energy_density(TetLaw law, const Eigen::Matrix3d& H, const Lame& m) {
+  // Every quantity below is formed from H = F - I, never as a difference of O(1) terms.
   if (law == TetLaw::stvk) {
-    const Eigen::Matrix3d E = 0.5 * (F.transpose() * F - Eigen::Matrix3d::Identity());
+    const Eigen::Matrix3d E = 0.5 * (H + H.transpose() + H.transpose() * H);
     return m.mu * E.squaredNorm() + 0.5 * m.lambda * E.trace() * E.trace();
   }
+  // ½μ(tr FᵀF - 3) + ½λ'((J - α)² - (1 - α)²), the constant taken off so that the rest
+  // state has zero energy, rewritten as ½μ(|H|² + 2 tr H) + ½λ'(J - 1)² - μ(J - 1) with
+  // J - 1 = tr H + ½((tr H)² - tr H²) + det H.
   const SnhParams p = snh(m);
-  const double J = F.determinant();
-  // The constant ½λ'(1 - α)² is taken off so that the rest state has zero energy.
-  return 0.5 * m.mu * (F.squaredNorm() - 3.0) + 0.5 * p.lambda * ((J - p.alpha) * (J - p.alpha) - (1.0 - p.alpha) * (1.0 - p.alpha));
+  const double t = H.trace();
+  const double j1 = t + 0.5 * (t * t - (H * H).trace()) + H.determinant();
+  return 0.5 * m.mu * (H.squaredNorm() + 2.0 * t) + 0.5 * p.lambda * j1 * j1 - m.mu * j1;
 }
 
 Eigen::Matrix3d first_piola(TetLaw law, const Eigen::Matrix3d& F, const Lame& m) {
@@ -120,7 +130,7 @@ elements::Mat<9> piola_derivative(TetLaw law, const Eigen::Matrix3d& F, const La
 }
 
 double tet_energy(TetLaw law, const TetPositions& x, const TetRest& rest, const Lame& m) {
-  return rest.volume * energy_density(law, deformation_gradient(x, rest), m);
+  return rest.volume * energy_density(law, displacement_gradient(x, rest), m);
 }
 
 Vec12 tet_gradient(TetLaw law, const TetPositions& x, const TetRest& rest, const Lame& m) {

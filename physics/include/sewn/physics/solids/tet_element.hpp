@@ -38,6 +38,7 @@ struct Lame {
 
 /// Rest data of one tetrahedron.
 struct TetRest {
+  Eigen::Matrix3d Dm = Eigen::Matrix3d::Identity();  ///< rest edges [X1-X0, X2-X0, X3-X0]
   Eigen::Matrix3d Dm_inv = Eigen::Matrix3d::Identity();
   double volume = 0.0;  ///< V̄ = |det Dm| / 6
 };
@@ -50,10 +51,14 @@ enum class TetLaw { stvk, stable_neo_hookean };
 
 /// Current deformation gradient F = Ds·Dm⁻¹. O(1).
 [[nodiscard]] Eigen::Matrix3d deformation_gradient(const TetPositions& x, const TetRest& rest);
+/// H = F - I computed as (Ds - Dm)·Dm⁻¹, free of the cancellation in F - I: energies are
+/// evaluated from it, so that a stiff element's energy carries round-off of the size of its
+/// strain, not of its modulus (Newton's line search compares energies). O(1).
+[[nodiscard]] Eigen::Matrix3d displacement_gradient(const TetPositions& x, const TetRest& rest);
 
-/// Ψ(F), first Piola stress P = ∂Ψ/∂F and its derivative ∂vec(P)/∂vec(F) (9×9, vec
-/// column-major) for a law.
-[[nodiscard]] double energy_density(TetLaw law, const Eigen::Matrix3d& F, const Lame& m);
+/// Ψ, first Piola stress P = ∂Ψ/∂F and its derivative ∂vec(P)/∂vec(F) (9×9, vec
+/// column-major) for a law. energy_density takes the displacement gradient H = F - I.
+[[nodiscard]] double energy_density(TetLaw law, const Eigen::Matrix3d& H, const Lame& m);
 [[nodiscard]] Eigen::Matrix3d first_piola(TetLaw law, const Eigen::Matrix3d& F, const Lame& m);
 [[nodiscard]] elements::Mat<9> piola_derivative(TetLaw law, const Eigen::Matrix3d& F, const Lame& m);
 
