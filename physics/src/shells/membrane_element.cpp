@@ -12,8 +12,6 @@ namespace sewn::physics::shells {
 
 namespace {
 using Mat32 = Eigen::Matrix<double, 3, 2>;
-
-Eigen::Matrix2d green_strain(const Mat32& F) { return 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity()); }
 }  // namespace
 
 MembraneMaterial membrane_material(double young, double poisson, double thickness) {
@@ -41,7 +39,19 @@ TriRest tri_rest(const TriPositions& X) {
   const Eigen::Vector3d e2 = n.cross(a).normalized();
   Eigen::Matrix2d Dm;
   Dm << a.dot(e1), b.dot(e1), 0.0, b.dot(e2);
-  return {Dm.inverse(), area};
+  Mat32 edges;
+  edges.col(0) = a;
+  edges.col(1) = b;
+  return {edges, Dm.inverse(), area};
+}
+
+Eigen::Matrix2d membrane_strain(const TriPositions& x, const TriRest& rest) {
+  Mat32 U;
+  U.col(0) = (x.col(1) - x.col(0)) - rest.edges.col(0);
+  U.col(1) = (x.col(2) - x.col(0)) - rest.edges.col(1);
+  const Eigen::Matrix2d UX = U.transpose() * rest.edges;
+  const Eigen::Matrix2d dG = UX + UX.transpose() + U.transpose() * U;
+  return 0.5 * rest.Dm_inv.transpose() * dG * rest.Dm_inv;
 }
 
 Mat32 membrane_deformation(const TriPositions& x, const TriRest& rest) {
@@ -52,13 +62,13 @@ Mat32 membrane_deformation(const TriPositions& x, const TriRest& rest) {
 }
 
 double membrane_energy(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m) {
-  const Eigen::Matrix2d E = green_strain(membrane_deformation(x, rest));
+  const Eigen::Matrix2d E = membrane_strain(x, rest);
   return m.thickness * rest.area * (m.mu * E.squaredNorm() + 0.5 * m.lambda_ps * E.trace() * E.trace());
 }
 
 Vec9 membrane_gradient(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m) {
   const Mat32 F = membrane_deformation(x, rest);
-  const Eigen::Matrix2d E = green_strain(F);
+  const Eigen::Matrix2d E = membrane_strain(x, rest);
   const Eigen::Matrix2d S = 2.0 * m.mu * E + m.lambda_ps * E.trace() * Eigen::Matrix2d::Identity();
   const Mat32 H = m.thickness * rest.area * F * S * rest.Dm_inv.transpose();
   Vec9 g;
@@ -71,7 +81,7 @@ Vec9 membrane_gradient(const TriPositions& x, const TriRest& rest, const Membran
 Mat9 membrane_hessian(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m) {
   const Mat32 F = membrane_deformation(x, rest);
   const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
-  const Eigen::Matrix2d E = green_strain(F);
+  const Eigen::Matrix2d E = membrane_strain(x, rest);
   const Eigen::Matrix2d S = 2.0 * m.mu * E + m.lambda_ps * E.trace() * I;
   // ∂vec(P)/∂vec(F), one column per unit dF: dP = dF·S + F(2μ dE + λ_ps tr(dE) I).
   elements::Mat<6> D;

@@ -30,6 +30,7 @@ struct MembraneMaterial {
 [[nodiscard]] MembraneMaterial membrane_material(double young, double poisson, double thickness);
 
 struct TriRest {
+  Eigen::Matrix<double, 3, 2> edges = Eigen::Matrix<double, 3, 2>::Zero();  ///< rest [X1-X0, X2-X0]
   Eigen::Matrix2d Dm_inv = Eigen::Matrix2d::Identity();
   double area = 0.0;  ///< Ā
 };
@@ -39,6 +40,11 @@ struct TriRest {
 
 /// F (3×2) of the current positions.
 [[nodiscard]] Eigen::Matrix<double, 3, 2> membrane_deformation(const TriPositions& x, const TriRest& rest);
+
+/// Green strain E = ½ Dm⁻ᵀ(UᵀX + XᵀU + UᵀU)Dm⁻¹, U = Ds - X the change of the edges X: free
+/// of the cancellation in FᵀF - I, so that a stiff membrane's energy carries round-off of the
+/// size of its strain (Newton's line search compares energies).
+[[nodiscard]] Eigen::Matrix2d membrane_strain(const TriPositions& x, const TriRest& rest);
 
 [[nodiscard]] double membrane_energy(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m);
 [[nodiscard]] Vec9 membrane_gradient(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m);
