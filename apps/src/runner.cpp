@@ -24,7 +24,10 @@
 #include "sewn/io/write.hpp"
 #include "sewn/physics/integrate/energy_ledger.hpp"
 #include "sewn/physics/integrate/implicit_midpoint.hpp"
+#include "sewn/physics/integrate/newton_euler.hpp"
 #include "sewn/physics/integrators.hpp"
+#include "sewn/physics/shells/shell_terms.hpp"
+#include "sewn/physics/solids/tets.hpp"
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/solids/inversion.hpp"
 #include "sewn/refine/cut.hpp"
@@ -296,6 +299,83 @@ Assembly assemble(const Scene& scene) {
   return a;
 }
 
+namespace {
+
+// Replaces the springs by finite-element tetrahedra on the same nodes (masses stay the lumped
+// ones the model computed).
+// Checks what a continuum model cannot take and removes the springs it replaces.
+void drop_springs(const Scene& scene, physics::MssModel<3>& model) {
+  const std::string m = "model \"" + scene.model + "\"";
+  if (!scene.cuts.empty()) throw SceneError(scene.file, "cuts", "cutting is not supported with " + m + " yet");
+  if (scene.damping == "viscous")
+    throw SceneError(scene.file, "damping.model", "\"viscous\" is per-spring damping, which " + m + " has none of: use \"rayleigh\" (alpha) or \"none\"");
+  if (scene.damping == "rayleigh" && scene.rayleigh_beta != 0.0)
+    throw SceneError(scene.file, "damping.beta", "stiffness-proportional damping acts on springs, which " + m + " has none of: use alpha");
+  physics::Springs& springs = model.springs();
+  for (Index s = 0; s < springs.size(); ++s)
+    if (springs.is_alive(s)) springs.remove(s);
+}
+
+// Replaces the springs by membrane triangles and hinges on the interior edges.
+void use_shell_model(const Scene& scene, const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh,
+                     physics::MssModel<3>& model) {
+  drop_springs(scene, model);
+  auto& membranes = model.system().add<physics::shells::Membranes>();
+  std::vector<std::array<Index, 3>> triangles;
+  std::vector<double> k_b;
+  for (const auto& el : model.elements()) {
+    if (!el.alive) continue;
+    const auto cell = mesh.cell(el.mesh_cell);
+    if (el.kind != physics::ElementKind::triangle || cell.size() != 3)
+      throw SceneError(scene.file, "model.type", "\"shell\" needs triangles only, but mesh cell " + std::to_string(el.mesh_cell) +
+                                                     " has " + std::to_string(cell.size()) + " points (use a tri_grid or a triangle mesh file)");
+    std::array<Index, 3> nodes{};
+    physics::shells::TriPositions X;
+    for (int a = 0; a < 3; ++a) {
+      nodes[a] = model.node_of_point(cell[a]);
+      X.col(a) = model.rest_position(nodes[a]);
+    }
+    const auto& mat = materials[el.material];
+    membranes.add(nodes, X, mat.young, mat.poisson, mat.thickness);
+    triangles.push_back(nodes);
+    k_b.push_back(physics::shells::hinge_stiffness(mat.young, mat.poisson, mat.thickness));
+  }
+  std::vector<double> rest_x;
+  for (Index i = 0; i < model.nodes().size(); ++i) {
+    const Vec3d p = model.rest_position(i);
+    rest_x.insert(rest_x.end(), {p.x(), p.y(), p.z()});
+  }
+  try {
+    model.system().add<physics::shells::Hinges>().add_interior_edges(triangles, rest_x, k_b);
+  } catch (const physics::InputError& e) {
+    throw SceneError(scene.file, "meshes", e.what());
+  }
+}
+
+void use_solid_model(const Scene& scene, const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh,
+                     physics::MssModel<3>& model) {
+  drop_springs(scene, model);
+  auto& tets = model.system().add<physics::solids::Tets>(scene.law == "stvk" ? physics::solids::TetLaw::stvk
+                                                                                  : physics::solids::TetLaw::stable_neo_hookean);
+  for (const auto& el : model.elements()) {
+    if (!el.alive) continue;
+    const auto cell = mesh.cell(el.mesh_cell);
+    if (el.kind != physics::ElementKind::tetrahedron || cell.size() != 4)
+      throw SceneError(scene.file, "model.type", "\"solid\" needs tetrahedra only, but mesh cell " + std::to_string(el.mesh_cell) +
+                                                     " has " + std::to_string(cell.size()) + " points (use a tet_grid or a tetrahedral mesh file)");
+    std::array<Index, 4> nodes{};
+    physics::solids::TetPositions X;
+    for (int a = 0; a < 4; ++a) {
+      nodes[a] = model.node_of_point(cell[a]);
+      X.col(a) = model.rest_position(nodes[a]);
+    }
+    const auto& mat = materials[el.material];
+    tets.add(nodes, X, mat.young, mat.poisson);
+  }
+}
+
+}  // namespace
+
 RunSummary run(const Scene& scene, const RunOptions& options) {
   RunSummary sum;
   sum.out = options.out.empty() ? std::filesystem::path("out") / scene.name : options.out;
@@ -333,6 +413,10 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
 
   // 2) fixed particles, then initial velocities of the free axes
   const IndexedMesh& mesh = assembly.mesh;
+  if (scene.model == "solid") use_solid_model(scene, materials, mesh, *model);
+  if (scene.model == "shell") use_shell_model(scene, materials, mesh, *model);
+
+  // 2) fixed particles
   for (std::size_t k = 0; k < scene.fixed.size(); ++k) {
     const FixSpec& fix = scene.fixed[k];
     physics::AxisMask axes = 0;
@@ -462,6 +546,13 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   physics::ImplicitMidpoint midpoint(mid_opt);
   const bool use_midpoint = scene.integrator == "midpoint";
   const bool use_implicit = scene.integrator == "implicit" || use_midpoint;
+  physics::integrate::NewtonEulerOptions no;
+  no.velocity_tolerance = scene.newton_tolerance;
+  no.max_iterations = static_cast<int>(scene.newton_iterations);
+  no.cg_tolerance = scene.tolerance;
+  no.cg_max_iterations = static_cast<int>(scene.max_iterations);
+  physics::integrate::NewtonEuler newton(no);
+  const bool use_newton = scene.integrator == "newton";
   const bool bar = !options.quiet && options.progress && isatty(STDERR_FILENO);
   sum.kinetic_start = model->system().kinetic_energy();
   write_frame(0.0);
@@ -513,6 +604,8 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
       cg = midpoint.step(model->system(), h).cg_iterations;
     else if (use_implicit)
       cg = implicit.step(model->system(), h).cg_iterations;
+    else if (use_newton)
+      cg = newton.step(model->system(), h).linear_iterations;
     else
       step_semi_implicit(semi, model->system(), h, t, scene);
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();

@@ -172,11 +172,19 @@ Field build_schema() {
                 field("beta", Kind::number).unit("s").fallback(0.0).at_least(0).doc("Rayleigh stiffness coefficient β."),
                 field("environment", Kind::number).unit("1/s").fallback(0.0).at_least(0).at_most(1e6).doc("Drag −c·m·v on every particle.")});
 
+  Field model = field("model", Kind::object);
+  model.doc("What the bodies' elasticity is made of (docs/elastic.md).")
+      .fallback(nlohmann::json::object())
+      .members({field("type", Kind::string).one_of({"mass-spring", "solid", "shell"}).fallback("mass-spring")
+                    .doc("`mass-spring`: the 2013 paper's springs on the map's edges; `solid`: finite-element tetrahedra (tetrahedral meshes only); `shell`: CST membranes with Green strain plus hinge bending with k_B = D/6 on the interior edges, thickness from the material (triangle meshes only). `solid` and `shell` take no cuts yet, and their damping comes from `rayleigh` α or `environment`, as spring damping does not apply."),
+                field("law", Kind::string).one_of({"stvk", "stable_neo_hookean"}).fallback("stable_neo_hookean")
+                    .doc("`solid`: St. Venant–Kirchhoff, or the inversion-safe stable neo-Hookean (Smith et al. 2018).")});
+
   Field integrator = field("integrator", Kind::object);
   integrator.doc("Time integration.")
       .fallback(nlohmann::json::object())
-      .members({field("type", Kind::string).one_of({"implicit", "semi-implicit", "midpoint"}).fallback("implicit")
-                    .doc("Linearly implicit Euler (Baraff–Witkin, CG: one solve per step, dissipative, loses angular momentum on fast rotations), semi-implicit (symplectic) Euler (explicit: below the stable step only), or the implicit midpoint rule with discrete-gradient springs solved by Newton and CG (keeps linear and angular momentum and the energy of free bodies to round-off at any step it converges at; several solves per step). See docs/integrators.md."),
+      .members({field("type", Kind::string).one_of({"implicit", "semi-implicit", "midpoint", "newton"}).fallback("implicit")
+                    .doc("Linearly implicit Euler (Baraff–Witkin, CG: one solve per step, dissipative, loses angular momentum on fast rotations), semi-implicit (symplectic) Euler (explicit: below the stable step only), or the implicit midpoint rule with discrete-gradient springs solved by Newton and CG (keeps linear and angular momentum and the energy of free bodies to round-off at any step it converges at; several solves per step), or backward Euler by Newton on the incremental potential (PSD-projected Hessians, CG solves, Armijo line search; docs/elastic.md). See docs/integrators.md."),
                 field("step", Kind::number).unit("s").fallback(1e-3).above(0).at_most(10).doc("Time step h."),
                 field("solver", Kind::string).one_of({"auto", "jacobi", "cholmod", "cholmod-pcg"}).fallback("auto")
                     .doc("Linear solver (implicit), docs/solvers.md: `jacobi` block-Jacobi CG, `cholmod` sparse Cholesky, `cholmod-pcg` CG preconditioned by a reused Cholesky factorization; `auto` picks by model size. The CHOLMOD ones need SuiteSparse at build time."),
@@ -184,6 +192,8 @@ Field build_schema() {
                 field("absolute_tolerance", Kind::number).unit("m/s").fallback(physics::solve::default_absolute_tolerance).at_least(0).at_most(1)
                     .doc("Floor of the residual as a velocity error on every free axis (implicit): a body at rest stops there instead of chasing round-off. 0: none."),
                 field("max_iterations", Kind::integer).fallback(physics::solve::default_max_iterations).at_least(1).at_most(1000000).doc("Iteration limit of the iterative solvers (implicit); reaching it is an error."),
+                field("newton_tolerance", Kind::number).unit("m/s").fallback(1e-6).above(0).doc("Newton stops when the largest update divided by h is below it (newton)."),
+                field("newton_iterations", Kind::integer).fallback(50).at_least(1).at_most(10000).doc("Newton iteration limit per step (newton); reaching it is an error."),
                 field("allow_unstable", Kind::boolean).fallback(false)
                     .doc("Run a semi-implicit step larger than the estimated stable bound (otherwise refused with the bound)."),
                 field("energy_rise_tolerance", Kind::number).fallback(1e-4).above(0).below(1)
@@ -210,6 +220,7 @@ Field build_schema() {
       field("velocities", Kind::array).of(velocity).fallback(nlohmann::json::array()).doc("Initial velocities (default: at rest)."),
       field("gravity", Kind::vec3).unit("m/s²").fallback({0.0, 0.0, -9.81}).at_least(-1e6).at_most(1e6)
           .doc("Gravity (each component within ±10⁶ m/s², 10⁵ g: beyond, the forces overflow the solver)."),
+      model,
       damping,
       integrator,
       field("duration", Kind::number).unit("s").fallback(1.0).above(0).at_most(1e6).doc("Simulated time."),
@@ -490,6 +501,11 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     s.environment_damping = d.number("environment");
   }
   {
+    Reader m(r["model"], *schema.member("model"));
+    s.model = m.string("type");
+    s.law = m.string("law");
+  }
+  {
     Reader in(r["integrator"], *schema.member("integrator"));
     s.integrator = in.string("type");
     s.step = in.number("step");
@@ -502,6 +518,8 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     s.tolerance = in.number("tolerance");
     s.absolute_tolerance = in.number("absolute_tolerance");
     s.max_iterations = static_cast<std::uint32_t>(in.integer("max_iterations"));
+    s.newton_tolerance = in.number("newton_tolerance");
+    s.newton_iterations = static_cast<std::uint32_t>(in.integer("newton_iterations"));
     s.allow_unstable = in.boolean("allow_unstable");
     s.energy_rise_tolerance = in.number("energy_rise_tolerance");
     s.stop_on_inversion = in.boolean("stop_on_inversion");

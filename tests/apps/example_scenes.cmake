@@ -20,6 +20,9 @@ set(expect_table1_hex            "8;1")     # the paper's timing set-ups: no cut
 set(expect_table1_tets           "8;5")
 set(expect_sofa_8x8x10           "891;640")
 set(expect_tet_beam_5x7x9        "480;1890")
+set(expect_newton_cantilever     "189;80")   # backward Euler by Newton on the mass-spring beam
+set(expect_solid_cantilever      "189;480")  # the same beam as finite-element tetrahedra
+set(expect_shell_plate           "85;128")   # membranes and hinges on 16x4x2 triangles
 
 foreach(v SEWN SCENES WORK)
   if(NOT DEFINED ${v})

@@ -2,6 +2,7 @@
 // input, each with its exact error class (in process) and a non-zero exit (the binary).
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -367,4 +368,68 @@ TEST_CASE("the clamp policy for elongated cells is announced with the number of 
   "duration": 0.002, "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})", "cubes", header, rows);
   CHECK(cubes.clamped_cells == 0);
   expect_run_error<sewn::physics::InputError>(beam(""), "too elongated");
+}
+
+TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped by Newton; misuse is named") {
+  auto scene = [](const std::string& mesh_type, const std::string& damping, const std::string& extra) {
+    return R"({"materials": {"m": {"young": 1e6, "poisson": 0.3, "density": 1000}},
+               "meshes": [{"type": ")" + mesh_type + R"(", "material": "m", "cells": [4, 1, 1], "size": [0.4, 0.1, 0.1]}],
+               "fixed": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [0.001, 1, 1]}}],
+               "model": {"type": "solid", "law": "stvk"}, "damping": )" + damping + R"(,
+               "integrator": {"type": "newton", "step": 0.005}, "duration": 0.1, "output": {"frames": 2, "picture": {"width": 200, "height": 150}})" +
+           extra + "}";
+  };
+  const std::string rayleigh = R"({"model": "rayleigh", "alpha": 1.0})";
+  SUBCASE("runs, with no spring left and elastic energy from the tetrahedra") {
+    const fs::path file = scratch("solid.json");
+    write(file, scene("tet_grid", rayleigh, ""));
+    RunOptions opt;
+    opt.quiet = true;
+    opt.out = scratch("solid_out");
+    const RunSummary sum = run(load_scene(file.string()), opt);
+    CHECK(sum.steps == 20);
+    std::vector<std::string> header;
+    const auto rows = read_csv(sum.csv, header);
+    const auto col = [&](const std::string& name) {
+      return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+    };
+    REQUIRE(col("elastic_energy") < header.size());
+    CHECK(rows.back()[col("springs")] == 0.0);
+    CHECK(rows.back()[col("elements")] == 24.0);
+    CHECK(rows.back()[col("elastic_energy")] > 0.0);
+    CHECK(std::isfinite(rows.back()[col("kinetic_energy")]));
+  }
+  SUBCASE("hexahedra") {
+    expect_run_error<SceneError>(scene("hex_grid", rayleigh, ""), "needs tetrahedra only");
+  }
+  SUBCASE("shell: membranes and hinges on a triangle mesh; a volume mesh is refused") {
+    std::string text = scene("tri_grid", rayleigh, "");
+    text.replace(text.find(R"("solid", "law": "stvk")"), 22, R"("shell")");
+    text.replace(text.find(R"("cells": [4, 1, 1], "size": [0.4, 0.1, 0.1])"), 43, R"("cells": [4, 1], "size": [0.4, 0.1])");
+    const fs::path file = scratch("shell.json");
+    write(file, text);
+    RunOptions opt;
+    opt.quiet = true;
+    opt.out = scratch("shell_out");
+    const RunSummary sum = run(load_scene(file.string()), opt);
+    std::vector<std::string> header;
+    const auto rows = read_csv(sum.csv, header);
+    const auto col = [&](const std::string& name) {
+      return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+    };
+    CHECK(rows.back()[col("springs")] == 0.0);
+    CHECK(rows.back()[col("elements")] == 8.0);
+    CHECK(rows.back()[col("elastic_energy")] > 0.0);
+    std::string hex = scene("tet_grid", rayleigh, "");
+    hex.replace(hex.find(R"("solid", "law": "stvk")"), 22, R"("shell")");
+    expect_run_error<SceneError>(hex, "needs triangles only");
+  }
+  SUBCASE("per-spring damping") {
+    expect_run_error<SceneError>(scene("tet_grid", R"({"model": "viscous"})", ""), "per-spring damping");
+  }
+  SUBCASE("cuts") {
+    expect_run_error<SceneError>(
+        scene("tet_grid", rayleigh, R"(, "cuts": [{"type": "plane", "time": 0.05, "point": [0.2, 0, 0], "normal": [1, 0, 0]}])"),
+        "cutting is not supported");
+  }
 }

@@ -88,6 +88,7 @@ struct Scene {
   std::vector<FixSpec> fixed;
   std::vector<VelocitySpec> velocities;  // later entries win
   Vec3 gravity{0, 0, -9.81};
+  std::string model = "mass-spring", law = "stable_neo_hookean";  // model.type, model.law
   std::string damping = "viscous";
   double rayleigh_alpha = 0, rayleigh_beta = 0, environment_damping = 0;
   std::string integrator = "implicit";
@@ -96,6 +97,8 @@ struct Scene {
   double tolerance = physics::solve::default_tolerance;
   double absolute_tolerance = physics::solve::default_absolute_tolerance;
   std::uint32_t max_iterations = physics::solve::default_max_iterations;
+  double newton_tolerance = 1e-6;  // m/s, integrator "newton"
+  std::uint32_t newton_iterations = 50;
   bool allow_unstable = false;
   double energy_rise_tolerance = 1e-4;  // relative, see physics::EnergyLedger
   bool stop_on_inversion = false;       // check every step, stop at the first inverted element

@@ -35,6 +35,10 @@ struct JacobianOptions {
   bool drop_viscous_position_terms = true;
   /// Replace (1 - l/d) by max(0, 1 - l/d) so that -∂F/∂x stays positive semidefinite.
   bool clamp_compression = true;
+  /// Project each element Hessian to positive semidefinite (eigenvalues clamped at 0) before it
+  /// enters the matrix, as Newton on an incremental potential needs (elements::StencilTerm).
+  /// Springs need no projection of their own: their PSD form is clamp_compression.
+  bool project_element_hessians = false;
 };
 
 /// One assembly pass: matrix += cx·∂F/∂x + cv·∂F/∂v (if matrix is set) and

@@ -1,0 +1,176 @@
+// bench_elastic (issue 15). Cases, all "ours":
+//   elastic/cantilever/N<n>/<solver>   static tip of the 1 m × 0.1 m × 0.1 m cantilever
+//       (E = 100 MPa, ν = 0.3, ρ = 1000, g = 9.81, clamped at x = 0; 10N×N×N cubes of 6 Kuhn
+//       tetrahedra, StVK) by one quasi-static Newton step (h = 1e3 s, so inertia weighs ~1e-9 of
+//       the stiffness); time of the solve, tip (mean z of the x = L nodes) and its error against
+//       Timoshenko's 14.868 mm (PHYSICS_NOTES §4), Newton and CG iterations.
+//   elastic/step/N<n>/<solver>         one dynamic step (h = 10 ms) of the same beam swinging,
+//       ms per step and per Newton iteration.
+#include <cmath>
+#include <ctime>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "sewn/physics/basic_terms.hpp"
+#include "sewn/physics/integrate/newton_euler.hpp"
+#include "sewn/physics/solids/tets.hpp"
+#include "sewn_bench.hpp"
+
+namespace {
+
+using namespace sewn::physics;
+using Eigen::Vector3d;
+
+constexpr double E = 100e6, nu = 0.3, rho = 1000.0, g = 9.81, L = 1.0, b = 0.1;
+constexpr double timoshenko_mm = 14.868;
+
+struct Beam {
+  System sys;
+  std::vector<Index> tip;  // nodes at x = L
+  std::vector<double> rest_z;
+};
+
+// 10N×N×N cubes, 6 tetrahedra each around the cube's main diagonal; lumped masses ρV/4.
+void build(Beam& beam, int n) {
+  const int nx = 10 * n, ny = n, nz = n;
+  const double a = b / n;
+  auto id = [&](int i, int j, int k) { return static_cast<Index>(i + (nx + 1) * (j + (ny + 1) * k)); };
+  std::vector<Vector3d> x;
+  for (int k = 0; k <= nz; ++k)
+    for (int j = 0; j <= ny; ++j)
+      for (int i = 0; i <= nx; ++i) x.emplace_back(a * i, a * j, a * k);
+  static const int path[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  std::vector<std::array<Index, 4>> tets;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i)
+        for (const auto& p : path) {
+          int c[3] = {i, j, k};
+          std::array<Index, 4> t{};
+          t[0] = id(c[0], c[1], c[2]);
+          for (int s = 0; s < 3; ++s) {
+            ++c[p[s]];
+            t[s + 1] = id(c[0], c[1], c[2]);
+          }
+          tets.push_back(t);
+        }
+  const double node_mass = rho * a * a * a / 6.0 / 4.0;  // per incident tetrahedron
+  std::vector<double> mass(x.size(), 0.0);
+  for (const auto& t : tets)
+    for (Index v : t) mass[v] += node_mass;
+  for (std::size_t i = 0; i < x.size(); ++i) beam.sys.nodes().add(x[i], Vector3d::Zero(), mass[i]);
+  auto& term = beam.sys.add<solids::Tets>(solids::TetLaw::stvk);
+  for (const auto& t : tets) {
+    solids::TetPositions X;
+    for (int c = 0; c < 4; ++c) X.col(c) = x[t[c]];
+    term.add(t, X, E, nu);
+  }
+  beam.sys.add<Gravity>(Vector3d(0, 0, -g));
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (x[i].x() == 0.0) beam.sys.nodes().fix(static_cast<Index>(i));
+    if (std::abs(x[i].x() - L) < 1e-12) {
+      beam.tip.push_back(static_cast<Index>(i));
+      beam.rest_z.push_back(x[i].z());
+    }
+  }
+}
+
+double tip_mm(const Beam& beam) {
+  double s = 0.0;
+  for (std::size_t k = 0; k < beam.tip.size(); ++k) s += beam.sys.nodes().position(beam.tip[k]).z() - beam.rest_z[k];
+  return -1e3 * s / static_cast<double>(beam.tip.size());
+}
+
+const char* name(integrate::LinearSolver s) { return s == integrate::LinearSolver::cg ? "cg" : "ldlt"; }
+
+void static_solve(benchmark::State& st, int n, integrate::LinearSolver solver) {
+  double tip = 0.0;
+  int newton = 0, linear = 0;
+  double dof = 0.0;
+  for (auto _ : st) {
+    Beam beam;
+    {
+      sewn::bench::Untimed pause(st);
+      build(beam, n);
+      dof = 3.0 * beam.sys.nodes().num_alive();
+    }
+    const double h = 1e3;
+    integrate::NewtonEulerOptions opt;
+    opt.solver = solver;
+    opt.velocity_tolerance = 1e-9 / h;  // |p|∞ below 1 nm
+    opt.cg_tolerance = 1e-6;
+    opt.cg_max_iterations = 100000;
+    integrate::NewtonEuler newton_euler(opt);
+    try {
+      const auto rep = newton_euler.step(beam.sys, h);
+      newton = rep.iterations;
+      linear = rep.linear_iterations;
+    } catch (const std::exception& e) {
+      st.SkipWithError((std::string("cantilever N=") + std::to_string(n) + ": " + e.what()).c_str());
+      return;
+    }
+    tip = tip_mm(beam);
+  }
+  st.counters["tip mm"] = tip;
+  st.counters["error vs Timoshenko %"] = 100.0 * std::abs(tip - timoshenko_mm) / timoshenko_mm;
+  st.counters["Newton iterations"] = newton;
+  st.counters["linear iterations"] = linear;
+  st.counters["_dof"] = dof;
+  st.counters["_n"] = n;
+}
+
+void dynamic_step(benchmark::State& st, int n, integrate::LinearSolver solver) {
+  Beam beam;
+  build(beam, n);
+  integrate::NewtonEulerOptions opt;
+  opt.solver = solver;
+  opt.velocity_tolerance = 1e-6;
+  integrate::NewtonEuler newton_euler(opt);
+  const double h = 1e-2;
+  // Start mid-swing: a few steps from rest so the step is a real nonlinear solve.
+  for (int k = 0; k < 3; ++k) (void)newton_euler.step(beam.sys, h);
+  double iterations = 0.0, steps = 0.0, linear = 0.0, cpu = 0.0;
+  for (auto _ : st) {
+    try {
+      const std::clock_t t0 = std::clock();
+      const auto rep = newton_euler.step(beam.sys, h);
+      cpu += static_cast<double>(std::clock() - t0) / CLOCKS_PER_SEC;
+      iterations += rep.iterations;
+      linear += rep.linear_iterations;
+      steps += 1.0;
+    } catch (const std::exception& e) {
+      st.SkipWithError((std::string("step N=") + std::to_string(n) + ": " + e.what()).c_str());
+      return;
+    }
+  }
+  st.counters["Newton iterations per step"] = iterations / steps;
+  st.counters["linear iterations per step"] = linear / steps;
+  st.counters["ms per Newton iteration"] = iterations > 0 ? 1e3 * cpu / iterations : 0.0;
+  st.counters["_vertices"] = beam.sys.nodes().num_alive();
+}
+
+void register_all() {
+  using sewn::bench::Scale;
+  const Scale scale = sewn::bench::scale();
+  std::vector<int> sizes = scale == Scale::smoke ? std::vector<int>{1} : scale == Scale::small ? std::vector<int>{1, 2}
+                                                                                                 : std::vector<int>{1, 2, 4};
+  for (const auto solver : {integrate::LinearSolver::ldlt, integrate::LinearSolver::cg})
+    for (int n : sizes)
+      sewn::bench::ours("elastic", "cantilever/N" + std::to_string(n) + "/" + name(solver),
+                        [n, solver](benchmark::State& st) { static_solve(st, n, solver); })
+          ->Iterations(1);
+  if (scale == Scale::full)
+    sewn::bench::ours("elastic", "cantilever/N8/ldlt",
+                      [](benchmark::State& st) { static_solve(st, 8, integrate::LinearSolver::ldlt); })
+        ->Iterations(1);
+  for (const auto solver : {integrate::LinearSolver::ldlt, integrate::LinearSolver::cg})
+    for (int n : sizes)
+      sewn::bench::ours("elastic", "step/N" + std::to_string(n) + "/" + name(solver),
+                        [n, solver](benchmark::State& st) { dynamic_step(st, n, solver); });
+}
+
+const sewn::bench::Registration reg(&register_all);
+
+}  // namespace

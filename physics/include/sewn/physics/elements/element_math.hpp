@@ -1,0 +1,58 @@
+#pragma once
+// Shared vocabulary of per-element energies (solids/, shells/): fixed-size vectors and
+// matrices of an element's degrees of freedom, the PSD projection Newton needs, and the
+// constant matrix that maps node positions to a linear element's deformation gradient.
+//
+// DOF order of every element: node-major, [x0 y0 z0 x1 y1 z1 ...], matching the node table.
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+
+namespace sewn::physics::elements {
+
+template <int N>
+using Vec = Eigen::Matrix<double, N, 1>;
+template <int N>
+using Mat = Eigen::Matrix<double, N, N>;
+
+/// Replaces H (symmetric) by its nearest positive-semidefinite matrix in the Frobenius norm:
+/// eigenvalues below zero are clamped to zero. Returns the most negative eigenvalue seen (0 if
+/// none). Cost: one symmetric eigendecomposition, O(N³) (12×12: a few microseconds); returns
+/// at once when the smallest diagonal-dominance test already proves H PSD.
+template <int N>
+double project_psd(Mat<N>& H) {
+  // Gershgorin: every row with a_ii ≥ Σ|a_ij| proves H PSD without a decomposition.
+  bool dominant = true;
+  for (int i = 0; i < N && dominant; ++i) {
+    double off = 0.0;
+    for (int j = 0; j < N; ++j)
+      if (j != i) off += std::abs(H(i, j));
+    dominant = H(i, i) >= off;
+  }
+  if (dominant) return 0.0;
+  Eigen::SelfAdjointEigenSolver<Mat<N>> eig(H);
+  Vec<N> d = eig.eigenvalues();
+  const double lowest = d.minCoeff();
+  if (lowest >= 0.0) return 0.0;
+  d = d.cwiseMax(0.0);
+  H = eig.eigenvectors() * d.asDiagonal() * eig.eigenvectors().transpose();
+  return lowest;
+}
+
+/// For a linear element of K+1 nodes whose deformation gradient is F = Ds·Dm⁻¹ (Ds's column j
+/// = x_{j+1} - x_0, F is 3×K), the constant (3K)×(3K+3) matrix B with vec(F) = B·q (vec
+/// column-major, q node-major). Energies chain through it: ∇q = Bᵀ vec(P), ∇²q = Bᵀ (∂P/∂F) B.
+template <int K>
+Eigen::Matrix<double, 3 * K, 3 * K + 3> deformation_jacobian(const Eigen::Matrix<double, K, K>& Dm_inv) {
+  Eigen::Matrix<double, 3 * K, 3 * K + 3> B = Eigen::Matrix<double, 3 * K, 3 * K + 3>::Zero();
+  for (int b = 0; b < K; ++b) {
+    const double w0 = -Dm_inv.col(b).sum();
+    for (int a = 0; a < 3; ++a) {
+      B(a + 3 * b, a) = w0;
+      for (int k = 1; k <= K; ++k) B(a + 3 * b, 3 * k + a) = Dm_inv(k - 1, b);
+    }
+  }
+  return B;
+}
+
+}  // namespace sewn::physics::elements

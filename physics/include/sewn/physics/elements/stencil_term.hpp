@@ -1,0 +1,71 @@
+#pragma once
+// StencilTerm<N>: the bookkeeping shared by force terms whose elements each couple a fixed
+// set of N nodes through a potential energy (tetrahedra: 4, membrane triangles: 3, hinges:
+// 4). A derived term supplies the element's energy, gradient and Hessian over its stencil
+// (DOF order [x0 y0 z0 x1 ...]); this class turns them into the ForceTerm interface:
+//   forces = -gradient, ∂F/∂x = -Hessian (PSD-projected per element when
+//   JacobianOptions::project_element_hessians is set), no velocity dependence,
+//   stability rows from the projected Hessian, pattern pairs, slot caching, node checks and
+//   renumbering.
+// Cost per pass: one element evaluation per element plus a scatter of 3N values (forces) or
+// N² 3×3 blocks (Jacobians). Memory: N node indices and N² block slots per element.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "sewn/physics/elements/element_math.hpp"
+#include "sewn/physics/force_term.hpp"
+
+namespace sewn::physics::elements {
+
+template <int N>
+class StencilTerm : public ForceTerm {
+ public:
+  using Nodes = std::array<Index, N>;
+  using Positions = Eigen::Matrix<double, 3, N>;
+  using Gradient = Vec<3 * N>;
+  using Hessian = Mat<3 * N>;
+
+  /// Number of elements. O(1).
+  [[nodiscard]] Index size() const { return static_cast<Index>(nodes_.size()); }
+  /// The nodes of element e (no bounds check beyond the vector's).
+  [[nodiscard]] const Nodes& element_nodes(Index e) const { return nodes_[e]; }
+  /// Positions of element e's nodes in state s.
+  [[nodiscard]] Positions gather(const StateView& s, Index e) const;
+
+  void add_forces(const StateView& s, std::span<double> f) const override;
+  [[nodiscard]] double potential_energy(const StateView& s) const override;
+  void collect_pairs(std::vector<NodePair>& out) const override;
+  void bind_pattern(const BlockMatrix& pattern) override;
+  void add_jacobians(const StateView& s, const JacobianRequest& req) const override;
+  void add_stability_rows(const StateView& s, StabilityRows& rows) const override;
+  void check_nodes(const NodeTable& nodes) const override;
+  void remap_nodes(std::span<const Index> old_to_new) override;
+
+  /// Energy, gradient and exact Hessian of element e at positions x.
+  [[nodiscard]] virtual double element_energy(Index e, const Positions& x) const = 0;
+  [[nodiscard]] virtual Gradient element_gradient(Index e, const Positions& x) const = 0;
+  [[nodiscard]] virtual Hessian element_hessian(Index e, const Positions& x) const = 0;
+
+ protected:
+  /// Appends an element; throws InputError (naming the term) if a node repeats. Returns its index.
+  Index push_element(const Nodes& nodes);
+  /// "tets element 12" and the like, for messages.
+  [[nodiscard]] std::string element_name(Index e) const;
+
+ private:
+  std::vector<Nodes> nodes_;
+  std::vector<Index> slots_;  // N² per element, row-major (a, b)
+  std::uint64_t bound_pattern_ = ~std::uint64_t{0};
+  std::uint64_t bound_topology_ = ~std::uint64_t{0};
+};
+
+extern template class StencilTerm<3>;
+extern template class StencilTerm<4>;
+
+}  // namespace sewn::physics::elements

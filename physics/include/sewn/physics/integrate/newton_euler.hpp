@@ -1,0 +1,119 @@
+#pragma once
+// NewtonEuler: backward Euler as an incremental potential (PHYSICS_NOTES §3.4). One step of
+// size h finds
+//     q_{n+1} = argmin Φ(q),  Φ(q) = (1/2h²)(q - q̂)ᵀM(q - q̂) + E(q) + D(q),  q̂ = q_n + h v_n,
+// then sets v_{n+1} = (q_{n+1} - q_n)/h. E is the sum of the terms' potentials (external
+// fields such as gravity included: that is the -f_extᵀq part). Velocity-dependent forces
+// (MassDamping, spring damping) are evaluated at v = (q - q_n)/h; they enter the gradient
+// exactly and Φ through D(q) = -½(q - q_n)·F_d(q, v), which is the Rayleigh potential
+// (1/2h)(q - q_n)ᵀC(q - q_n) when F_d = -Cv is linear (the probe at the start of a step skips
+// D when no term depends on velocity).
+//
+// Newton: g = M(q - q̂)/h² - F(q, v), H = M/h² - ∂F/∂x - (1/h)∂F/∂v with every element Hessian
+// PSD-projected (JacobianOptions::project_element_hessians, clamp_compression); H p = -g is
+// solved on the free axes (fixed axes follow their prescribed velocity, q = q_n + h v_n, and
+// are filtered); Armijo backtracking α = 1, ½, ... until Φ(q + αp) ≤ Φ(q) + c α gᵀp; stop
+// when |p|∞/h < velocity_tolerance.
+//
+// The linear solve is the single function solve_linear() (block-Jacobi PCG on the block
+// matrix, or Eigen's SimplicialLDLT on its sparse copy), so a solver layer can replace it.
+//
+// Failure (no descent direction or line search exhausted, too many iterations, a non-finite
+// energy, gradient or state) throws NewtonError naming what failed, with the node table
+// unchanged (positions and velocities as before the step).
+//
+// Extra DOFs: the step works on flat arrays of dof_count() entries with a per-DOF inertia and
+// a per-DOF free flag, all built in prepare(). Scalar DOFs such as a rod's twist angle per
+// edge are to be appended after the 3n position entries (inertia J, free unless clamped), with
+// their block in the matrix; a System without them has dof_count() = 3n and pays nothing.
+//
+// Cost per Newton iteration: one Jacobian assembly (element Hessians + projections), one
+// linear solve (CG: iterations × one block-sparse product; LDLT: one numeric factorisation,
+// the symbolic one cached per pattern) and, per line-search trial, one force and one energy
+// evaluation (two force evaluations when some term depends on velocity).
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sewn/physics/aligned.hpp"
+#include "sewn/physics/cg.hpp"
+#include "sewn/physics/errors.hpp"
+#include "sewn/physics/system.hpp"
+
+namespace sewn::physics::integrate {
+
+enum class LinearSolver {
+  cg,    ///< block-Jacobi PCG on the block matrix to a relative tolerance (inexact Newton)
+  ldlt,  ///< Eigen SimplicialLDLT on the filtered sparse copy (exact; symbolic step cached)
+};
+
+struct NewtonEulerOptions {
+  double velocity_tolerance = 1e-6;  ///< m/s: converged when |p|∞/h is below it
+  int max_iterations = 50;
+  int max_line_search = 40;          ///< halvings of α before "no descent"
+  double armijo = 1e-4;              ///< c of the sufficient-decrease test
+  LinearSolver solver = LinearSolver::cg;
+  double cg_tolerance = 1e-4;        ///< η: relative residual of each Newton system
+  int cg_max_iterations = 5000;
+};
+
+/// What a step did.
+struct NewtonReport {
+  int iterations = 0;         ///< Newton iterations (linear solves)
+  int line_search_steps = 0;  ///< halvings of α, summed over iterations
+  int linear_iterations = 0;  ///< CG iterations, summed (0 with LDLT)
+  int steepest_fallbacks = 0; ///< iterations whose solve gave no descent and used -D⁻¹g instead
+  double step_velocity = 0.0; ///< |p|∞/h of the last iteration, m/s
+  double phi_decrease = 0.0;  ///< Φ(q̂) - Φ(q_{n+1}) ≥ 0
+};
+
+/// A step that failed; the node table is unchanged. reason() names the failure.
+class NewtonError : public SolverError {
+ public:
+  enum Reason { no_descent, too_many_iterations, non_finite };
+  NewtonError(const std::string& what, Reason r, const NewtonReport& rep)
+      : SolverError(what, rep.iterations, rep.step_velocity), reason_(r), report_(rep) {}
+  [[nodiscard]] Reason reason() const { return reason_; }
+  [[nodiscard]] const NewtonReport& report() const { return report_; }
+
+ private:
+  Reason reason_;
+  NewtonReport report_;
+};
+
+class NewtonEuler {
+ public:
+  explicit NewtonEuler(NewtonEulerOptions options = {});
+  ~NewtonEuler();
+  NewtonEuler(NewtonEuler&&) noexcept;
+  NewtonEuler& operator=(NewtonEuler&&) noexcept;
+
+  /// Advances sys by h > 0. Throws InputError on a bad h, NewtonError (state unchanged) on
+  /// failure. Allocation only when the DOF count or the pattern changed.
+  NewtonReport step(System& sys, double h);
+  [[nodiscard]] NewtonEulerOptions& options() { return opt_; }
+  /// Φ at positions q for the step being prepared (tests: monotone decrease). Valid after a
+  /// step; evaluates with that step's q_n, v_n and h.
+  [[nodiscard]] double incremental_potential(const System& sys, std::span<const double> q);
+
+ private:
+  struct LdltCache;
+  void prepare(System& sys, double h);
+  // Φ and its gradient at q (velocities (q - q_n)/h); returns Φ, fills g_. O(elements).
+  double evaluate(const System& sys, std::span<const double> q, bool want_gradient);
+  void assemble(System& sys);
+  // Solves H p = -g on the free axes into p_; returns CG iterations (0 for LDLT).
+  int solve_linear(const BlockMatrix& A);
+  [[nodiscard]] std::size_t dof_count() const { return inertia_.size(); }
+
+  NewtonEulerOptions opt_;
+  double h_ = 0.0;
+  bool damped_ = false;
+  AlignedVector<double> xn_, vn_, qhat_, q_, trial_, inertia_, free_, g_, f_, f0_, vel_, p_, rhs_, precond_, zeros_;
+  CgWorkspace ws_;
+  std::unique_ptr<LdltCache> ldlt_;
+};
+
+}  // namespace sewn::physics::integrate

@@ -1,0 +1,126 @@
+#include "sewn/physics/elements/stencil_term.hpp"
+
+#include "sewn/physics/errors.hpp"
+#include "sewn/physics/nodes.hpp"
+
+namespace sewn::physics::elements {
+
+template <int N>
+typename StencilTerm<N>::Positions StencilTerm<N>::gather(const StateView& s, Index e) const {
+  Positions x;
+  for (int a = 0; a < N; ++a)
+    for (int c = 0; c < 3; ++c) x(c, a) = s.x[3 * std::size_t{nodes_[e][a]} + c];
+  return x;
+}
+
+template <int N>
+std::string StencilTerm<N>::element_name(Index e) const {
+  return std::string(name()) + " element " + std::to_string(e);
+}
+
+template <int N>
+Index StencilTerm<N>::push_element(const Nodes& nodes) {
+  for (int a = 0; a < N; ++a)
+    for (int b = a + 1; b < N; ++b)
+      if (nodes[a] == nodes[b])
+        throw InputError(element_name(size()) + ": node " + std::to_string(nodes[a]) + " appears twice");
+  nodes_.push_back(nodes);
+  touch_topology();
+  return size() - 1;
+}
+
+template <int N>
+void StencilTerm<N>::add_forces(const StateView& s, std::span<double> f) const {
+  for (Index e = 0; e < size(); ++e) {
+    const Gradient g = element_gradient(e, gather(s, e));
+    for (int a = 0; a < N; ++a)
+      for (int c = 0; c < 3; ++c) f[3 * std::size_t{nodes_[e][a]} + c] -= g[3 * a + c];
+  }
+}
+
+template <int N>
+double StencilTerm<N>::potential_energy(const StateView& s) const {
+  double sum = 0.0;
+  for (Index e = 0; e < size(); ++e) sum += element_energy(e, gather(s, e));
+  return sum;
+}
+
+template <int N>
+void StencilTerm<N>::collect_pairs(std::vector<NodePair>& out) const {
+  for (const Nodes& n : nodes_)
+    for (int a = 0; a < N; ++a)
+      for (int b = a + 1; b < N; ++b) out.push_back({n[a], n[b]});
+}
+
+template <int N>
+void StencilTerm<N>::bind_pattern(const BlockMatrix& pattern) {
+  slots_.resize(std::size_t{N} * N * nodes_.size());
+  for (Index e = 0; e < size(); ++e)
+    for (int a = 0; a < N; ++a)
+      for (int b = 0; b < N; ++b) slots_[(std::size_t{e} * N + a) * N + b] = pattern.find(nodes_[e][a], nodes_[e][b]);
+  bound_pattern_ = pattern.pattern_version();
+  bound_topology_ = topology_version();
+}
+
+template <int N>
+void StencilTerm<N>::add_jacobians(const StateView& s, const JacobianRequest& req) const {
+  if (req.matrix != nullptr && (req.matrix->pattern_version() != bound_pattern_ || bound_topology_ != topology_version()))
+    throw InputError(std::string(name()) +
+                     ": add_jacobians on a pattern that is not bound to the current elements; call System::refresh()");
+  const bool product = !req.product_in.empty();
+  if (req.cx == 0.0 && !product) return;
+  for (Index e = 0; e < size(); ++e) {
+    Hessian H = element_hessian(e, gather(s, e));
+    if (req.options.project_element_hessians) project_psd<3 * N>(H);
+    const Nodes& n = nodes_[e];
+    if (req.matrix != nullptr && req.cx != 0.0)
+      for (int a = 0; a < N; ++a)
+        for (int b = 0; b < N; ++b)
+          req.matrix->block(slots_[(std::size_t{e} * N + a) * N + b]) -= req.cx * H.template block<3, 3>(3 * a, 3 * b);
+    if (product) {
+      Gradient p;
+      for (int a = 0; a < N; ++a)
+        for (int c = 0; c < 3; ++c) p[3 * a + c] = req.product_in[3 * std::size_t{n[a]} + c];
+      const Gradient q = H * p;
+      for (int a = 0; a < N; ++a)
+        for (int c = 0; c < 3; ++c) req.product_out[3 * std::size_t{n[a]} + c] -= q[3 * a + c];
+    }
+  }
+}
+
+template <int N>
+void StencilTerm<N>::add_stability_rows(const StateView& s, StabilityRows& rows) const {
+  for (Index e = 0; e < size(); ++e) {
+    Hessian H = element_hessian(e, gather(s, e));
+    project_psd<3 * N>(H);
+    const Nodes& n = nodes_[e];
+    for (int a = 0; a < N; ++a) {
+      rows.add_diagonal(StabilityRows::stiffness, n[a], H.template block<3, 3>(3 * a, 3 * a));
+      for (int b = a + 1; b < N; ++b)
+        rows.add_offdiagonal(StabilityRows::stiffness, n[a], n[b], H.template block<3, 3>(3 * a, 3 * b));
+    }
+  }
+}
+
+template <int N>
+void StencilTerm<N>::check_nodes(const NodeTable& nodes) const {
+  for (Index e = 0; e < size(); ++e)
+    for (Index i : nodes_[e]) {
+      if (i >= nodes.size())
+        throw InputError(element_name(e) + " refers to node " + std::to_string(i) + " but there are " +
+                         std::to_string(nodes.size()) + " nodes");
+      if (!nodes.is_alive(i)) throw InputError(element_name(e) + " refers to removed node " + std::to_string(i));
+    }
+}
+
+template <int N>
+void StencilTerm<N>::remap_nodes(std::span<const Index> old_to_new) {
+  for (Nodes& n : nodes_)
+    for (Index& i : n) i = old_to_new[i];
+  touch_topology();
+}
+
+template class StencilTerm<3>;
+template class StencilTerm<4>;
+
+}  // namespace sewn::physics::elements

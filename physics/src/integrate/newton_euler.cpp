@@ -1,0 +1,224 @@
+#include "sewn/physics/integrate/newton_euler.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <Eigen/SparseCholesky>
+
+namespace sewn::physics::integrate {
+
+struct NewtonEuler::LdltCache {
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
+  std::uint64_t pattern = ~std::uint64_t{0};
+};
+
+NewtonEuler::NewtonEuler(NewtonEulerOptions options) : opt_(options) {}
+NewtonEuler::~NewtonEuler() = default;
+NewtonEuler::NewtonEuler(NewtonEuler&&) noexcept = default;
+NewtonEuler& NewtonEuler::operator=(NewtonEuler&&) noexcept = default;
+
+void NewtonEuler::prepare(System& sys, double h) {
+  const NodeTable& nodes = sys.nodes();
+  const std::size_t n3 = 3 * std::size_t{nodes.size()};
+  for (auto* a : {&xn_, &vn_, &qhat_, &q_, &trial_, &inertia_, &free_, &g_, &f_, &f0_, &vel_, &p_, &rhs_})
+    a->resize(n3);
+  zeros_.assign(n3, 0.0);
+  precond_.resize(3 * n3);
+  ws_.resize(n3);
+  h_ = h;
+  const auto x = nodes.x(), v = nodes.v();
+  const auto m = nodes.masses();
+  const auto fixed = nodes.fixed_masks();
+  for (std::size_t k = 0; k < n3; ++k) {
+    if (!std::isfinite(x[k]) || !std::isfinite(v[k])) {
+      std::ostringstream s;
+      s << "newton euler: the state is not finite at node " << k / 3 << " (" << (std::isfinite(x[k]) ? "velocity" : "position")
+        << ") before the step";
+      throw NewtonError(s.str(), NewtonError::non_finite, {});
+    }
+    xn_[k] = x[k];
+    vn_[k] = v[k];
+    qhat_[k] = x[k] + h * v[k];
+    inertia_[k] = m[k / 3];
+    free_[k] = ((fixed[k / 3] >> (k % 3)) & 1) ? 0.0 : 1.0;
+  }
+  // Probe: do any forces depend on velocity? Compare F(x_n, 1) with F(x_n, 0).
+  std::fill(vel_.begin(), vel_.end(), 0.0);
+  std::fill(f0_.begin(), f0_.end(), 0.0);
+  sys.add_forces({x, vel_, m}, f0_);
+  std::fill(vel_.begin(), vel_.end(), 1.0);
+  std::fill(f_.begin(), f_.end(), 0.0);
+  sys.add_forces({x, vel_, m}, f_);
+  damped_ = false;
+  for (std::size_t k = 0; k < n3 && !damped_; ++k) damped_ = f_[k] != f0_[k];
+}
+
+double NewtonEuler::evaluate(const System& sys, std::span<const double> q, bool want_gradient) {
+  const std::size_t n = dof_count();
+  const auto m = sys.nodes().masses();
+  for (std::size_t k = 0; k < n; ++k) vel_[k] = free_[k] != 0.0 ? (q[k] - xn_[k]) / h_ : vn_[k];
+  const StateView s{q, vel_, m};
+  double phi = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double d = q[k] - qhat_[k];
+    phi += free_[k] * inertia_[k] * d * d;
+  }
+  phi *= 0.5 / (h_ * h_);
+  for (const auto& t : sys.terms()) phi += t->potential_energy(s);
+  if (!want_gradient && !damped_) return phi;
+  std::fill(f_.begin(), f_.end(), 0.0);
+  sys.add_forces(s, f_);
+  if (damped_) {
+    // D = -½ Δq·F_d with F_d = F(q, v) - F(q, 0).
+    std::fill(f0_.begin(), f0_.end(), 0.0);
+    sys.add_forces({q, zeros_, m}, f0_);
+    double d = 0.0;
+    for (std::size_t k = 0; k < n; ++k) d -= free_[k] * (q[k] - xn_[k]) * (f_[k] - f0_[k]);
+    phi += 0.5 * d;
+  }
+  if (want_gradient)
+    for (std::size_t k = 0; k < n; ++k) g_[k] = free_[k] * (inertia_[k] * (q[k] - qhat_[k]) / (h_ * h_) - f_[k]);
+  return phi;
+}
+
+void NewtonEuler::assemble(System& sys) {
+  BlockMatrix& A = sys.matrix();
+  A.set_zero();
+  JacobianRequest req;
+  req.matrix = &A;
+  req.cx = -1.0;
+  req.cv = -1.0 / h_;
+  req.options.project_element_hessians = true;
+  req.options.clamp_compression = true;
+  req.options.drop_viscous_position_terms = true;
+  const StateView s{q_, vel_, sys.nodes().masses()};
+  for (const auto& t : sys.terms()) t->add_jacobians(s, req);
+  for (Index i = 0; i < A.size(); ++i)
+    A.block(A.diagonal(i)).diagonal().array() += inertia_[3 * std::size_t{i}] / (h_ * h_);
+}
+
+int NewtonEuler::solve_linear(const BlockMatrix& A) {
+  const std::size_t n = dof_count();
+  for (std::size_t k = 0; k < n; ++k) {
+    rhs_[k] = -g_[k];
+    p_[k] = 0.0;
+  }
+  if (opt_.solver == LinearSolver::cg) {
+    block_jacobi_inverse(A, free_, precond_);
+    const CgResult r = filtered_pcg(A, rhs_, p_, free_, precond_, opt_.cg_tolerance, opt_.cg_max_iterations, ws_);
+    return r.iterations;
+  }
+  // LDLT on the sparse copy with fixed rows and columns replaced by the identity; the
+  // pattern (hence the symbolic factorisation) does not depend on which axes are fixed.
+  Eigen::SparseMatrix<double> S = A.to_sparse();
+  for (int c = 0; c < S.outerSize(); ++c)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(S, c); it; ++it)
+      if (free_[it.row()] == 0.0 || free_[it.col()] == 0.0) it.valueRef() = it.row() == it.col() ? 1.0 : 0.0;
+  if (!ldlt_) ldlt_ = std::make_unique<LdltCache>();
+  if (ldlt_->pattern != A.pattern_version()) {
+    ldlt_->solver.analyzePattern(S);
+    ldlt_->pattern = A.pattern_version();
+  }
+  ldlt_->solver.factorize(S);
+  if (ldlt_->solver.info() != Eigen::Success) return 0;  // p stays 0: reported as no descent
+  Eigen::Map<Eigen::VectorXd> p(p_.data(), static_cast<Eigen::Index>(n));
+  p = ldlt_->solver.solve(Eigen::Map<const Eigen::VectorXd>(rhs_.data(), static_cast<Eigen::Index>(n)));
+  for (std::size_t k = 0; k < n; ++k) p_[k] *= free_[k];
+  return 0;
+}
+
+double NewtonEuler::incremental_potential(const System& sys, std::span<const double> q) {
+  return evaluate(sys, q, false);
+}
+
+NewtonReport NewtonEuler::step(System& sys, double h) {
+  if (!std::isfinite(h) || h <= 0.0) throw InputError("newton euler: step h must be finite and > 0, got " + std::to_string(h));
+  sys.refresh();
+  prepare(sys, h);
+  NewtonReport rep;
+  const std::size_t n = dof_count();
+  std::copy(qhat_.begin(), qhat_.end(), q_.begin());
+  double phi = evaluate(sys, q_, true);
+  const double phi0 = phi;
+  auto fail = [&](NewtonError::Reason why, const std::string& what) {
+    throw NewtonError("newton euler: " + what + " (after " + std::to_string(rep.iterations) + " iterations, |p|inf/h = " +
+                          std::to_string(rep.step_velocity) + " m/s); the state is unchanged",
+                      why, rep);
+  };
+  auto first_non_finite = [&](const AlignedVector<double>& a) {
+    for (std::size_t k = 0; k < n; ++k)
+      if (!std::isfinite(a[k])) return static_cast<long long>(k);
+    return -1LL;
+  };
+  if (!std::isfinite(phi)) fail(NewtonError::non_finite, "the incremental potential is not finite at the predicted state");
+  if (const auto k = first_non_finite(g_); k >= 0)
+    fail(NewtonError::non_finite, "the gradient is not finite at node " + std::to_string(k / 3));
+
+  bool converged = false;
+  while (!converged) {
+    if (rep.iterations >= opt_.max_iterations) fail(NewtonError::too_many_iterations, "no convergence in the iteration limit");
+    ++rep.iterations;
+    assemble(sys);
+    rep.linear_iterations += solve_linear(sys.matrix());
+    double slope = 0.0, pmax = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      slope += g_[k] * p_[k];
+      pmax = std::max(pmax, std::abs(p_[k]));
+    }
+    if (!(slope < 0.0) || !std::isfinite(pmax)) {
+      // An inexact or failed solve: fall back on the Jacobi-scaled gradient, always a descent.
+      ++rep.steepest_fallbacks;
+      const BlockMatrix& A = sys.matrix();
+      slope = pmax = 0.0;
+      for (std::size_t k = 0; k < n; ++k) {
+        const double d = A.block(A.diagonal(static_cast<Index>(k / 3)))(k % 3, k % 3);
+        p_[k] = free_[k] * (-g_[k] / d);
+        slope += g_[k] * p_[k];
+        pmax = std::max(pmax, std::abs(p_[k]));
+      }
+    }
+    rep.step_velocity = pmax / h;
+    if (pmax == 0.0 || rep.step_velocity < opt_.velocity_tolerance) {
+      // The Newton step is within tolerance: take it whole (it is smaller than what the
+      // line search could resolve against round-off in Φ).
+      for (std::size_t k = 0; k < n; ++k) q_[k] += p_[k];
+      phi = evaluate(sys, q_, true);
+      converged = true;
+      break;
+    }
+    // Armijo backtracking; round-off in Φ is allowed for at a few ulps of its terms' size.
+    double alpha = 1.0;
+    const double noise = 8.0 * std::numeric_limits<double>::epsilon() * std::abs(phi);
+    for (int ls = 0;; ++ls) {
+      if (ls > opt_.max_line_search) fail(NewtonError::no_descent, "the line search found no decrease of the incremental potential");
+      for (std::size_t k = 0; k < n; ++k) trial_[k] = q_[k] + alpha * p_[k];
+      const double phi_t = evaluate(sys, trial_, false);
+      if (std::isfinite(phi_t) && phi_t <= phi + opt_.armijo * alpha * slope + noise) {
+        std::swap(q_, trial_);
+        break;
+      }
+      alpha *= 0.5;
+      ++rep.line_search_steps;
+    }
+    phi = evaluate(sys, q_, true);
+    if (!std::isfinite(phi)) fail(NewtonError::non_finite, "the incremental potential became non-finite");
+    if (const auto k = first_non_finite(g_); k >= 0)
+      fail(NewtonError::non_finite, "the gradient is not finite at node " + std::to_string(k / 3));
+  }
+  if (const auto k = first_non_finite(q_); k >= 0)
+    fail(NewtonError::non_finite, "the new position is not finite at node " + std::to_string(k / 3));
+  rep.phi_decrease = phi0 - phi;
+  NodeTable& nodes = sys.nodes();
+  auto x = nodes.x();
+  auto v = nodes.v();
+  for (std::size_t k = 0; k < n; ++k) {
+    x[k] = q_[k];
+    if (free_[k] != 0.0) v[k] = (q_[k] - xn_[k]) / h;
+  }
+  nodes.mark_state_finite();
+  return rep;
+}
+
+}  // namespace sewn::physics::integrate
