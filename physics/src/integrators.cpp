@@ -156,6 +156,7 @@ StepReport SymplecticEuler::step(System& sys, double h) {
     if (bad == 0) nodes.mark_state_finite();
   }
   ++steps_;
+  sys.step_accepted();
   if (watch && steps_ % static_cast<std::uint64_t>(opt_.health.energy_check_interval) == 0)
     watchdog_.check(sys, opt_.health, steps_);
   return rep;
@@ -257,6 +258,7 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
     if (bad == 0) nodes.mark_state_finite();
   }
   ++steps_;
+  sys.step_accepted();
   if (watch && steps_ % static_cast<std::uint64_t>(opt_.health.energy_check_interval) == 0)
     watchdog_.check(sys, opt_.health, steps_);
   return rep;

@@ -45,6 +45,7 @@ class Rod {
   [[nodiscard]] std::array<int, 2> stencil_edges(int s) const;
   [[nodiscard]] double rest_length(int edge) const { return rest_length_[static_cast<std::size_t>(edge)]; }
   [[nodiscard]] const BendTwistRest& stencil_rest(int s) const { return stencils_[static_cast<std::size_t>(s)].rest; }
+  [[nodiscard]] const BendTwistFrames& stencil_frames(int s) const { return stencils_[static_cast<std::size_t>(s)].frames; }
 
   /// Replaces the natural curvatures and twist of stencil s (e.g. a straight rest state for a
   /// rod built closed). Throws InputError if s is out of range or a value is not finite. O(1).
