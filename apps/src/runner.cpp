@@ -236,6 +236,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   mo.environment = scene.environment_damping;
   mo.source = scene.file;
   auto model = std::make_unique<physics::MssModel<3>>(assembly.mesh, materials, assembly.material_of_cell, mo);
+  add_obstacles(model->system(), scene.obstacles);
 
   // 2) fixed particles
   const IndexedMesh& mesh = assembly.mesh;

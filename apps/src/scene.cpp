@@ -165,6 +165,7 @@ Field build_schema() {
       integrator,
       field("duration", Kind::number).unit("s").fallback(1.0).above(0).at_most(1e6).doc("Simulated time."),
       field("cuts", Kind::array).of(cut).fallback(nlohmann::json::array()).doc("Scheduled cuts."),
+      obstacles_schema(),
       output,
   });
   return root;
@@ -327,6 +328,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     s.fixed.push_back({read_selector(fj.at("where"), *fix_schema.member("where")), read_axes(fr.string("axes"))});
   }
   s.gravity = r.vec3("gravity");
+  s.obstacles = read_obstacles(r["obstacles"], *schema.member("obstacles"), file);
   {
     Reader d(r["damping"], *schema.member("damping"));
     s.damping = d.string("model");

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "sewn/apps/obstacle_keys.hpp"
 #include "sewn/apps/schema.hpp"
 
 namespace sewn::app {
@@ -87,6 +88,7 @@ struct Scene {
   std::uint32_t max_iterations = 2000;
   bool allow_unstable = false;
   std::vector<CutSpec> cuts;
+  std::vector<ObstacleSpec> obstacles;
   std::uint32_t frames = 50;
   bool write_vtu = true, write_csv = true, write_picture = true;
   std::string color_by = "displacement", style = "shaded";
