@@ -206,7 +206,9 @@ bool Obstacles::has_friction() const {
   });
 }
 
-void Obstacles::step_accepted(const StateView& s) {
+void Obstacles::step_accepted(const StateView& s) { refresh_lambda(s); }
+
+void Obstacles::refresh_lambda(const StateView& s) const {
   if (!has_friction()) return;
   lambda_.assign(std::size_t{s.size()} * shapes_.size(), 0.0);
   for (Index i = 0; i < s.size(); ++i) {
@@ -221,7 +223,7 @@ void Obstacles::step_accepted(const StateView& s) {
 
 void Obstacles::ensure_lambda(const StateView& s) const {
   if (lambda_known_ && lambda_.size() == std::size_t{s.size()} * shapes_.size()) return;
-  const_cast<Obstacles*>(this)->step_accepted(s);
+  refresh_lambda(s);
 }
 
 void Obstacles::add_forces(const StateView& s, std::span<double> f) const {

@@ -65,12 +65,12 @@ Points Rods::gather(Index r, std::span<const double> x) const {
   return p;
 }
 
-void Rods::ensure_twist(const Entry& e, const Points& x) const {
+void Rods::ensure_twist(Index r, const Points& x) const {
   if (!quasi_static_) return;
+  Entry& e = rods_[r];  // θ is the term's own (mutable) state
   if (e.solved_at.cols() == x.cols() && e.solved_at == x) return;
-  Entry& m = const_cast<Entry&>(e);  // the cache of θ is the term's own (mutable) state
-  (void)m.rod.solve_twist(x);
-  m.solved_at = x;
+  (void)e.rod.solve_twist(x);
+  e.solved_at = x;
 }
 
 void Rods::add_forces(const StateView& s, std::span<double> f) const {
@@ -78,7 +78,7 @@ void Rods::add_forces(const StateView& s, std::span<double> f) const {
   for (Index r = 0; r < num_rods(); ++r) {
     const Entry& e = rods_[r];
     const Points x = gather(r, s.x);
-    ensure_twist(e, x);
+    ensure_twist(r, x);
     (void)e.rod.evaluate(x, g, nullptr);
     for (std::size_t k = 0; k < e.nodes.size(); ++k)
       for (int a = 0; a < 3; ++a) f[3 * e.nodes[k] + static_cast<std::size_t>(a)] -= g[3 * static_cast<Eigen::Index>(k) + a];
@@ -89,7 +89,7 @@ double Rods::potential_energy(const StateView& s) const {
   double E = 0;
   for (Index r = 0; r < num_rods(); ++r) {
     const Points x = gather(r, s.x);
-    ensure_twist(rods_[r], x);
+    ensure_twist(r, x);
     E += rods_[r].rod.energy(x);
   }
   return E;
@@ -133,7 +133,7 @@ void Rods::bind_pattern(const BlockMatrix& pattern) {
 }
 
 template <class Visit>
-void Rods::for_each_block(const Entry& e, const Points& x, Visit&& visit) const {
+void Rods::for_each_block(const Entry& e, const Points& x, bool project, Visit&& visit) const {
   std::size_t slot = 0;
   for (int s = 0; s < e.rod.num_stencils(); ++s) {
     const auto v = e.rod.stencil_vertices(s);
@@ -142,7 +142,7 @@ void Rods::for_each_block(const Entry& e, const Points& x, Visit&& visit) const 
                                        e.rod.theta()[static_cast<std::size_t>(ed[1])], e.rod.stencil_rest(s),
                                        e.rod.stencil_frames(s), Want::hessian);
     Eigen::Matrix<double, 9, 9> H = b.hessian.topLeftCorner<9, 9>();
-    if (project_) H = project_psd<9>(H);
+    if (project) H = project_psd<9>(H);
     for (int a = 0; a < 3; ++a)
       for (int c = 0; c < 3; ++c, ++slot) visit(v[static_cast<std::size_t>(a)], v[static_cast<std::size_t>(c)], Eigen::Matrix3d(H.block<3, 3>(3 * a, 3 * c)), slot);
   }
@@ -151,7 +151,7 @@ void Rods::for_each_block(const Entry& e, const Points& x, Visit&& visit) const 
     const int v[2] = {j, (j + 1) % n};
     const StretchEval st = stretch(x.col(v[0]), x.col(v[1]), e.rod.section().EA, e.rod.rest_length(j), true);
     Eigen::Matrix<double, 6, 6> H = st.hessian;
-    if (project_) H = project_psd<6>(H);
+    if (project) H = project_psd<6>(H);
     for (int a = 0; a < 2; ++a)
       for (int c = 0; c < 2; ++c, ++slot) visit(v[a], v[c], Eigen::Matrix3d(H.block<3, 3>(3 * a, 3 * c)), slot);
   }
@@ -164,9 +164,9 @@ void Rods::add_jacobians(const StateView& s, const JacobianRequest& req) const {
   for (Index r = 0; r < num_rods(); ++r) {
     const Entry& e = rods_[r];
     const Points x = gather(r, s.x);
-    ensure_twist(e, x);
+    ensure_twist(r, x);
     // ∂F/∂x = −H.
-    for_each_block(e, x, [&](int a, int b, const Eigen::Matrix3d& B, std::size_t slot) {
+    for_each_block(e, x, project_, [&](int a, int b, const Eigen::Matrix3d& B, std::size_t slot) {
       const Index na = e.nodes[static_cast<std::size_t>(a)], nb = e.nodes[static_cast<std::size_t>(b)];
       if (req.matrix) req.matrix->block(e.slots[slot]) -= req.cx * B;
       if (product) {
@@ -179,13 +179,11 @@ void Rods::add_jacobians(const StateView& s, const JacobianRequest& req) const {
 }
 
 void Rods::add_stability_rows(const StateView& s, StabilityRows& rows) const {
-  const bool keep = project_;
-  const_cast<Rods*>(this)->project_ = true;  // the bound needs PSD blocks
   for (Index r = 0; r < num_rods(); ++r) {
     const Entry& e = rods_[r];
     const Points x = gather(r, s.x);
-    ensure_twist(e, x);
-    for_each_block(e, x, [&](int a, int b, const Eigen::Matrix3d& B, std::size_t) {
+    ensure_twist(r, x);
+    for_each_block(e, x, true, [&](int a, int b, const Eigen::Matrix3d& B, std::size_t) {  // the bound needs PSD blocks
       const Index na = e.nodes[static_cast<std::size_t>(a)], nb = e.nodes[static_cast<std::size_t>(b)];
       if (na == nb)
         rows.add_diagonal(StabilityRows::stiffness, na, B);
@@ -193,13 +191,12 @@ void Rods::add_stability_rows(const StateView& s, StabilityRows& rows) const {
         rows.add_offdiagonal(StabilityRows::stiffness, na, nb, B);
     });
   }
-  const_cast<Rods*>(this)->project_ = keep;
 }
 
 void Rods::step_accepted(const StateView& s) {
   for (Index r = 0; r < num_rods(); ++r) {
     const Points x = gather(r, s.x);
-    ensure_twist(rods_[r], x);
+    ensure_twist(r, x);
     rods_[r].rod.update_frames(x);
   }
 }

@@ -106,6 +106,7 @@ class Obstacles final : public ForceTerm {
 
  private:
   void ensure_lambda(const StateView& s) const;
+  void refresh_lambda(const StateView& s) const;  // λ = k d at s (λ is the term's mutable history)
   [[nodiscard]] bool has_friction() const;
 
   double k_, eps_v_;

@@ -80,11 +80,11 @@ class Rods final : public ForceTerm {
     Points solved_at;             // positions of the last θ solve (0 columns: none yet)
     std::vector<Index> slots;     // per stencil 9 block slots, then per edge 4
   };
-  void ensure_twist(const Entry& e, const Points& x) const;
-  // Per-stencil and per-edge position Hessians of rod e at x (projected if asked), calling
+  void ensure_twist(Index r, const Points& x) const;
+  // Per-stencil and per-edge position Hessians of rod e at x (PSD-projected if `project`), calling
   // visit(vertex a, vertex b, 3×3 block, slot index into e.slots).
   template <class Visit>
-  void for_each_block(const Entry& e, const Points& x, Visit&& visit) const;
+  void for_each_block(const Entry& e, const Points& x, bool project, Visit&& visit) const;
 
   mutable std::vector<Entry> rods_;
   bool quasi_static_ = true;
