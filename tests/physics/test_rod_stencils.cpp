@@ -120,6 +120,11 @@ TEST_CASE("rod stencil: bend-twist gradient and Hessian match finite differences
       // ordered differently: agreement to round-off of the largest entry, up to ~1e7 at the kink).
       const BendTwistEval g = eval(c, c.q, Want::gradient), H = eval(c, c.q, Want::hessian);
       CHECK((g.gradient - H.gradient).norm() <= 1e-10 * (1 + g.gradient.norm()));
+      // The closed-form angle block equals the AD Hessian's.
+      const BendTwistEval a = eval(c, c.q, Want::angle_hessian);
+      CHECK((a.hessian.bottomRightCorner<2, 2>() - H.hessian.bottomRightCorner<2, 2>()).norm() <=
+            1e-10 * (1 + H.hessian.bottomRightCorner<2, 2>().norm()));
+      CHECK(a.hessian.topLeftCorner<9, 11>().isZero());
     }
   }
 }

@@ -2,6 +2,7 @@
 // the assembled Jacobian (exact for a straight rod; with the Schur complement over θ, exact
 // for a curved one), zero net force and torque, and a cantilever rod under gravity settling,
 // under the linearly implicit integrator, onto the static solution.
+#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -11,6 +12,7 @@
 #include <doctest/doctest.h>
 
 #include "helpers.hpp"
+#include "sewn/physics/errors.hpp"
 #include "sewn/physics/rods/rods_term.hpp"
 #include "sewn/physics/rods/static_solve.hpp"
 
@@ -167,4 +169,53 @@ TEST_CASE("rods term: a cantilever rod under gravity settles onto the static sol
   CHECK(tip_static < -0.01);  // a real deflection
   CHECK(tip_dynamic == doctest::Approx(tip_static).epsilon(1e-4));
   CHECK(sys.kinetic_energy() < 1e-12);
+}
+
+TEST_CASE("rods: bad rods are refused with the vertex or edge named") {
+  const Section sec = Section::circular(1e6, 0.3, 0.01);
+  Points one(3, 1);
+  one.col(0) = Vec3::Zero();
+  CHECK_THROWS_WITH_AS(Rod(one, false, sec), doctest::Contains("at least 2 vertices"), InputError);
+  Points dup(3, 3);
+  dup << 0, 1, 1, 0, 0, 0, 0, 0, 0;
+  CHECK_THROWS_WITH_AS(Rod(dup, false, sec), doctest::Contains("edge 1 has zero rest length"), InputError);
+  Points fold(3, 3);
+  fold << 0, 1, 0, 0, 0, 0, 0, 0, 0;
+  CHECK_THROWS_WITH_AS(Rod(fold, false, sec), doctest::Contains("folds back on itself at vertex 1"), InputError);
+  Points ok(3, 3);
+  ok << 0, 1, 2, 0, 0.1, 0, 0, 0, 0;
+  const std::vector<Vec3> one_director{Vec3(0, 0, 1)};
+  CHECK_THROWS_WITH_AS(Rod(ok, false, sec, one_director), doctest::Contains("1 rest directors given for 2 edges"), InputError);
+  const std::vector<Vec3> parallel{Vec3(1, 0.1, 0), Vec3(0, 0, 1)};
+  CHECK_THROWS_WITH_AS(Rod(ok, false, sec, parallel), doctest::Contains("edge 0"), InputError);
+  System sys;
+  for (int i = 0; i < 3; ++i) (void)sys.nodes().add(ok.col(i), Vec3::Zero(), 1.0);
+  Rods& rods = sys.add<Rods>();
+  const std::vector<Index> twice{0, 1, 0};
+  CHECK_THROWS_WITH_AS((void)rods.add_rod(twice, sys.nodes().x(), false, sec), doctest::Contains("visits node 0 twice"), InputError);
+  const std::vector<Index> outside{0, 1, 7};
+  CHECK_THROWS_WITH_AS((void)rods.add_rod(outside, sys.nodes().x(), false, sec), doctest::Contains("node 7"), InputError);
+  CHECK(rods.num_rods() == 0);
+}
+
+TEST_CASE("rods term: cost of a force evaluation on a 101-vertex rod (report only)") {
+  System sys;
+  std::vector<Index> ids;
+  Rods& rods = helix_rod(sys, 101, ids);
+  rods.rod(0).fix_theta(0);
+  std::mt19937 rng(2);
+  std::vector<double> f(3 * ids.size());
+  const int reps = 20;
+  double sink = 0;
+  rods.add_forces(sys.nodes().state(), f);  // the first solve starts from θ = 0
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 0; k < reps; ++k) {
+    perturb(sys, rng, 1e-4);  // a new state: the twist is solved again, warm-started
+    std::fill(f.begin(), f.end(), 0.0);
+    rods.add_forces(sys.nodes().state(), f);
+    sink += f[3];
+  }
+  const auto t1 = std::chrono::steady_clock::now();
+  MESSAGE("101-vertex rod: forces with the twist solve " << std::chrono::duration<double, std::milli>(t1 - t0).count() / reps << " ms");
+  CHECK(std::isfinite(sink));
 }

@@ -19,6 +19,26 @@ std::string num(double v) {
   return buf;
 }
 
+// LDLᵀ solve of (T + shift·I) p = −g for a tridiagonal T (diagonal `diag`, `sub[k]` coupling
+// k and k+1). False if a pivot is not positive (the shifted matrix is not positive definite).
+bool tridiagonal_descent(const std::vector<double>& diag, const std::vector<double>& sub, const Eigen::VectorXd& g,
+                         double shift, Eigen::VectorXd& step) {
+  const std::size_t n = diag.size();
+  std::vector<double> d(n), l(n, 0.0);
+  step.resize(static_cast<Eigen::Index>(n));
+  for (std::size_t k = 0; k < n; ++k) {
+    d[k] = diag[k] + shift - (k > 0 ? l[k - 1] * sub[k - 1] : 0.0);
+    if (!(d[k] > 0)) return false;
+    if (k + 1 < n) l[k] = sub[k] / d[k];
+    step[static_cast<Eigen::Index>(k)] = -g[static_cast<Eigen::Index>(k)] - (k > 0 ? l[k - 1] * step[static_cast<Eigen::Index>(k - 1)] : 0.0);
+  }
+  for (std::size_t k = n; k-- > 0;) {
+    step[static_cast<Eigen::Index>(k)] /= d[k];
+    if (k + 1 < n) step[static_cast<Eigen::Index>(k)] -= l[k] * step[static_cast<Eigen::Index>(k + 1)];
+  }
+  return true;
+}
+
 }  // namespace
 
 Rod::Rod(const Points& rest, bool closed, const Section& section, std::span<const Vec3> rest_directors)
@@ -193,16 +213,21 @@ int Rod::solve_twist(const Points& x) {
     for (int s = 0; s < num_stencils(); ++s) E += eval_stencil(x, s, Want::energy).energy;
     return E;
   };
+  // Open rods: the free angles' Hessian is tridiagonal in their order (a Thomas solve); closed
+  // rods add one corner pair, solved by a sparse LDLᵀ.
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt;
   std::vector<Eigen::Triplet<double>> trips;
+  std::vector<double> diag(static_cast<std::size_t>(nf)), sub(static_cast<std::size_t>(std::max(nf - 1, 0)));
   Eigen::VectorXd g(nf);
   double E = theta_energy();
   for (int it = 0; it < 100; ++it) {
     g.setZero();
     trips.clear();
+    std::fill(diag.begin(), diag.end(), 0.0);
+    std::fill(sub.begin(), sub.end(), 0.0);
     double diag_max = 0;
     for (int s = 0; s < num_stencils(); ++s) {
-      const BendTwistEval b = eval_stencil(x, s, Want::hessian);
+      const BendTwistEval b = eval_stencil(x, s, Want::angle_hessian);
       const auto e = stencil_edges(s);
       for (int r = 0; r < 2; ++r) {
         const int fr = free_index[static_cast<std::size_t>(e[static_cast<std::size_t>(r)])];
@@ -211,18 +236,29 @@ int Rod::solve_twist(const Points& x) {
         for (int c = 0; c < 2; ++c) {
           const int fc = free_index[static_cast<std::size_t>(e[static_cast<std::size_t>(c)])];
           if (fc < 0) continue;
-          trips.emplace_back(fr, fc, b.hessian(9 + r, 9 + c));
-          if (r == c) diag_max = std::max(diag_max, b.hessian(9 + r, 9 + c));
+          const double h = b.hessian(9 + r, 9 + c);
+          if (closed_)
+            trips.emplace_back(fr, fc, h);
+          else if (fr == fc)
+            diag[static_cast<std::size_t>(fr)] += h;
+          else if (fc == fr + 1)
+            sub[static_cast<std::size_t>(fr)] += h;
+          if (r == c) diag_max = std::max(diag_max, h);
         }
       }
     }
     // The θ block is PSD for twist alone and may lose definiteness where bending couples in;
     // a shift that grows until the factorisation is positive keeps every step a descent step.
     Eigen::SparseMatrix<double> A(nf, nf);
-    A.setFromTriplets(trips.begin(), trips.end());
+    if (closed_) A.setFromTriplets(trips.begin(), trips.end());
     Eigen::VectorXd step;
     double shift = 1e-12 * std::max(diag_max, 1e-300);
     for (int attempt = 0; attempt < 40; ++attempt, shift *= 10) {
+      if (!closed_) {
+        if (tridiagonal_descent(diag, sub, g, shift, step)) break;
+        step.resize(0);
+        continue;
+      }
       Eigen::SparseMatrix<double> S = A;
       for (int k = 0; k < nf; ++k) S.coeffRef(k, k) += shift;
       ldlt.compute(S);

@@ -39,7 +39,8 @@ struct Core {
 // Energy and closed-form gradient of the bend-twist stencil over q = (x0, x1, x2, θ0, θ1).
 // Instantiated with double (values) and AutoDiffScalar (Hessian = derivative of the gradient).
 template <class T>
-Core<T> core(const Eigen::Matrix<T, 11, 1>& q, const BendTwistRest& r, const BendTwistFrames& f, bool with_gradient) {
+Core<T> core(const Eigen::Matrix<T, 11, 1>& q, const BendTwistRest& r, const BendTwistFrames& f, bool with_gradient,
+             Eigen::Matrix2d* angle_hessian = nullptr) {
   Core<T> out;
   const V3<T> e0 = q.template segment<3>(3) - q.template segment<3>(0);
   const V3<T> e1 = q.template segment<3>(6) - q.template segment<3>(3);
@@ -94,6 +95,21 @@ Core<T> core(const Eigen::Matrix<T, 11, 1>& q, const BendTwistRest& r, const Ben
   out.gradient.template segment<3>(6) = ge1;
   out.gradient[9] = sigma0;
   out.gradient[10] = sigma1;
+  if (angle_hessian) {
+    // ∂κ1/∂θj = −½ m1^j·κb, ∂κ2/∂θj = −½ m2^j·κb; since ∂m1/∂θ = m2 and ∂m2/∂θ = −m1, the
+    // second derivatives are ∂²κ1/∂θj² = ∂κ2/∂θj and ∂²κ2/∂θj² = −∂κ1/∂θj (no cross terms);
+    // the twist is linear in θ with ∂m/∂θ = (−1, 1).
+    const double dk1[2] = {-0.5 * value_of(m1_0.dot(kb)), -0.5 * value_of(m1_1.dot(kb))};
+    const double dk2[2] = {-0.5 * value_of(m2_0.dot(kb)), -0.5 * value_of(m2_1.dot(kb))};
+    const double dm[2] = {-1.0, 1.0};
+    const double e1 = value_of(d1), e2 = value_of(d2);
+    for (int j = 0; j < 2; ++j)
+      for (int k = 0; k < 2; ++k) {
+        double h = r.EI1 * dk1[j] * dk1[k] + r.EI2 * dk2[j] * dk2[k] + r.GJ * dm[j] * dm[k];
+        if (j == k) h += r.EI1 * e1 * dk2[j] - r.EI2 * e2 * dk1[j];
+        (*angle_hessian)(j, k) = inv_d * h;
+      }
+  }
   return out;
 }
 
@@ -173,9 +189,12 @@ BendTwistEval bend_twist(const Vec3& x0, const Vec3& x1, const Vec3& x2, double 
   BendTwistEval out;
   const Eigen::Matrix<double, 11, 1> q = pack(x0, x1, x2, theta0, theta1);
   if (want != Want::hessian) {
-    const Core<double> c = core<double>(q, rest, frames, want == Want::gradient);
+    Eigen::Matrix2d angles;
+    const bool grad = want == Want::gradient || want == Want::angle_hessian;
+    const Core<double> c = core<double>(q, rest, frames, grad, want == Want::angle_hessian ? &angles : nullptr);
     out.energy = c.energy;
-    if (want == Want::gradient) out.gradient = c.gradient;
+    if (grad) out.gradient = c.gradient;
+    if (want == Want::angle_hessian) out.hessian.bottomRightCorner<2, 2>() = angles;
     out.kappa1 = c.kappa1;
     out.kappa2 = c.kappa2;
     out.twist = c.twist;

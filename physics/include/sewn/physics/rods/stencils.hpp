@@ -92,7 +92,10 @@ struct BendTwistEval {
   Eigen::Matrix<double, 11, 11> hessian = Eigen::Matrix<double, 11, 11>::Zero();
 };
 
-enum class Want { energy, gradient, hessian };
+/// What bend_twist() computes: the energy; and the gradient; and the full Hessian; or the
+/// gradient with only the 2×2 angle block of the Hessian (entries (9..10, 9..10), closed form,
+/// the rest zero) — all a quasi-static twist solve needs, at the cost of a gradient.
+enum class Want { energy, gradient, hessian, angle_hessian };
 
 /// Evaluates the bend–twist stencil. Gradient: closed form (PHYSICS_NOTES §3.1 plus the
 /// transported frames' spin), O(1), ~0.2 µs. Hessian: forward-mode automatic differentiation of
