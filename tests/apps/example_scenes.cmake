@@ -20,6 +20,7 @@ set(expect_table1_hex            "8;1")     # the paper's timing set-ups: no cut
 set(expect_table1_tets           "8;5")
 set(expect_sofa_8x8x10           "891;640")
 set(expect_tet_beam_5x7x9        "480;1890")
+set(expect_obstacles_spike       "81;32")    # rigid obstacles: no cut
 
 foreach(v SEWN SCENES WORK)
   if(NOT DEFINED ${v})
