@@ -53,8 +53,8 @@ TEST_CASE("scene obstacles: every type with its defaults") {
   CHECK(s.obstacles[0].friction_velocity == 1e-3);
   CHECK(s.obstacles[1].stiffness == 2e4);
   const auto& box = std::get<Box>(s.obstacles[2].shape);
-  CHECK(box.center.isApprox(Vec3(1.5, 2, 2.5)));
-  CHECK(box.half_extents.isApprox(Vec3(0.5, 1, 1.5)));
+  CHECK(box.center.isApprox(Eigen::Vector3d(1.5, 2, 2.5)));
+  CHECK(box.half_extents.isApprox(Eigen::Vector3d(0.5, 1, 1.5)));
   CHECK(std::get<Cone>(s.obstacles[3].shape).axis.z() == -1.0);
   CHECK(parse_scene(cube_scene(), "scene.json").obstacles.empty());
 }
