@@ -41,7 +41,8 @@ class Rods final : public ForceTerm {
                 std::span<const Vec3> rest_directors = {});
   [[nodiscard]] Index num_rods() const { return static_cast<Index>(rods_.size()); }
   /// The rod (its θ, clamps, frames). Changing θ or clamps through it takes effect at the next
-  /// force evaluation. Throws InputError if r is out of range.
+  /// force evaluation. The reference is invalidated by add_rod(). Throws InputError if r is
+  /// out of range.
   [[nodiscard]] Rod& rod(Index r);
   [[nodiscard]] const Rod& rod(Index r) const;
   [[nodiscard]] std::span<const Index> rod_nodes(Index r) const;
