@@ -241,18 +241,21 @@ TEST_CASE("rod sections: circular and elliptic moduli, bad input rejected") {
 }
 
 TEST_CASE("rod stencil: cost of the closed-form gradient and the AD Hessian (report only)") {
+  // The machine is shared: the fastest of 30 batches is the least disturbed estimate.
   std::mt19937 rng(3);
   const Case c = random_case(rng, 0.7, 0.1);
   using clock = std::chrono::steady_clock;
-  double sink = 0;
-  const int reps = 2000;
-  auto t0 = clock::now();
-  for (int k = 0; k < reps; ++k) sink += eval(c, c.q, Want::gradient).gradient[k % 11];
-  auto t1 = clock::now();
-  for (int k = 0; k < reps; ++k) sink += eval(c, c.q, Want::hessian).hessian(k % 11, 3);
-  auto t2 = clock::now();
-  const double g_us = std::chrono::duration<double, std::micro>(t1 - t0).count() / reps;
-  const double h_us = std::chrono::duration<double, std::micro>(t2 - t1).count() / reps;
-  MESSAGE("bend-twist stencil: gradient " << g_us << " us, gradient+Hessian (AD) " << h_us << " us");
+  double sink = 0, g_us = 1e9, h_us = 1e9;
+  const int reps = 200;
+  for (int batch = 0; batch < 30; ++batch) {
+    auto t0 = clock::now();
+    for (int k = 0; k < reps; ++k) sink += eval(c, c.q, Want::gradient).gradient[k % 11];
+    auto t1 = clock::now();
+    for (int k = 0; k < reps; ++k) sink += eval(c, c.q, Want::hessian).hessian(k % 11, 3);
+    auto t2 = clock::now();
+    g_us = std::min(g_us, std::chrono::duration<double, std::micro>(t1 - t0).count() / reps);
+    h_us = std::min(h_us, std::chrono::duration<double, std::micro>(t2 - t1).count() / reps);
+  }
+  MESSAGE("bend-twist stencil (fastest of 30 batches): gradient " << g_us << " us, gradient+Hessian (AD) " << h_us << " us");
   CHECK(std::isfinite(sink));
 }

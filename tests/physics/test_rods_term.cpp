@@ -208,15 +208,17 @@ TEST_CASE("rods term: cost of a force evaluation on a 101-vertex rod (report onl
   const int reps = 20;
   double sink = 0;
   rods.add_forces(sys.nodes().state(), f);  // the first solve starts from θ = 0
-  const auto t0 = std::chrono::steady_clock::now();
+  double best = 1e9;  // the machine is shared: the fastest call is the least disturbed
   for (int k = 0; k < reps; ++k) {
     perturb(sys, rng, 1e-4);  // a new state: the twist is solved again, warm-started
     std::fill(f.begin(), f.end(), 0.0);
+    const auto t0 = std::chrono::steady_clock::now();
     rods.add_forces(sys.nodes().state(), f);
+    const auto t1 = std::chrono::steady_clock::now();
+    best = std::min(best, std::chrono::duration<double, std::milli>(t1 - t0).count());
     sink += f[3];
   }
-  const auto t1 = std::chrono::steady_clock::now();
-  MESSAGE("101-vertex rod: forces with the twist solve " << std::chrono::duration<double, std::milli>(t1 - t0).count() / reps << " ms");
+  MESSAGE("101-vertex rod: forces with the twist solve (fastest of " << reps << ") " << best << " ms");
   CHECK(std::isfinite(sink));
 }
 
