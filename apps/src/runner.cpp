@@ -399,6 +399,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   mo.environment = scene.environment_damping;
   mo.source = scene.file;
   auto model = std::make_unique<physics::MssModel<3>>(assembly.mesh, materials, assembly.material_of_cell, mo);
+  add_obstacles(model->system(), scene.obstacles);
 
   // A policy that altered stiffnesses is said so: the body is stiffer than the material.
   sum.clamped_cells = static_cast<std::uint64_t>(

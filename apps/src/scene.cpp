@@ -225,6 +225,7 @@ Field build_schema() {
       integrator,
       field("duration", Kind::number).unit("s").fallback(1.0).above(0).at_most(1e6).doc("Simulated time."),
       field("cuts", Kind::array).of(cut).fallback(nlohmann::json::array()).doc("Scheduled cuts."),
+      obstacles_schema(),
       output,
       limits,
   });
@@ -493,6 +494,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
                             vr.vec3("angular"), vr.vec3("center")});
   }
   s.gravity = r.vec3("gravity");
+  s.obstacles = read_obstacles(r["obstacles"], *schema.member("obstacles"), file);
   {
     Reader d(r["damping"], *schema.member("damping"));
     s.damping = d.string("model");

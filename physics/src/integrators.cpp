@@ -129,6 +129,7 @@ StepReport SymplecticEuler::step(System& sys, double h) {
     max_speed = std::bit_cast<double>(speed);
   }
   ++steps_;
+  sys.step_accepted();
   if (watch && finite)
     if (auto blowup = watchdog_.after_step(sys, opt_.health, steps_, max_speed)) {
       const double suggested = 0.9 * bound_.h_max;
@@ -262,6 +263,7 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
     max_speed = std::bit_cast<double>(speed);
   }
   ++steps_;
+  sys.step_accepted();
   if (watch && finite)
     if (auto blowup = watchdog_.after_step(sys, opt_.health, steps_, max_speed)) {
       // No stability bound exists for this scheme; its energy grows when the linearisation

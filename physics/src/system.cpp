@@ -169,4 +169,9 @@ std::uint64_t System::version() const {
   return key;
 }
 
+void System::step_accepted() {
+  const StateView s = nodes_.state();
+  for (const auto& t : terms_) t->step_accepted(s);
+}
+
 }  // namespace sewn::physics

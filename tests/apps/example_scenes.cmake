@@ -23,6 +23,7 @@ set(expect_tet_beam_5x7x9        "480;1890")
 set(expect_newton_cantilever     "189;80")   # backward Euler by Newton on the mass-spring beam
 set(expect_solid_cantilever      "189;480")  # the same beam as finite-element tetrahedra
 set(expect_shell_plate           "85;128")   # membranes and hinges on 16x4x2 triangles
+set(expect_obstacles_spike       "81;32")    # rigid obstacles: no cut
 
 foreach(v SEWN SCENES WORK)
   if(NOT DEFINED ${v})

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "sewn/apps/obstacle_keys.hpp"
 #include "sewn/apps/schema.hpp"
 #include "sewn/physics/solve/linear_solver.hpp"
 
@@ -103,6 +104,7 @@ struct Scene {
   double energy_rise_tolerance = 1e-4;  // relative, see physics::EnergyLedger
   bool stop_on_inversion = false;       // check every step, stop at the first inverted element
   std::vector<CutSpec> cuts;
+  std::vector<ObstacleSpec> obstacles;
   std::uint32_t frames = 50;
   bool write_vtu = true, write_csv = true, write_picture = true;
   std::string color_by = "displacement", style = "shaded";

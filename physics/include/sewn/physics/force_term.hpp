@@ -118,6 +118,11 @@ class ForceTerm {
   /// Adds this term's stiffness and damping blocks for the stable-step bound.
   virtual void add_stability_rows(const StateView& /*s*/, StabilityRows& /*rows*/) const {}
 
+  /// Called by integrators once per accepted step, at the new state: terms with history that
+  /// is frozen within a step (rods' time-parallel frames, lagged contact normals) update it
+  /// here. Default: nothing.
+  virtual void step_accepted(const StateView& /*s*/) {}
+
   /// Throws InputError naming the element if one refers to a node out of range or removed.
   virtual void check_nodes(const NodeTable& /*nodes*/) const {}
   /// Renumbers nodes after compaction (old -> new, invalid_index for removed). check_nodes()

@@ -79,6 +79,10 @@ class System {
   /// mass is added. Calls refresh(). O(elements).
   void add_jacobians(const JacobianRequest& req);
 
+  /// Tells every term that a step was accepted at the current state (ForceTerm::step_accepted).
+  /// Integrators call it once per step. O(terms) plus what the terms with history do.
+  void step_accepted();
+
   /// ½ Σ m v². O(n).
   [[nodiscard]] double kinetic_energy() const;
   /// Σ of the terms' potentials. O(elements).

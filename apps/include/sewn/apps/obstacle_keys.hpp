@@ -1,0 +1,30 @@
+#pragma once
+// The scene key `obstacles`: rigid obstacles (physics/obstacles) read from a scene file and
+// added to a system — kept apart from scene.cpp so the scene layer only lists the key.
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "sewn/apps/schema.hpp"
+#include "sewn/physics/obstacles/obstacles.hpp"
+#include "sewn/physics/system.hpp"
+
+namespace sewn::app {
+
+struct ObstacleSpec {
+  physics::obstacles::Shape shape;
+  double stiffness = 0;          ///< N/m per node
+  double friction_velocity = 0;  ///< m/s
+};
+
+/// The schema of the `obstacles` array (one object per obstacle, selected by `type`).
+Field obstacles_schema();
+/// Reads a validated `obstacles` array; throws SceneError naming "obstacles[i].key" for values
+/// the schema cannot express (a zero normal or axis, box min ≥ max). O(obstacles).
+std::vector<ObstacleSpec> read_obstacles(const nlohmann::json& j, const Field& schema, const std::string& file);
+/// Adds one Obstacles term per obstacle to sys. O(obstacles).
+void add_obstacles(physics::System& sys, const std::vector<ObstacleSpec>& obstacles);
+
+}  // namespace sewn::app

@@ -1,0 +1,96 @@
+#pragma once
+// Rods: discrete elastic rods as a ForceTerm on the system's node positions. Each rod's
+// material angles θ are the term's own state, solved quasi-statically: whenever forces or the
+// energy are asked for at a new state, θ is minimised with positions held (Rod::solve_twist,
+// a Newton on the tridiagonal θ block from the previous θ). Because ∂E/∂θ = 0 there, the
+// position gradient of E is the exact gradient of the reduced energy min_θ E (envelope
+// theorem): the forces are exact.
+//
+// Jacobian. The exact ∂F/∂x of the reduced energy is −(H_xx − H_xθ H_θθ⁻¹ H_θx): the Schur
+// complement over θ, which couples every vertex of a rod with every other (H_θθ⁻¹ is dense).
+// add_jacobians() writes −H_xx only (stencil by stencil, each projected to PSD unless
+// set_project_hessians(false)): stiffer than the exact reduced Jacobian (H_θθ is positive
+// definite), so a linearly implicit step stays stable and is merely more damped in modes that
+// couple bending and twist; for a straight rod H_xθ = 0 and nothing is dropped. The test
+// suite builds the Schur complement from Rod::evaluate and checks it against finite differences.
+//
+// Hook for θ as extra degrees of freedom (the Newton integrator, later): set_quasi_static(false)
+// stops the θ solve; the integrator then owns θ (Rod::set_theta), takes each rod's full
+// Hessian in rod DOF order from Rod::evaluate (positions of rod_nodes(r)[k] at 3k.., θ^j at
+// 3n + j), gives θ^j its inertia J = ρ(πr⁴/2)|ē^j| if wanted, and calls step_accepted().
+//
+// Time-parallel frames are updated in step_accepted(), which integrators call once per accepted
+// step; within a step the frames are frozen (PHYSICS_NOTES §3.4's history state).
+
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "sewn/physics/force_term.hpp"
+#include "sewn/physics/rods/rod.hpp"
+
+namespace sewn::physics::rods {
+
+class Rods final : public ForceTerm {
+ public:
+  /// Adds a rod through `nodes` (node indices in order; closed: the last joins the first) whose
+  /// rest shape is their positions in x (3·N state array); see Rod's constructor for
+  /// `rest_directors` and what is rejected. Throws InputError on a repeated or out-of-range
+  /// node. Returns the rod's index. O(rod length); the pattern is rebuilt when next needed.
+  Index add_rod(std::span<const Index> nodes, std::span<const double> x, bool closed, const Section& section,
+                std::span<const Vec3> rest_directors = {});
+  [[nodiscard]] Index num_rods() const { return static_cast<Index>(rods_.size()); }
+  /// The rod (its θ, clamps, frames). Changing θ or clamps through it takes effect at the next
+  /// force evaluation. The reference is invalidated by add_rod(). Throws InputError if r is
+  /// out of range.
+  [[nodiscard]] Rod& rod(Index r);
+  [[nodiscard]] const Rod& rod(Index r) const;
+  [[nodiscard]] std::span<const Index> rod_nodes(Index r) const;
+  /// Positions of rod r's vertices in state array x (3N). O(rod length).
+  [[nodiscard]] Points gather(Index r, std::span<const double> x) const;
+
+  /// Quasi-static θ (default) or θ owned by the caller (see the header comment).
+  void set_quasi_static(bool on) { quasi_static_ = on; }
+  /// Whether add_jacobians projects each stencil's position Hessian to PSD (default true).
+  void set_project_hessians(bool on) { project_ = on; }
+
+  [[nodiscard]] std::string_view name() const override { return "rods"; }
+  /// Solves θ at s (if s changed since the last solve), then adds −∂E/∂x. Throws
+  /// rods::SolveError if a twist solve fails. O(vertices · twist Newton iterations).
+  void add_forces(const StateView& s, std::span<double> f) const override;
+  /// Energy at s, with θ solved there. Same cost as add_forces.
+  [[nodiscard]] double potential_energy(const StateView& s) const override;
+  /// Σ ½ EA l̄ over edges (the energy of a 100 % stretch).
+  [[nodiscard]] double energy_scale() const override;
+  void collect_pairs(std::vector<NodePair>& out) const override;
+  void bind_pattern(const BlockMatrix& pattern) override;
+  /// −H_xx as described above, at the θ of the last solve. O(stencils), a few µs each (AD
+  /// Hessian, 2.4 µs measured, and a 9×9 eigen-decomposition).
+  void add_jacobians(const StateView& s, const JacobianRequest& req) const override;
+  void add_stability_rows(const StateView& s, StabilityRows& rows) const override;
+  /// Transports every rod's reference frames to the accepted state and tracks its reference
+  /// twists. O(vertices).
+  void step_accepted(const StateView& s) override;
+  void check_nodes(const NodeTable& nodes) const override;
+  void remap_nodes(std::span<const Index> old_to_new) override;
+
+ private:
+  struct Entry {
+    Rod rod;
+    std::vector<Index> nodes;
+    Points solved_at;             // positions of the last θ solve (0 columns: none yet)
+    std::vector<Index> slots;     // per stencil 9 block slots, then per edge 4
+  };
+  void ensure_twist(Index r, const Points& x) const;
+  // Per-stencil and per-edge position Hessians of rod e at x (PSD-projected if `project`), calling
+  // visit(vertex a, vertex b, 3×3 block, slot index into e.slots).
+  template <class Visit>
+  void for_each_block(const Entry& e, const Points& x, bool project, Visit&& visit) const;
+
+  mutable std::vector<Entry> rods_;
+  bool quasi_static_ = true;
+  bool project_ = true;
+  std::uint64_t bound_pattern_ = ~std::uint64_t{0};
+};
+
+}  // namespace sewn::physics::rods
