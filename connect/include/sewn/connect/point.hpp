@@ -120,7 +120,8 @@ class PointConnection {
   /// Energy, angles and flags at q; with `want_gradient` also dE/dq (forward-mode automatic
   /// differentiation of the energy, exact to round-off). At ω below 1e-8 the bending energy is
   /// ½k_b|d − d̄|² (equal to ½k_bω² to O(ω⁴), and differentiable there). Near the singular
-  /// configurations the values are still returned, flagged. Cost O(1): ~1–3 µs with gradient.
+  /// configurations the values are still returned, flagged. Cost O(1): measured ~0.7 µs for the
+  /// energy, ~7 µs with the gradient (18-wide forward AD; AMD EPYC, shared machine).
   [[nodiscard]] PointEval evaluate(const Eigen::VectorXd& q, TwistUpdate update, bool want_gradient) const;
 
   /// After an accepted step at q: the incremental δ becomes the accepted one (by `update`),
