@@ -18,11 +18,13 @@ using physics::rods::transport_exact;
 constexpr int max_dofs = 18;  // triangle + triangle
 constexpr double two_pi = 2 * std::numbers::pi;
 using AD = Eigen::AutoDiffScalar<Eigen::Matrix<double, max_dofs, 1>>;
+using AD2 = Eigen::AutoDiffScalar<Eigen::Matrix<AD, max_dofs, 1>>;  // second order: AD of AD
 template <class T>
 using V3 = Eigen::Matrix<T, 3, 1>;
 
 double value_of(double v) { return v; }
 double value_of(const AD& v) { return v.value(); }
+double value_of(const AD2& v) { return v.value().value(); }
 
 [[noreturn]] void fail(const std::string& name, const std::string& why) {
   throw InputError("point connection '" + name + "': " + why);
@@ -90,14 +92,14 @@ Frame<T> build_frame(const Side& side, const Q& q, double sign, const std::array
     const V3<T> a1 = transport_exact<T>(r->tangent.cast<T>(), t, r->director.cast<T>());
     const V3<T> a2 = t.cross(a1);
     f.m1 = cos(q[6]) * a1 + sin(q[6]) * a2;
-    f.m3 = sign * t;
+    f.m3 = T(sign) * t;
   } else {
     const V3<T> e1 = q.template segment<3>(3) - q.template segment<3>(0);
     const V3<T> e2 = q.template segment<3>(6) - q.template segment<3>(0);
     const V3<T> nrm = e1.cross(e2);
     f.m1 = nrm / sqrt(nrm.dot(nrm));
-    const V3<T> axis = coef[0] * e1 + coef[1] * e2;
-    f.m3 = (sign / sqrt(axis.dot(axis))) * axis;
+    const V3<T> axis = T(coef[0]) * e1 + T(coef[1]) * e2;
+    f.m3 = (T(sign) / sqrt(axis.dot(axis))) * axis;
   }
   f.m2 = f.m3.cross(f.m1);
   return f;
@@ -205,7 +207,8 @@ PointConnection::PointConnection(std::string name, Side m, Side n, PointStiffnes
   accepted_twist_ = rest_twist_;
 }
 
-PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update, bool want_gradient) const {
+PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update, bool want_gradient,
+                                    Eigen::MatrixXd* hessian) const {
   if (q.size() != num_dofs())
     fail(name_, "configuration has " + std::to_string(q.size()) + " entries, the stencil " + std::to_string(num_dofs()));
   PointEval out;
@@ -222,11 +225,11 @@ PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update
     const T raw = signed_angle_t<T>(transport_exact<T>(fm.m3, fn.m3, fm.m1), fn.m1, fn.m3);
     T delta = raw;
     if (update == TwistUpdate::incremental_i) {
-      delta = raw + two_pi * std::round((accepted_twist_ - value_of(raw)) / two_pi);
+      delta = raw + T(two_pi * std::round((accepted_twist_ - value_of(raw)) / two_pi));
     } else if (update == TwistUpdate::incremental_ii) {
       // Turn m1 by the accepted δ first: what is left to measure is the step's increment (< π).
       const V3<T> m1t = cos(T(accepted_twist_)) * fm.m1 + sin(T(accepted_twist_)) * fm.m2;
-      delta = accepted_twist_ + signed_angle_t<T>(transport_exact<T>(fm.m3, fn.m3, m1t), fn.m1, fn.m3);
+      delta = T(accepted_twist_) + signed_angle_t<T>(transport_exact<T>(fm.m3, fn.m3, m1t), fn.m1, fn.m3);
     }
     const V3<T> d(fn.m3.dot(fm.m1), fn.m3.dot(fm.m2), fn.m3.dot(fm.m3));
     const V3<T> db = rest_d_.cast<T>();
@@ -236,21 +239,34 @@ PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update
     if (value_of(s2) < 1e-16 && value_of(d.dot(db)) > 0) {
       // ω < 1e-8: |d − d̄|² = 2 − 2cos ω = ω² + O(ω⁴), and smooth where sqrt(s2) is not.
       const V3<T> dd = d - db;
-      eb = 0.5 * k_.bend * dd.dot(dd);
+      eb = T(0.5 * k_.bend) * dd.dot(dd);
       c.bend = value_of(sqrt(T(value_of(s2))));
     } else {
       const T w = atan2(sqrt(s2), d.dot(db));
-      eb = 0.5 * k_.bend * w * w;
+      eb = T(0.5 * k_.bend) * w * w;
       c.bend = value_of(w);
     }
-    const T dt = delta - rest_twist_;
-    c.energy = 0.5 * k_.twist * dt * dt + eb;
+    const T dt = delta - T(rest_twist_);
+    c.energy = T(0.5 * k_.twist) * dt * dt + eb;
     c.twist = value_of(delta);
     c.twist_raw = value_of(raw);
     return c;
   };
   Core<double> c;
-  if (want_gradient) {
+  if (hessian) {
+    const Eigen::Index n = q.size();
+    Eigen::Matrix<AD2, Eigen::Dynamic, 1> qa(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      qa[i].value() = AD(q[i], max_dofs, static_cast<int>(i));
+      qa[i].derivatives() = Eigen::Matrix<AD, max_dofs, 1>::Constant(AD(0.0));
+      qa[i].derivatives()[i] = AD(1.0);
+    }
+    const auto ca = run(qa);
+    c = {value_of(ca.energy), ca.twist, ca.twist_raw, ca.bend, ca.one_plus_c};
+    out.gradient = ca.energy.value().derivatives().head(n);
+    hessian->resize(n, n);
+    for (Eigen::Index j = 0; j < n; ++j) hessian->row(j) = ca.energy.derivatives()[j].derivatives().head(n).transpose();
+  } else if (want_gradient) {
     Eigen::Matrix<AD, Eigen::Dynamic, 1> qa(q.size());
     for (Eigen::Index i = 0; i < q.size(); ++i) qa[i] = AD(q[i], max_dofs, static_cast<int>(i));
     const auto ca = run(qa);

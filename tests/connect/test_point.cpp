@@ -75,6 +75,26 @@ void check_gradient(const PointConnection& c, const VectorXd& q, TwistUpdate u) 
   CHECK((e.gradient - fd).norm() <= 1e-6 * std::max(1.0, fd.norm()));
 }
 
+// The Hessian against central differences of the (exact, AD) gradient, and its symmetry.
+void check_hessian(const PointConnection& c, const VectorXd& q, TwistUpdate u) {
+  Eigen::MatrixXd H;
+  const PointEval e = c.evaluate(q, u, true, &H);
+  REQUIRE(H.rows() == q.size());
+  REQUIRE(H.cols() == q.size());
+  CHECK((e.gradient - c.evaluate(q, u, true).gradient).norm() <= 1e-12 * std::max(1.0, e.gradient.norm()));
+  Eigen::MatrixXd fd(q.size(), q.size());
+  const double h = 1e-6;
+  for (Eigen::Index i = 0; i < q.size(); ++i) {
+    VectorXd qp = q, qm = q;
+    qp[i] += h;
+    qm[i] -= h;
+    fd.col(i) = (c.evaluate(qp, u, true).gradient - c.evaluate(qm, u, true).gradient) / (2 * h);
+  }
+  INFO("analytic\n" << H << "\nfinite\n" << fd);
+  CHECK((H - H.transpose()).norm() <= 1e-10 * std::max(1.0, H.norm()));
+  CHECK((H - fd).norm() <= 1e-5 * std::max(1.0, fd.norm()));
+}
+
 VectorXd perturbed(const VectorXd& q, std::mt19937& rng, double size) {
   std::uniform_real_distribution<double> u(-size, size);
   VectorXd out = q;
@@ -120,7 +140,7 @@ TEST_CASE("point connection: rest state has zero energy and the orientation rule
   CHECK_FALSE(cf.evaluate(f.q, TwistUpdate::direct, false).singular());
 }
 
-TEST_CASE("point connection: gradients match finite differences (rod-triangle, rod-rod, triangle-triangle)") {
+TEST_CASE("point connection: gradients and Hessians match finite differences (rod-triangle, rod-rod, triangle-triangle)") {
   std::mt19937 rng(16);
   for (TwistUpdate u : {TwistUpdate::direct, TwistUpdate::incremental_i, TwistUpdate::incremental_ii}) {
     CAPTURE(static_cast<int>(u));
@@ -133,9 +153,13 @@ TEST_CASE("point connection: gradients match finite differences (rod-triangle, r
     PointConnection tt("tt", TriangleSide{{0, 1, 2}, std::nullopt}, TriangleSide{{3, 0, 4}, std::nullopt}, {1.0, 2.0},
                        qt);
     for (int trial = 0; trial < 5; ++trial) {
-      check_gradient(rt, perturbed(s.q, rng, 0.15), u);
-      check_gradient(rr, perturbed(r.q, rng, 0.15), u);
-      check_gradient(tt, perturbed(qt, rng, 0.15), u);
+      const VectorXd a = perturbed(s.q, rng, 0.15), b = perturbed(r.q, rng, 0.15), t = perturbed(qt, rng, 0.15);
+      check_gradient(rt, a, u);
+      check_gradient(rr, b, u);
+      check_gradient(tt, t, u);
+      check_hessian(rt, a, u);
+      check_hessian(rr, b, u);
+      check_hessian(tt, t, u);
     }
   }
 }
@@ -164,8 +188,10 @@ TEST_CASE("point connection: bending energy is ½k_b ω² of the axis' tilt, and
   // Tiny tilt (ω ~ 1e-9, the guarded branch): finite gradient equal to its finite difference.
   VectorXd q0 = s.q;
   q0[13] = 1e-9;
-  const PointEval e0 = c.evaluate(q0, TwistUpdate::incremental_ii, true);
+  Eigen::MatrixXd h0;
+  const PointEval e0 = c.evaluate(q0, TwistUpdate::incremental_ii, true, &h0);
   CHECK(e0.gradient.allFinite());
+  CHECK(h0.allFinite());
   q0[13] = 1e-4;  // the regular branch, just above
   check_gradient(c, q0, TwistUpdate::incremental_ii);
 }
@@ -185,6 +211,7 @@ TEST_CASE("point connection: gradients near the singular configurations") {
     const PointEval e = c.evaluate(q, u, false);
     CHECK(e.twist - c.rest_twist() == doctest::Approx(6.0 + pi - 0.05).epsilon(1e-9));
     check_gradient(c, q, u);
+    check_hessian(c, q, u);
     q[15] += 2 * pi - 0.1;  // increment now 3π − 0.15 ≡ π − 0.15 — the other side: aliased by design
     CHECK(std::abs(c.evaluate(q, u, false).twist - c.rest_twist() - (6.0 + 3 * pi - 0.15)) > 1.0);
   }
@@ -202,6 +229,7 @@ TEST_CASE("point connection: gradients near the singular configurations") {
       CHECK_FALSE(e.near_antiparallel);
       check_gradient(c, q, TwistUpdate::incremental_ii);
       check_gradient(c, q, TwistUpdate::incremental_i);
+      check_hessian(c, q, TwistUpdate::incremental_ii);
     } else {
       CHECK(e.near_antiparallel);
     }
