@@ -1,6 +1,8 @@
-// A rod split in two at a vertex and rejoined by a point connection with k_t = GJ/D (D the
-// Voronoi length of the joint) must twist exactly like the unsplit rod: the twist is solved
-// over both halves' material angles and compared with the unsplit rod's own twist solve.
+// A rod split in two at a vertex and rejoined by a point connection with k_t = GJ/D, k_b = EI/D
+// (D the Voronoi length of the joint) must twist exactly like the unsplit rod (the twist is
+// solved over both halves' material angles and compared with the unsplit rod's own twist
+// solve), and bend like it up to the difference of the two discrete curvature measures
+// (the rod's 2 tan(φ/2), the connection's φ), which vanishes under refinement.
 
 #include <cmath>
 #include <vector>
@@ -61,6 +63,11 @@ struct SplitRod {
         joint(make_joint(a, xa, b, xb, split, sec)),
         k(split) {}
 
+  // Moves the split rod to the whole rod's positions x (the joint's two copies together).
+  void move(const Points& x) {
+    xa = x.leftCols(k + 1);
+    xb = x.rightCols(x.cols() - k);
+  }
   int num_theta() const { return a.num_edges() + b.num_edges(); }
   void set_theta(const Eigen::VectorXd& th) {
     for (int j = 0; j < a.num_edges(); ++j) a.set_theta(j, th[j]);
@@ -138,4 +145,40 @@ TEST_CASE("a rod split by a point connection with k_t = GJ/D twists like the uns
   double sum_d = 0;
   for (int i = 1; i + 1 < n; ++i) sum_d += 0.5 * ((x.col(i) - x.col(i - 1)).norm() + (x.col(i + 1) - x.col(i)).norm());
   CHECK(e_whole == doctest::Approx(sec.GJ * phi * phi / (2 * sum_d)).epsilon(1e-9));
+}
+
+TEST_CASE("a rod split by a point connection with k_b = EI/D bends like the unsplit rod, converging under refinement") {
+  // A straight rod bent into a circular arc (radius 1, angle 1.5 rad) in the plane ⟂ its
+  // directors, split at its middle vertex: the joint's bending is ½(EI/D)φ² against the rod's
+  // ½(EI/D)(2 tan(φ/2))², φ the turning angle h/R, a relative difference ~φ²/6 in one of n
+  // terms: the total energies agree to O(n^-3).
+  const Section sec = Section::circular(1e7, 0.3, 0.01);
+  double previous = 0;
+  for (int n : {9, 17, 33}) {
+    CAPTURE(n);
+    const double arc = 1.5;
+    Points rest(3, n), bent(3, n);
+    for (int j = 0; j < n; ++j) {
+      const double s = arc * j / (n - 1);
+      rest.col(j) = Eigen::Vector3d(s, 0, 0);
+      bent.col(j) = Eigen::Vector3d(std::sin(s), 1 - std::cos(s), 0);
+    }
+    const std::vector<Eigen::Vector3d> up(static_cast<std::size_t>(n - 1), Eigen::Vector3d(0, 0, 1));
+    Rod whole(rest, false, sec, up);
+    const double e_whole = whole.energy(bent);
+    SplitRod s(rest, (n - 1) / 2, sec);
+    s.move(bent);
+    Eigen::VectorXd g;
+    const double e_split = s.energy_and_gradient(g);
+    const double rel = std::abs(e_split - e_whole) / e_whole;
+    const double phi = arc / (n - 1);
+    // The difference in closed form: only the joint vertex differs, by ½(EI/D)(φ² − 4 tan²(φ/2)).
+    const double D = phi;  // the joint's rest Voronoi length: both rest edges are arc/(n−1) = φ
+    const double expected = 0.5 * sec.EI1 / D * (phi * phi - 4 * std::tan(phi / 2) * std::tan(phi / 2));
+    INFO("relative difference " << rel);
+    CHECK(e_whole > 0);
+    CHECK((e_split - e_whole) == doctest::Approx(expected).epsilon(1e-6));
+    if (previous > 0) CHECK(rel < previous / 6);  // ~ n^-3: halving h divides it by ~8
+    previous = rel;
+  }
 }
