@@ -211,6 +211,7 @@ PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update
                                     Eigen::MatrixXd* hessian) const {
   if (q.size() != num_dofs())
     fail(name_, "configuration has " + std::to_string(q.size()) + " entries, the stencil " + std::to_string(num_dofs()));
+  if (!q.allFinite()) fail(name_, "configuration is not finite");
   PointEval out;
   auto run = [&](const auto& qt) {
     using T = typename std::decay_t<decltype(qt)>::Scalar;

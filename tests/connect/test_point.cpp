@@ -348,4 +348,8 @@ TEST_CASE("point connection: bad input names the connection") {
   throws_with([&] { PointConnection("joint-7", outside, s.rod, {1, 1}, s.q); }, "outside");
   PointConnection ok("joint-7", s.tri, s.rod, {1, 1}, s.q);
   throws_with([&] { (void)ok.evaluate(s.q.head(15), TwistUpdate::direct, false); }, "entries");
+  VectorXd nan = s.q;
+  nan[4] = std::nan("");
+  throws_with([&] { (void)ok.evaluate(nan, TwistUpdate::incremental_ii, true); }, "not finite");
+  throws_with([&] { PointConnection("joint-7", s.tri, s.rod, {1, 1}, nan); }, "not finite");
 }

@@ -120,7 +120,9 @@ class PointConnection {
   /// Energy, angles and flags at q; with `want_gradient` also dE/dq (forward-mode automatic
   /// differentiation of the energy, exact to round-off). At ω below 1e-8 the bending energy is
   /// ½k_b|d − d̄|² (equal to ½k_bω² to O(ω⁴), and differentiable there). Near the singular
-  /// configurations the values are still returned, flagged. Cost O(1): measured ~0.7 µs for the
+  /// configurations the values are still returned, flagged; a rod edge of zero length or a
+  /// triangle of zero area *now* gives non-finite values (callers check, as for the rods).
+  /// Throws physics::InputError naming the connection if q has the wrong size or is not finite. Cost O(1): measured ~0.7 µs for the
   /// energy, ~7–15 µs with the gradient (18-wide forward AD; AMD EPYC, shared machine).
   /// With `hessian`, also d²E/dq² (and the gradient): second-order forward AD, exact to
   /// round-off, symmetric, not projected (indefinite away from rest). Measured ~0.65 ms: 18×18
