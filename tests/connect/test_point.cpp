@@ -353,3 +353,40 @@ TEST_CASE("point connection: bad input names the connection") {
   throws_with([&] { (void)ok.evaluate(nan, TwistUpdate::incremental_ii, true); }, "not finite");
   throws_with([&] { PointConnection("joint-7", s.tri, s.rod, {1, 1}, nan); }, "not finite");
 }
+
+TEST_CASE("point connection: accept() keeps a rod side's frame in step with Rod::update_frames") {
+  // A rod (vertices 0, 1, 2) leaving a held triangle (0, 10, 11) at vertex 0, swung about a
+  // tilted axis through the joint for 20 steps with θ held; after each accepted step the
+  // connection's twist must equal the one built from the rod's own material frame.
+  using physics::rods::Points;
+  const auto sec = physics::rods::Section::circular(1e7, 0.3, 0.01);
+  Points rest(3, 3);
+  rest << 0, 0.4, 0.8, 0, 0.05, 0, 0, 0, 0.03;
+  physics::rods::Rod rod(rest, false, sec);
+  rod.set_theta(0, 0.4);
+  const TriangleSide tri{{0, 10, 11}, std::nullopt};
+  auto stencil = [&](const Points& x) {
+    VectorXd q(16);
+    q << 0, 0, 0, -1, 0.5, 0, -1, -0.5, 0, 0, 0, 0, 0, 0, 0, rod.theta()[0];
+    q.segment<3>(9) = x.col(0);
+    q.segment<3>(12) = x.col(1);
+    return q;
+  };
+  PointConnection c("swing", tri, rod_edge_side(rod, rest, 0), {1.0, 1.0}, stencil(rest));
+  const Eigen::Matrix3d step = Eigen::AngleAxisd(0.1, Vec3(0.3, 1, 0.5).normalized()).toRotationMatrix();
+  Points x = rest;
+  double worst = 0;
+  for (int k = 0; k < 20; ++k) {
+    x = step * x;
+    const VectorXd q = stencil(x);
+    const double raw = c.evaluate(q, TwistUpdate::direct, false).twist_raw;
+    const Vec3 m3(1, 0, 0), m1(0, 0, 1);  // the triangle's frame: axis into the joint, normal
+    const Vec3 n3 = (x.col(1) - x.col(0)).normalized();
+    const Vec3 n1 = rod.material_directors(x, 0).first;
+    const double expected = physics::rods::signed_angle(physics::rods::parallel_transport(m3, n3, m1), n1, n3);
+    worst = std::max(worst, std::abs(std::remainder(raw - expected, 2 * pi)));
+    c.accept(q, TwistUpdate::incremental_ii);
+    rod.update_frames(x);
+  }
+  CHECK(worst < 1e-10);
+}
