@@ -21,14 +21,6 @@ using AD = Eigen::AutoDiffScalar<Eigen::Matrix<double, 11, 1>>;
 double value_of(double v) { return v; }
 double value_of(const AD& v) { return v.value(); }
 
-// The exact transport formula; the guarded double version is parallel_transport().
-template <class T>
-V3<T> transport(const V3<T>& a, const V3<T>& b, const V3<T>& u) {
-  const T c = a.dot(b);
-  const V3<T> w = a.cross(b);
-  return c * u + w.cross(u) + (w.dot(u) / (T(1.0) + c)) * w;
-}
-
 template <class T>
 struct Core {
   T energy{};
@@ -52,8 +44,8 @@ Core<T> core(const Eigen::Matrix<T, 11, 1>& q, const BendTwistRest& r, const Ben
   const V3<T> t0 = e0 / l0, t1 = e1 / l1;
   const V3<T> tb0 = f.tangent0.cast<T>(), tb1 = f.tangent1.cast<T>();
   // Reference frames: the start-of-step directors transported to the current tangents.
-  const V3<T> a0 = transport<T>(tb0, t0, f.director0.cast<T>());
-  const V3<T> a1 = transport<T>(tb1, t1, f.director1.cast<T>());
+  const V3<T> a0 = transport_exact<T>(tb0, t0, f.director0.cast<T>());
+  const V3<T> a1 = transport_exact<T>(tb1, t1, f.director1.cast<T>());
   const V3<T> b0 = t0.cross(a0), b1 = t1.cross(a1);
   const T c0 = cos(q[9]), s0 = sin(q[9]), c1 = cos(q[10]), s1 = sin(q[10]);
   const V3<T> m1_0 = c0 * a0 + s0 * b0, m2_0 = c0 * b0 - s0 * a0;
@@ -62,7 +54,7 @@ Core<T> core(const Eigen::Matrix<T, 11, 1>& q, const BendTwistRest& r, const Ben
   const V3<T> kb = (T(2.0) / chi) * t0.cross(t1);
   const T k1 = T(0.5) * (m2_0 + m2_1).dot(kb);
   const T k2 = T(-0.5) * (m1_0 + m1_1).dot(kb);
-  const V3<T> u = transport<T>(t0, t1, a0);
+  const V3<T> u = transport_exact<T>(t0, t1, a0);
   const T raw = atan2(u.cross(a1).dot(t1), u.dot(a1));
   const double wrap = two_pi * std::round((f.reference_twist - value_of(raw)) / two_pi);
   const T mref = raw + wrap;
@@ -137,13 +129,13 @@ Vec3 any_perpendicular(const Vec3& t) {
 
 Vec3 parallel_transport(const Vec3& a, const Vec3& b, const Vec3& u) {
   const double c = a.dot(b);
-  if (1 + c > 1e-6) return transport<double>(a, b, u);
+  if (1 + c > 1e-6) return transport_exact<double>(a, b, u);
   // Nearly opposite: a half turn about p ⟂ a takes a to −a, then the (now regular) transport
   // from −a to b.
   const Vec3 p = any_perpendicular(a);
   const Vec3 a_flipped = 2 * p.dot(a) * p - a;
   const Vec3 u_flipped = 2 * p.dot(u) * p - u;
-  return transport<double>(a_flipped, b, u_flipped);
+  return transport_exact<double>(a_flipped, b, u_flipped);
 }
 
 double signed_angle(const Vec3& u, const Vec3& v, const Vec3& n) { return std::atan2(u.cross(v).dot(n), u.dot(v)); }

@@ -32,6 +32,17 @@ using Vec3 = Eigen::Vector3d;
 /// well-defined half turns; continuity in a, b is lost only there). O(1).
 [[nodiscard]] Vec3 parallel_transport(const Vec3& a, const Vec3& b, const Vec3& u);
 
+/// The exact formula c u + w×u + (w·u)/(1+c) w of P_a^b(u), for any scalar type (the
+/// connect module and the rod stencils differentiate through it with AutoDiffScalar).
+/// Unguarded: non-finite at b = −a; parallel_transport() is the guarded double version. O(1).
+template <class T>
+[[nodiscard]] Eigen::Matrix<T, 3, 1> transport_exact(const Eigen::Matrix<T, 3, 1>& a, const Eigen::Matrix<T, 3, 1>& b,
+                                                     const Eigen::Matrix<T, 3, 1>& u) {
+  const T c = a.dot(b);
+  const Eigen::Matrix<T, 3, 1> w = a.cross(b);
+  return c * u + w.cross(u) + (w.dot(u) / (T(1.0) + c)) * w;
+}
+
 /// Signed angle from u to v about the unit axis n (both ⟂ n), in (−π, π]. O(1).
 [[nodiscard]] double signed_angle(const Vec3& u, const Vec3& v, const Vec3& n);
 

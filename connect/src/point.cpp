@@ -1,0 +1,301 @@
+#include "sewn/connect/point.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+#include <unsupported/Eigen/AutoDiff>
+
+#include "sewn/physics/rods/stencils.hpp"
+
+namespace sewn::connect {
+
+namespace {
+
+using physics::InputError;
+using physics::rods::transport_exact;
+
+constexpr int max_dofs = 18;  // triangle + triangle
+constexpr double two_pi = 2 * std::numbers::pi;
+using AD = Eigen::AutoDiffScalar<Eigen::Matrix<double, max_dofs, 1>>;
+using AD2 = Eigen::AutoDiffScalar<Eigen::Matrix<AD, max_dofs, 1>>;  // second order: AD of AD
+template <class T>
+using V3 = Eigen::Matrix<T, 3, 1>;
+
+double value_of(double v) { return v; }
+double value_of(const AD& v) { return v.value(); }
+double value_of(const AD2& v) { return v.value().value(); }
+
+[[noreturn]] void fail(const std::string& name, const std::string& why) {
+  throw InputError("point connection '" + name + "': " + why);
+}
+
+std::string describe(const Side& s) {
+  std::ostringstream o;
+  if (const auto* r = std::get_if<RodEdgeSide>(&s))
+    o << "rod edge (" << r->from << ", " << r->to << ")";
+  else {
+    const auto& t = std::get<TriangleSide>(s);
+    o << "triangle (" << t.nodes[0] << ", " << t.nodes[1] << ", " << t.nodes[2] << ")";
+  }
+  return o.str();
+}
+
+std::vector<Index> side_nodes(const Side& s) {
+  if (const auto* r = std::get_if<RodEdgeSide>(&s)) return {r->from, r->to};
+  const auto& t = std::get<TriangleSide>(s);
+  return {t.nodes.begin(), t.nodes.end()};
+}
+
+int side_dofs(const Side& s) { return std::holds_alternative<RodEdgeSide>(s) ? 7 : 9; }
+
+// The one node both sides hold; rejects sides that are degenerate or share 0 or 2+ nodes.
+Index shared_node(const std::string& name, const Side& m, const Side& n) {
+  for (const Side* s : {&m, &n}) {
+    const auto v = side_nodes(*s);
+    for (std::size_t i = 0; i < v.size(); ++i)
+      for (std::size_t j = i + 1; j < v.size(); ++j)
+        if (v[i] == v[j]) fail(name, describe(*s) + " repeats node " + std::to_string(v[i]));
+  }
+  std::vector<Index> common;
+  for (Index a : side_nodes(m))
+    for (Index b : side_nodes(n))
+      if (a == b) common.push_back(a);
+  if (common.empty()) fail(name, describe(m) + " and " + describe(n) + " share no node");
+  if (common.size() > 1)
+    fail(name, describe(m) + " and " + describe(n) +
+                   " share more than one node (an edge: that is a curve connection, not a point one)");
+  return common[0];
+}
+
+// A triangle side with its nodes rotated to start at the joint (orientation kept).
+TriangleSide rotated(TriangleSide t, Index joint) {
+  while (t.nodes[0] != joint) t.nodes = {t.nodes[1], t.nodes[2], t.nodes[0]};
+  return t;
+}
+
+template <class T>
+struct Frame {
+  V3<T> m1, m2, m3;
+};
+
+// The side's frame from its stencil slice q (7 or 9 entries), axis sign and triangle coefficients.
+template <class T, class Q>
+Frame<T> build_frame(const Side& side, const Q& q, double sign, const std::array<double, 2>& coef) {
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
+  Frame<T> f;
+  if (const auto* r = std::get_if<RodEdgeSide>(&side)) {
+    const V3<T> e = q.template segment<3>(3) - q.template segment<3>(0);
+    const V3<T> t = e / sqrt(e.dot(e));
+    const V3<T> a1 = transport_exact<T>(r->tangent.cast<T>(), t, r->director.cast<T>());
+    const V3<T> a2 = t.cross(a1);
+    f.m1 = cos(q[6]) * a1 + sin(q[6]) * a2;
+    f.m3 = T(sign) * t;
+  } else {
+    const V3<T> e1 = q.template segment<3>(3) - q.template segment<3>(0);
+    const V3<T> e2 = q.template segment<3>(6) - q.template segment<3>(0);
+    const V3<T> nrm = e1.cross(e2);
+    f.m1 = nrm / sqrt(nrm.dot(nrm));
+    const V3<T> axis = T(coef[0]) * e1 + T(coef[1]) * e2;
+    f.m3 = (T(sign) / sqrt(axis.dot(axis))) * axis;
+  }
+  f.m2 = f.m3.cross(f.m1);
+  return f;
+}
+
+template <class T>
+T signed_angle_t(const V3<T>& u, const V3<T>& v, const V3<T>& axis) {
+  using std::atan2;
+  return atan2(u.cross(v).dot(axis), u.dot(v));
+}
+
+template <class T>
+struct Core {
+  T energy{};
+  double twist = 0, twist_raw = 0, bend = 0, one_plus_c = 2;
+};
+
+}  // namespace
+
+RodEdgeSide rod_edge_side(const physics::rods::Rod& rod, const physics::rods::Points& x, int edge, Index node_offset) {
+  if (edge < 0 || edge >= rod.num_edges())
+    throw InputError("rod_edge_side: edge " + std::to_string(edge) + " out of range (the rod has " +
+                     std::to_string(rod.num_edges()) + " edges)");
+  const int n = rod.num_vertices();
+  const int to = (edge + 1) % n;
+  RodEdgeSide s;
+  s.from = node_offset + static_cast<Index>(edge);
+  s.to = node_offset + static_cast<Index>(to);
+  s.tangent = (x.col(to) - x.col(edge)).normalized();
+  s.director = rod.reference_director(x, edge);
+  return s;
+}
+
+std::vector<Index> stencil_layout(const std::string& name, const Side& m, const Side& n) {
+  const Index joint = shared_node(name, m, n);
+  std::vector<Index> out;
+  for (const Side* s : {&m, &n}) {
+    if (std::holds_alternative<TriangleSide>(*s)) {
+      const auto t = rotated(std::get<TriangleSide>(*s), joint);
+      out.insert(out.end(), t.nodes.begin(), t.nodes.end());
+    } else {
+      const auto v = side_nodes(*s);
+      out.insert(out.end(), v.begin(), v.end());
+    }
+  }
+  return out;
+}
+
+PointConnection::PointConnection(std::string name, Side m, Side n, PointStiffness k, const Eigen::VectorXd& q_rest)
+    : name_(std::move(name)), m_(std::move(m)), n_(std::move(n)), k_(k) {
+  if (!std::isfinite(k_.twist) || !std::isfinite(k_.bend) || k_.twist < 0 || k_.bend < 0)
+    fail(name_, "stiffnesses must be finite and >= 0 (twist " + std::to_string(k_.twist) + ", bend " +
+                    std::to_string(k_.bend) + ")");
+  nodes_ = stencil_layout(name_, m_, n_);
+  joint_ = shared_node(name_, m_, n_);
+  dofs_m_ = side_dofs(m_);
+  dofs_n_ = side_dofs(n_);
+  if (q_rest.size() != num_dofs())
+    fail(name_, "rest configuration has " + std::to_string(q_rest.size()) + " entries, the stencil " +
+                    std::to_string(num_dofs()));
+  if (!q_rest.allFinite()) fail(name_, "rest configuration is not finite");
+
+  // Per side: geometry checks, the triangle axis coefficients, the into/out-of-joint sign.
+  auto prepare = [&](Side& s, const Eigen::VectorXd& q, std::array<double, 2>& coef, double into_joint) -> double {
+    if (auto* r = std::get_if<RodEdgeSide>(&s)) {
+      const Vec3 e = q.segment<3>(3) - q.segment<3>(0);
+      if (!(e.norm() > 0)) fail(name_, describe(s) + " has zero length at rest");
+      if (std::abs(r->tangent.norm() - 1) > 1e-9 || std::abs(r->director.norm() - 1) > 1e-9 ||
+          std::abs(r->tangent.dot(r->director)) > 1e-9)
+        fail(name_, describe(s) + ": its stored tangent and director are not an orthonormal pair");
+      const double out_sign = (r->from == joint_) ? 1.0 : -1.0;  // t points out of the joint if it starts there
+      return into_joint * out_sign;
+    }
+    auto& t = std::get<TriangleSide>(s);
+    t = rotated(t, joint_);
+    const Vec3 e1 = q.segment<3>(3) - q.segment<3>(0), e2 = q.segment<3>(6) - q.segment<3>(0);
+    const Vec3 nrm = e1.cross(e2);
+    if (!(nrm.norm() > 1e-12 * e1.norm() * e2.norm()) || !(nrm.norm() > 0))
+      fail(name_, describe(s) + " has zero area at rest: no frame can be built on it");
+    Vec3 axis = e1.normalized() + e2.normalized();
+    if (t.rest_axis) {
+      axis = *t.rest_axis;
+      if (!(axis.norm() > 0) || !axis.allFinite()) fail(name_, describe(s) + ": rest axis is zero or not finite");
+      if (std::abs(axis.normalized().dot(nrm.normalized())) > 1e-6)
+        fail(name_, describe(s) + ": rest axis is not in the triangle's plane");
+    }
+    // axis = c1 e1 + c2 e2 by the Gram system; inside the corner iff both coefficients >= 0.
+    Eigen::Matrix2d g;
+    g << e1.dot(e1), e1.dot(e2), e1.dot(e2), e2.dot(e2);
+    const Eigen::Vector2d c = g.inverse() * Eigen::Vector2d(e1.dot(axis), e2.dot(axis));
+    if (c[0] < 0 || c[1] < 0) fail(name_, describe(s) + ": rest axis lies outside the joint corner's angle");
+    coef = {c[0], c[1]};
+    return into_joint;  // the axis points from the joint into the triangle: out of the joint
+  };
+  const Eigen::VectorXd qm = q_rest.head(dofs_m_), qn = q_rest.tail(dofs_n_);
+  sign_m_ = prepare(m_, qm, coef_m_, -1.0);
+  sign_n_ = prepare(n_, qn, coef_n_, 1.0);
+  const auto fm = build_frame<double>(m_, qm, sign_m_, coef_m_);
+  const auto fn = build_frame<double>(n_, qn, sign_n_, coef_n_);
+  if (fm.m3.dot(fn.m3) < 0) sign_n_ = -sign_n_;
+  const auto fn2 = build_frame<double>(n_, qn, sign_n_, coef_n_);
+  rest_d_ = Vec3(fn2.m3.dot(fm.m1), fn2.m3.dot(fm.m2), fn2.m3.dot(fm.m3));
+  const Vec3 u = transport_exact<double>(fm.m3, fn2.m3, fm.m1);
+  rest_twist_ = signed_angle_t<double>(u, fn2.m1, fn2.m3);
+  accepted_twist_ = rest_twist_;
+}
+
+PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update, bool want_gradient,
+                                    Eigen::MatrixXd* hessian) const {
+  if (q.size() != num_dofs())
+    fail(name_, "configuration has " + std::to_string(q.size()) + " entries, the stencil " + std::to_string(num_dofs()));
+  if (!q.allFinite()) fail(name_, "configuration is not finite");
+  PointEval out;
+  auto run = [&](const auto& qt) {
+    using T = typename std::decay_t<decltype(qt)>::Scalar;
+    using std::atan2;
+    using std::cos;
+    using std::sin;
+    using std::sqrt;
+    const auto fm = build_frame<T>(m_, qt.head(dofs_m_), sign_m_, coef_m_);
+    const auto fn = build_frame<T>(n_, qt.segment(dofs_m_, dofs_n_), sign_n_, coef_n_);
+    Core<T> c;
+    c.one_plus_c = 1 + value_of(fm.m3.dot(fn.m3));
+    const T raw = signed_angle_t<T>(transport_exact<T>(fm.m3, fn.m3, fm.m1), fn.m1, fn.m3);
+    T delta = raw;
+    if (update == TwistUpdate::incremental_i) {
+      delta = raw + T(two_pi * std::round((accepted_twist_ - value_of(raw)) / two_pi));
+    } else if (update == TwistUpdate::incremental_ii) {
+      // Turn m1 by the accepted δ first: what is left to measure is the step's increment (< π).
+      const V3<T> m1t = cos(T(accepted_twist_)) * fm.m1 + sin(T(accepted_twist_)) * fm.m2;
+      delta = T(accepted_twist_) + signed_angle_t<T>(transport_exact<T>(fm.m3, fn.m3, m1t), fn.m1, fn.m3);
+    }
+    const V3<T> d(fn.m3.dot(fm.m1), fn.m3.dot(fm.m2), fn.m3.dot(fm.m3));
+    const V3<T> db = rest_d_.cast<T>();
+    const V3<T> cr = d.cross(db);
+    const T s2 = cr.dot(cr);
+    T eb;
+    if (value_of(s2) < 1e-16 && value_of(d.dot(db)) > 0) {
+      // ω < 1e-8: |d − d̄|² = 2 − 2cos ω = ω² + O(ω⁴), and smooth where sqrt(s2) is not.
+      const V3<T> dd = d - db;
+      eb = T(0.5 * k_.bend) * dd.dot(dd);
+      c.bend = value_of(sqrt(T(value_of(s2))));
+    } else {
+      const T w = atan2(sqrt(s2), d.dot(db));
+      eb = T(0.5 * k_.bend) * w * w;
+      c.bend = value_of(w);
+    }
+    const T dt = delta - T(rest_twist_);
+    c.energy = T(0.5 * k_.twist) * dt * dt + eb;
+    c.twist = value_of(delta);
+    c.twist_raw = value_of(raw);
+    return c;
+  };
+  Core<double> c;
+  if (hessian) {
+    const Eigen::Index n = q.size();
+    Eigen::Matrix<AD2, Eigen::Dynamic, 1> qa(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      qa[i].value() = AD(q[i], max_dofs, static_cast<int>(i));
+      qa[i].derivatives() = Eigen::Matrix<AD, max_dofs, 1>::Constant(AD(0.0));
+      qa[i].derivatives()[i] = AD(1.0);
+    }
+    const auto ca = run(qa);
+    c = {value_of(ca.energy), ca.twist, ca.twist_raw, ca.bend, ca.one_plus_c};
+    out.gradient = ca.energy.value().derivatives().head(n);
+    hessian->resize(n, n);
+    for (Eigen::Index j = 0; j < n; ++j) hessian->row(j) = ca.energy.derivatives()[j].derivatives().head(n).transpose();
+  } else if (want_gradient) {
+    Eigen::Matrix<AD, Eigen::Dynamic, 1> qa(q.size());
+    for (Eigen::Index i = 0; i < q.size(); ++i) qa[i] = AD(q[i], max_dofs, static_cast<int>(i));
+    const auto ca = run(qa);
+    c = {value_of(ca.energy), ca.twist, ca.twist_raw, ca.bend, ca.one_plus_c};
+    out.gradient = ca.energy.derivatives().head(q.size());
+  } else {
+    c = run(q);
+  }
+  out.energy = c.energy;
+  out.twist = c.twist;
+  out.twist_raw = c.twist_raw;
+  out.bend_angle = c.bend;
+  out.near_antiparallel = c.one_plus_c < antiparallel_margin;
+  out.bend_near_pi = c.bend > std::numbers::pi - bend_margin;
+  return out;
+}
+
+void PointConnection::accept(const Eigen::VectorXd& q, TwistUpdate update) {
+  accepted_twist_ = evaluate(q, update, false).twist;
+  auto advance = [](Side& s, const Eigen::VectorXd& qs) {
+    if (auto* r = std::get_if<RodEdgeSide>(&s)) {
+      const Vec3 t = (qs.segment<3>(3) - qs.segment<3>(0)).normalized();
+      r->director = physics::rods::parallel_transport(r->tangent, t, r->director).normalized();
+      r->tangent = t;
+    }
+  };
+  advance(m_, q.head(dofs_m_));
+  advance(n_, q.tail(dofs_n_));
+}
+
+}  // namespace sewn::connect
