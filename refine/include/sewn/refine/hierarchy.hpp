@@ -1,0 +1,62 @@
+#pragma once
+// The refinement hierarchy of the 2014 paper (PHYSICS_NOTES §2.1) as it lives on a mass-spring
+// model: every element and every edge has a level (1, 2, 4, ...: a power of two, doubled by each
+// refinement; printed as the index 1 + log2), an element's sides are its hierarchical edges,
+// each starting at a hierarchical dart (a dart at one of the element's 4 corners), and a particle
+// strictly inside a side is a T-junction of that element, slaved to the side's two corners.
+//
+// The levels are stored by the model itself (physics::Element::level, physics::SpringRef::level)
+// and the hierarchical darts by its per-dart corner codes (MssModel::is_corner_dart), so every
+// map operation run through MssModel::edit() (cuts included) keeps them where they belong.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sewn/physics/mss_model.hpp"
+
+namespace sewn::refine {
+
+using physics::Index;
+using physics::MssModel;
+
+/// The index printed for a level: 1 + log2(level) (level 1 -> 1, 2 -> 2, 4 -> 3, ...).
+[[nodiscard]] int level_index(std::uint32_t level);
+
+/// A particle strictly inside a side (hierarchical edge) of an element: its position and
+/// velocity are the linear interpolation of the side's two corners (weights 1-t and t, t the
+/// dyadic rest parameter along the side, from the side's first corner in the element's β1 order).
+struct TJunction {
+  Index node = physics::invalid_index;
+  Index element = physics::invalid_index;  ///< the element it is not a corner of
+  std::array<Index, 2> master{physics::invalid_index, physics::invalid_index};
+  double t = 0;  ///< rest parameter along the side, in (0, 1)
+};
+
+/// Every T-junction of the live quads, ordered by the level of their element, coarse to fine,
+/// so that masters that are themselves T-junctions (of a coarser element) come first.
+/// O(darts of the live quads).
+template <int D>
+[[nodiscard]] std::vector<TJunction> t_junctions(const MssModel<D>& m);
+
+/// What check_hierarchy() found: one line per violated invariant, naming the element, dart or
+/// particle.
+struct HierarchyReport {
+  std::vector<std::string> problems;
+  [[nodiscard]] bool ok() const { return problems.empty(); }
+  [[nodiscard]] std::string str() const;
+};
+
+/// Checks the hierarchy invariants of every live quad, beside the map's own validate():
+/// levels are powers of two, a child's level is twice its parent's; each element's face ring
+/// holds exactly 4 hierarchical darts, the first its canonical dart; along each side the edge
+/// levels satisfy Σ 1/l_e = 1/l_E with every l_e ≥ l_E (exact, in integers); every T-junction
+/// lies at its dyadic parameter between the side's corners at rest (to 1e-12 of the side);
+/// every particle's mass is Σ ρ·measure/4 over the elements it is a corner of, and every edge
+/// spring's stiffness is Σ k_E·l_e/l_E over the elements whose sides hold it (to 1e-12, relative).
+/// O(darts + springs).
+template <int D>
+[[nodiscard]] HierarchyReport check_hierarchy(const MssModel<D>& m);
+
+}  // namespace sewn::refine
