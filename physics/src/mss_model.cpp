@@ -497,11 +497,17 @@ std::vector<Index> MssModel<D>::element_nodes(Index e) const {
     static const CornerPaths hex = corner_paths(template_of(ElementKind::hexahedron));
     static const CornerPaths tet = corner_paths(template_of(ElementKind::tetrahedron));
     const CornerPaths& paths = el.kind == ElementKind::hexahedron ? hex : tet;
-    for (std::size_t v = 0; v < out.size(); ++v) {
+    bool on_template = true;
+    for (std::size_t v = 0; v < out.size() && on_template; ++v) {
       std::uint32_t x = el.dart.index();
       for (std::uint8_t op : paths[v]) x = map_.b(x, op);
+      on_template = dart_vertex_[x] == v;
       out[v] = node_of(Dart(x));
     }
+    if constexpr (D == 3)
+      if (!on_template)  // a refined neighbour split its faces: find the corners by their codes
+        for (Dart y : map_.template cell<3>(el.dart))
+          if (dart_vertex_[y.index()] != not_a_corner) out[dart_vertex_[y.index()]] = node_of(y);
   } else if (el.kind == ElementKind::segment) {
     out[0] = node_of(el.dart);
     out[1] = end_node(el.dart);

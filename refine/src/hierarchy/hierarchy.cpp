@@ -6,6 +6,7 @@
 #include <map>
 #include <sstream>
 
+#include "hierarchy/segment_walk.hpp"
 #include "hierarchy/sides.hpp"
 
 namespace sewn::refine {
@@ -18,6 +19,52 @@ using physics::ElementKind;
 bool is_quad(const Element& el) { return el.alive && el.kind == ElementKind::quad; }
 
 bool near(double a, double b, double scale) { return std::abs(a - b) <= 1e-12 * scale; }
+
+constexpr std::array<std::array<int, 2>, 12> hex_edges = {
+    {{0, 1}, {3, 2}, {4, 5}, {7, 6}, {0, 3}, {1, 2}, {4, 7}, {5, 6}, {0, 4}, {1, 5}, {2, 6}, {3, 7}}};
+
+// A hexahedron: 8 corners, each met by 3 of its darts; each of its 12 hierarchical edges a chain
+// of the volume's edges along the rest segment between its corners with Σ 1/l_e = 1/l_E and its
+// T-junctions at their dyadic parameters; its mass share and its edge contributions k_E·l_e/l_E.
+template <int D, class Problem>
+void check_hex(const MssModel<D>& m, Index e, std::vector<double>& mass, std::map<Index, double>& spring_k, Problem&& problem) {
+  const Element& el = m.elements()[e];
+  const std::string name = "element " + std::to_string(e);
+  const DartList vol = m.map().template cell<3>(el.dart);
+  std::array<int, 8> seen{};
+  for (Dart x : vol)
+    if (m.is_corner_dart(x)) ++seen[static_cast<std::size_t>(m.corner_of_dart(x))];
+  for (int v = 0; v < 8; ++v)
+    if (seen[static_cast<std::size_t>(v)] != 3)
+      problem(name + ": corner " + std::to_string(v) + " is met by " + std::to_string(seen[static_cast<std::size_t>(v)]) +
+              " hierarchical darts, not 3");
+  const std::vector<Index> corner = m.element_nodes(e);
+  for (Index n : corner)
+    if (n != physics::invalid_index) mass[n] += m.materials()[el.material].density * el.measure / 8;
+  for (std::size_t k = 0; k < 12; ++k) {
+    const Index a = corner[static_cast<std::size_t>(hex_edges[k][0])], b = corner[static_cast<std::size_t>(hex_edges[k][1])];
+    std::vector<Dart> path;
+    try {
+      path = detail::walk_segment(m, std::span<const Dart>(vol.data(), vol.size()), a, b);
+    } catch (const std::logic_error& ex) {
+      problem(name + ": edge " + std::to_string(k) + ": " + ex.what());
+      continue;
+    }
+    const double length = (m.rest_position(b) - m.rest_position(a)).norm();
+    const std::uint64_t side = detail::whole / el.level;
+    std::uint64_t acc = 0;
+    for (Dart x : path) {
+      const double t = static_cast<double>(acc) / static_cast<double>(side);
+      const Eigen::Vector3d expect = (1 - t) * m.rest_position(a) + t * m.rest_position(b);
+      if (!((m.rest_position(m.node_of(x)) - expect).norm() <= 1e-12 * length))
+        problem(name + ": particle " + std::to_string(m.node_of(x)) + " on edge " + std::to_string(k) + " is off its dyadic place");
+      const std::uint32_t le = detail::edge_level(m, x);
+      spring_k[m.spring_of(x)] += el.edge_k[k] * le / el.level;
+      acc += detail::whole / le;
+    }
+    if (acc != side) problem(name + ": edge " + std::to_string(k) + " does not sum Σ 1/l_e = 1/l_E");
+  }
+}
 
 }  // namespace
 
@@ -71,7 +118,12 @@ HierarchyReport check_hierarchy(const MssModel<D>& m) {
     if (el.parent != physics::invalid_index && elements[el.parent].level * 2 != el.level)
       problem(name + ": level " + std::to_string(el.level) + " is not twice its parent's");
     if (el.first_child != physics::invalid_index && el.alive) problem(name + ": refined but still alive");
-    if (el.alive && el.kind != ElementKind::quad) quads_only = false;
+    if (el.alive && el.kind != ElementKind::quad && el.kind != ElementKind::hexahedron) quads_only = false;
+    if constexpr (D == 3)
+      if (el.alive && el.kind == ElementKind::hexahedron) {
+        check_hex(m, e, mass, spring_k, problem);
+        continue;
+      }
     if (!is_quad(el)) continue;
     if (!m.is_corner_dart(el.dart)) {
       problem(name + ": its canonical dart " + std::to_string(el.dart.index()) + " is not hierarchical");

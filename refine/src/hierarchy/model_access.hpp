@@ -34,6 +34,12 @@ struct ModelAccess {
     m.dart_vertex_[d.index()] = vertex;
     m.dart_edge_[d.index()] = static_cast<std::uint8_t>(side | 0x80);  // one dart per element and edge in 2D
   }
+  /// Dart d starts at local vertex `vertex` (or not_a_corner); `code` is its local edge with
+  /// bit 7 set on the one dart per element and edge counted (MssModel's per-dart edge code).
+  static void set_codes(Model& m, Dart d, std::uint8_t vertex, std::uint8_t code) {
+    m.dart_vertex_[d.index()] = vertex;
+    m.dart_edge_[d.index()] = code;
+  }
   static std::uint8_t dart_code(const Model& m, Dart d) { return m.dart_edge_[d.index()]; }
   static void copy_code(Model& m, Dart from, Dart to, std::uint8_t vertex) {
     m.dart_vertex_[to.index()] = vertex;

@@ -178,6 +178,8 @@ class MssModel {
   /// True if dart d starts at a corner of its element (a hierarchical dart: the first dart of
   /// one of the element's sides); false if it starts at a T-junction. O(1).
   [[nodiscard]] bool is_corner_dart(Dart d) const { return dart_vertex_[d.index()] != not_a_corner; }
+  /// The local vertex of its element that dart d starts at (not_a_corner for a T-junction). O(1).
+  [[nodiscard]] int corner_of_dart(Dart d) const { return dart_vertex_[d.index()]; }
   /// The local side (local edge, see local_edges()) of its element that dart d lies on. O(1).
   [[nodiscard]] int side_of(Dart d) const { return dart_edge_[d.index()] & 0x7f; }
   /// Rest position of node i.
