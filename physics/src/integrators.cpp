@@ -141,12 +141,14 @@ StepReport SymplecticEuler::step(System& sys, double h) {
   sys.compute_forces();
   NodeTable& nodes = sys.nodes();
   if (opt_.health.check_finite) check_finite(nodes, "SymplecticEuler::step");
+  SlaveNodes& slaves = sys.slaves();  // T-junctions: forces to their masters, masses lumped there
+  if (!slaves.empty()) slaves.pass_forces(nodes.f());
   {
     const std::size_t n3 = nodes.x().size();
     double* __restrict x = nodes.x().data();
     double* __restrict v = nodes.v().data();
     const double* __restrict f = nodes.f().data();
-    const double* __restrict im = nodes.inverse_mass_dof().data();
+    const double* __restrict im = (slaves.empty() ? nodes.inverse_mass_dof() : slaves.inverse_mass_dof(nodes)).data();
     std::uint64_t bad = 0;
     for (std::size_t k = 0; k < n3; ++k) {
       v[k] += h * im[k] * f[k];
@@ -155,6 +157,7 @@ StepReport SymplecticEuler::step(System& sys, double h) {
     }
     if (bad == 0) nodes.mark_state_finite();
   }
+  if (!slaves.empty()) slaves.after_step(nodes);
   ++steps_;
   if (watch && steps_ % static_cast<std::uint64_t>(opt_.health.energy_check_interval) == 0)
     watchdog_.check(sys, opt_.health, steps_);
@@ -200,6 +203,8 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
   // 1) forces at the start of the step, checked before anything is changed
   sys.compute_forces();
   if (opt_.health.check_finite) check_finite(nodes, "LinearlyImplicitEuler::step");
+  SlaveNodes& slaves = sys.slaves();  // T-junctions: the paper's shares here, or the reduced solve below
+  if (!slaves.empty() && !slaves.reduces()) slaves.pass_forces(nodes.f());
 
   // 2) A = M - h ∂F/∂V - h² ∂F/∂P into the reused pattern, and ∂F/∂P·V₀ in the same pass
   BlockMatrix& A = sys.matrix();
@@ -227,7 +232,9 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
     if (!opt_.warm_start || free_[k] == 0.0) dv_[k] = 0.0;
   }
   block_jacobi_inverse(A, free_, precond_);
-  const CgResult cg = filtered_pcg(A, b_, dv_, free_, precond_, opt_.cg_tolerance, opt_.cg_max_iterations, ws_);
+  const CgResult cg = slaves.reduces()
+                         ? slaves.solve_reduced(A, b_, dv_, free_, precond_, opt_.cg_tolerance, opt_.cg_max_iterations)
+                         : filtered_pcg(A, b_, dv_, free_, precond_, opt_.cg_tolerance, opt_.cg_max_iterations, ws_);
   rep.cg_iterations = cg.iterations;
   rep.cg_relative_residual = cg.relative_residual;
   rep.cg_converged = cg.converged;
@@ -256,6 +263,7 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
     }
     if (bad == 0) nodes.mark_state_finite();
   }
+  if (!slaves.empty()) slaves.after_step(nodes);
   ++steps_;
   if (watch && steps_ % static_cast<std::uint64_t>(opt_.health.energy_check_interval) == 0)
     watchdog_.check(sys, opt_.health, steps_);

@@ -77,32 +77,6 @@ std::string HierarchyReport::str() const {
 }
 
 template <int D>
-std::vector<TJunction> t_junctions(const MssModel<D>& m) {
-  std::vector<TJunction> out;
-  std::vector<std::uint32_t> level_of;  // per entry of out, for the coarse-to-fine order
-  for (Index e = 0; e < m.elements().size(); ++e) {
-    const Element& el = m.elements()[e];
-    if (!is_quad(el)) continue;
-    const auto c = detail::corner_darts(m, el);
-    for (int k = 0; k < 4; ++k) {
-      const Dart end = c[static_cast<std::size_t>((k + 1) % 4)];
-      const std::uint64_t side = detail::whole / el.level;
-      std::uint64_t acc = 0;
-      for (Dart x = c[static_cast<std::size_t>(k)]; x != end; x = m.map().beta(x, 1)) {
-        if (x != c[static_cast<std::size_t>(k)])
-          out.push_back({m.node_of(x), e, {m.node_of(c[static_cast<std::size_t>(k)]), m.node_of(end)},
-                         static_cast<double>(acc) / static_cast<double>(side)});
-        acc += detail::whole / detail::edge_level(m, x);
-      }
-    }
-  }
-  std::stable_sort(out.begin(), out.end(), [&](const TJunction& a, const TJunction& b) {
-    return m.elements()[a.element].level < m.elements()[b.element].level;
-  });
-  return out;
-}
-
-template <int D>
 HierarchyReport check_hierarchy(const MssModel<D>& m) {
   HierarchyReport r;
   auto problem = [&](const std::string& s) { r.problems.push_back(s); };
@@ -178,8 +152,6 @@ HierarchyReport check_hierarchy(const MssModel<D>& m) {
   return r;
 }
 
-template std::vector<TJunction> t_junctions(const MssModel<2>&);
-template std::vector<TJunction> t_junctions(const MssModel<3>&);
 template HierarchyReport check_hierarchy(const MssModel<2>&);
 template HierarchyReport check_hierarchy(const MssModel<3>&);
 

@@ -61,6 +61,7 @@ RefineReport refine_elements(MssModel<D>& m, std::span<const Index> elements, co
     }
     detail::ModelAccess<D>::set_refining(m, false);
   }
+  if (!elements.empty()) constrain_t_junctions(m, m.system().slaves().treatment());
   return report;
 }
 

@@ -24,21 +24,29 @@ using physics::MssModel;
 /// The index printed for a level: 1 + log2(level) (level 1 -> 1, 2 -> 2, 4 -> 3, ...).
 [[nodiscard]] int level_index(std::uint32_t level);
 
-/// A particle strictly inside a side (hierarchical edge) of an element: its position and
-/// velocity are the linear interpolation of the side's two corners (weights 1-t and t, t the
-/// dyadic rest parameter along the side, from the side's first corner in the element's β1 order).
+/// A particle strictly inside a side (border T-junction) or, in 3D, strictly inside a face
+/// (middle T-junction) of a live element: its position and velocity are the linear (bilinear)
+/// interpolation of the side's 2 (the face's 4) corners, with weights from its dyadic rest place.
 struct TJunction {
   Index node = physics::invalid_index;
-  Index element = physics::invalid_index;  ///< the element it is not a corner of
-  std::array<Index, 2> master{physics::invalid_index, physics::invalid_index};
-  double t = 0;  ///< rest parameter along the side, in (0, 1)
+  Index element = physics::invalid_index;  ///< the coarsest element it is not a corner of
+  int masters = 2;                          ///< 2 (border) or 4 (middle)
+  std::array<Index, 4> master{physics::invalid_index, physics::invalid_index, physics::invalid_index, physics::invalid_index};
+  std::array<double, 4> weight{};
 };
 
-/// Every T-junction of the live quads, ordered by the level of their element, coarse to fine,
-/// so that masters that are themselves T-junctions (of a coarser element) come first.
-/// O(darts of the live quads).
+/// Every T-junction of the live quads and hexahedra, once each (from the coarsest element it
+/// lies strictly inside a side or face of), ordered coarse to fine, so that masters that are
+/// themselves T-junctions come first. O(darts of the live elements).
 template <int D>
 [[nodiscard]] std::vector<TJunction> t_junctions(const MssModel<D>& m);
+
+/// Makes the T-junctions the system's slave nodes (physics::SlaveNodes) with the given
+/// treatment: the virtual-work reduction, or the 2014 paper's equal force shares among the
+/// particles of the elements the T-junction is a corner of, then projection. refine_element()
+/// calls it after every refinement with the treatment in place. O(model).
+template <int D>
+void constrain_t_junctions(MssModel<D>& m, physics::SlaveTreatment treatment);
 
 /// What check_hierarchy() found: one line per violated invariant, naming the element, dart or
 /// particle.
