@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include "sewn/physics/integrators.hpp"
+#include "sewn/refine/criterion.hpp"
 #include "sewn/refine/hierarchy.hpp"
 #include "sewn/refine/subdivide.hpp"
 
@@ -181,4 +182,30 @@ TEST_CASE("T-junctions: nested T-junctions are listed coarse to fine and bad sla
   bad[0].weight[0] += 0.1;
   CHECK_THROWS_WITH_AS(sn.set(bad), doctest::Contains("weights sum"), InputError);
   CHECK_NOTHROW(sn.set(s));
+}
+
+TEST_CASE("adaptive refinement: the diagonal-strain criterion refines strained elements, one level per step") {
+  MssModel<2> m(quad_grid(4, 1, {{0.1, 0.1, 1}, {}}), {material}, {}, free_body());
+  // stretch the right end: only the last element's diagonals strain
+  for (Index i = 0; i < m.nodes().size(); ++i)
+    if (m.rest_position(i).x() > 0.35) m.nodes().set_position(i, m.rest_position(i) + Vector3d(0.005, 0, 0));
+  const DiagonalStrain<2> criterion(2.0);
+  CHECK(DiagonalStrain<2>::strain_percent(m, 3) > 2.0);
+  CHECK(DiagonalStrain<2>::strain_percent(m, 0) == 0.0);
+  RefineOptions o;
+  o.max_level = 3;
+  const RefineReport r1 = adapt(m, criterion, o);
+  CHECK(r1.elements == 1);
+  CHECK(m.elements()[3].first_child != invalid_index);
+  const auto report = check_hierarchy(m);
+  INFO(report.str());
+  CHECK(report.ok());
+  // the children of the strained element hold the same strain (rest data is exact): next call refines
+  // them, once each, and then the maximum level stops it
+  const RefineReport r2 = adapt(m, criterion, o);
+  CHECK(r2.elements >= 1);
+  for (Index c : r2.children) CHECK(level_index(m.elements()[c].level) == 3);
+  CHECK(adapt(m, criterion, o).elements == 0);
+  CHECK(check_hierarchy(m).ok());
+  CHECK_THROWS_AS(DiagonalStrain<2>(0.0), InputError);
 }
