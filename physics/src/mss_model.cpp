@@ -621,13 +621,17 @@ void MssModel<D>::install_hooks() {
   map_.template on_split<2>([this, unsupported](AttrId<2>, AttrId<2>) {
     if (!refining_) unsupported("an element was split in two");
   });
-  map_.template on_merge<2>([unsupported](AttrId<2>, AttrId<2>) { unsupported("two elements were merged"); });
+  map_.template on_merge<2>([this, unsupported](AttrId<2>, AttrId<2>) {
+    if (!refining_) unsupported("two elements were merged");
+  });
   map_.template on_erase<2>([this, element_erased](AttrId<2> gone) { element_erased(map_.value(gone).element); });
   if constexpr (D == 3) {
     map_.template on_split<3>([this, unsupported](AttrId<3>, AttrId<3>) {
       if (!refining_) unsupported("an element was split in two");
     });
-    map_.template on_merge<3>([unsupported](AttrId<3>, AttrId<3>) { unsupported("two elements were merged"); });
+    map_.template on_merge<3>([this, unsupported](AttrId<3>, AttrId<3>) {
+      if (!refining_) unsupported("two elements were merged");
+    });
     map_.template on_erase<3>([this, element_erased](AttrId<3> gone) { element_erased(map_.value(gone).element); });
   }
 }

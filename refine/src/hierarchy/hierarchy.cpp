@@ -140,6 +140,22 @@ HierarchyReport check_hierarchy(const MssModel<D>& m) {
                 ", not 1/l_E = " + std::to_string(1.0 / el.level));
     }
   }
+  // every live diagonal spring belongs to a live element and joins two of its corners at rest distance
+  std::vector<char> owned(m.springs().size(), 0);
+  for (Index e = 0; e < elements.size(); ++e) {
+    if (!elements[e].alive) continue;
+    for (Index d : elements[e].diagonal)
+      if (d != physics::invalid_index) {
+        owned[d] = 1;
+        const double rest = (m.rest_position(m.springs().node_j(d)) - m.rest_position(m.springs().node_i(d))).norm();
+        if (!(rest > 0) || !near(m.springs().rest_length(d), rest, rest))
+          problem("element " + std::to_string(e) + ": diagonal spring " + std::to_string(d) + " has rest length " +
+                  std::to_string(m.springs().rest_length(d)) + " between particles " + std::to_string(rest) + " apart");
+      }
+  }
+  for (Index s = 0; s < m.springs().size(); ++s)
+    if (m.springs().is_alive(s) && m.springs().kind(s) == physics::SpringKind::diagonal && !owned[s])
+      problem("diagonal spring " + std::to_string(s) + " belongs to no live element");
   if (!quads_only) return r;
   for (Index i = 0; i < nodes.size(); ++i)
     if (nodes.is_alive(i) && !near(nodes.mass(i), mass[i], mass[i]))

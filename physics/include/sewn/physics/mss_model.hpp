@@ -251,7 +251,7 @@ class MssModel {
   std::uint32_t generation_ = 0;
   std::vector<std::uint32_t> seen_edge_, seen_element_, seen_node_, seen_spring_;
   std::string unsupported_;  // an edit the model cannot follow (element merge), reported by resync
-  bool refining_ = false;    // element splits are refinement, which sets up the children itself
+  bool refining_ = false;    // element splits and merges are refinement and coarsening, which set up the elements
 
   friend struct refine::detail::ModelAccess<D>;
 };
