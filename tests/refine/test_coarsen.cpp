@@ -176,3 +176,46 @@ TEST_CASE("coarsen: refused with the reason, the model unchanged") {
   CHECK(state() == after_cut);
   check_all(m);
 }
+
+TEST_CASE("cut and refine: seeded random refine / coarsen / cut sequences") {
+  for (unsigned seed : {1u, 2u, 3u, 4u}) {
+    CAPTURE(seed);
+    MssModel<2> m(quad_grid(3, 3, {{0.1, 0.1, 1}, {}}), {material}, {}, options());
+    const double mass0 = m.node_mass();
+    std::mt19937 rng(seed);
+    RefineOptions o;
+    o.max_level = 4;
+    int cuts = 0, refused = 0;
+    for (int step = 0; step < 40; ++step) {
+      CAPTURE(step);
+      std::vector<Index> leaves, families;
+      for (Index e = 0; e < m.elements().size(); ++e) {
+        if (m.elements()[e].alive && level_index(m.elements()[e].level) < o.max_level) leaves.push_back(e);
+        if (can_coarsen(m, e)) families.push_back(e);
+      }
+      const int op = std::uniform_int_distribution<int>(0, 3)(rng);
+      if (op <= 1 && !leaves.empty()) {
+        (void)refine_element(m, leaves[std::uniform_int_distribution<std::size_t>(0, leaves.size() - 1)(rng)], o);
+      } else if (op == 2 && !families.empty()) {
+        (void)coarsen(m, families[std::uniform_int_distribution<std::size_t>(0, families.size() - 1)(rng)]);
+      } else {
+        const auto inner = inner_facets(m);
+        if (inner.empty()) continue;
+        const Facet f = inner[std::uniform_int_distribution<std::size_t>(0, inner.size() - 1)(rng)];
+        const Index a = m.element_of(f.dart), b = m.element_of(m.map().beta(f.dart, 2));
+        const auto before = std::make_tuple(m.map().num_darts(), m.nodes().num_alive(), m.springs().size(), m.node_mass());
+        if (m.elements()[a].level == m.elements()[b].level) {
+          (void)cut(m, std::vector<Facet>{f});
+          ++cuts;
+        } else {  // across a level jump: refused, the model unchanged
+          CHECK_THROWS_WITH_AS(cut(m, std::vector<Facet>{f}), doctest::Contains("level jump"), InputError);
+          CHECK(before == std::make_tuple(m.map().num_darts(), m.nodes().num_alive(), m.springs().size(), m.node_mass()));
+          ++refused;
+        }
+      }
+      check_all(m);
+      CHECK(std::abs(m.node_mass() - mass0) <= 1e-13 * mass0);
+    }
+    CHECK(cuts > 0);
+  }
+}

@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "sewn/physics/integrators.hpp"
+#include "sewn/refine/cut.hpp"
 #include "sewn/refine/hierarchy.hpp"
 #include "sewn/refine/subdivide.hpp"
 
@@ -204,4 +205,36 @@ TEST_CASE("refine hexahedra: tetrahedra and quads of a 3-map are refused, the mo
   one.max_level = 1;
   CHECK_THROWS_WITH_AS(refine_element(hexes, 0, one), doctest::Contains("maximum level 1"), InputError);
   CHECK(hexes.nodes().num_alive() == 8);
+}
+
+TEST_CASE("refine hexahedra and cut: seeded random refine / cut sequences") {
+  for (unsigned seed : {1u, 2u}) {
+    CAPTURE(seed);
+    MssModel<3> m(grid(2, 2, 2, 1.0), {material}, {}, no_gravity());
+    const double mass0 = m.node_mass();
+    std::mt19937 rng(seed);
+    RefineOptions o;
+    o.max_level = 3;
+    int cuts = 0;
+    for (int step = 0; step < 12; ++step) {
+      CAPTURE(step);
+      if (std::uniform_int_distribution<int>(0, 1)(rng) == 0) {
+        std::vector<Index> can;
+        for (Index e : live(m))
+          if (level_index(m.elements()[e].level) < o.max_level) can.push_back(e);
+        if (!can.empty()) (void)refine_element(m, can[std::uniform_int_distribution<std::size_t>(0, can.size() - 1)(rng)], o);
+      } else {
+        // faces between elements of one level (a cut across a level jump is refused, see the 2D test)
+        std::vector<Facet> same;
+        for (const Facet& f : inner_facets(m))
+          if (m.elements()[m.element_of(f.dart)].level == m.elements()[m.element_of(m.map().beta(f.dart, 3))].level) same.push_back(f);
+        if (same.empty()) continue;
+        (void)cut(m, std::vector<Facet>{same[std::uniform_int_distribution<std::size_t>(0, same.size() - 1)(rng)]});
+        ++cuts;
+      }
+      check_all(m);
+      CHECK(std::abs(m.node_mass() - mass0) <= 1e-13 * mass0);
+    }
+    CHECK(cuts > 0);
+  }
 }
