@@ -56,14 +56,16 @@ struct HierarchyReport {
   [[nodiscard]] std::string str() const;
 };
 
-/// Checks the hierarchy invariants of every live quad, beside the map's own validate():
-/// levels are powers of two, a child's level is twice its parent's; each element's face ring
-/// holds exactly 4 hierarchical darts, the first its canonical dart; along each side the edge
-/// levels satisfy Σ 1/l_e = 1/l_E with every l_e ≥ l_E (exact, in integers); every T-junction
-/// lies at its dyadic parameter between the side's corners at rest (to 1e-12 of the side);
-/// every particle's mass is Σ ρ·measure/4 over the elements it is a corner of, and every edge
-/// spring's stiffness is Σ k_E·l_e/l_E over the elements whose sides hold it (to 1e-12, relative).
-/// O(darts + springs).
+/// Checks the hierarchy invariants of every live element, beside the map's own validate():
+/// levels are powers of two, a child's level is twice its parent's, a refined element is not
+/// alive. Quads: the face ring holds exactly 4 hierarchical darts, the first the canonical dart.
+/// Hexahedra: each corner is met by 3 hierarchical darts. Along each side (hierarchical edge)
+/// the edge levels satisfy Σ 1/l_e = 1/l_E with every l_e ≥ l_E (exact, in integers) and every
+/// particle inside lies at its dyadic parameter between the side's corners at rest (to 1e-12 of
+/// the side). Every diagonal spring belongs to a live element, at its rest distance. When all
+/// live elements are quads or hexahedra: every particle's mass is Σ ρ·measure/c over the
+/// elements it is a corner of, and every edge spring's stiffness is Σ k_E·l_e/l_E over the
+/// elements whose sides hold it (to 1e-12, relative). O(darts + springs).
 template <int D>
 [[nodiscard]] HierarchyReport check_hierarchy(const MssModel<D>& m);
 
