@@ -209,3 +209,29 @@ TEST_CASE("adaptive refinement: the diagonal-strain criterion refines strained e
   CHECK(check_hierarchy(m).ok());
   CHECK_THROWS_AS(DiagonalStrain<2>(0.0), InputError);
 }
+
+TEST_CASE("adaptive refinement: the adapter refines under strain and coarsens back after the hysteresis") {
+  MssModel<2> m(quad_grid(4, 1, {{0.1, 0.1, 1}, {}}), {material}, {}, free_body());
+  const Index particles0 = m.nodes().num_alive();
+  const DiagonalStrain<2> criterion(2.0);
+  Adapter<2>::Options o;
+  o.refine.max_level = 2;
+  o.calm_steps = 3;
+  Adapter<2> adapter(criterion, o);
+  auto stretch = [&](double dx) {
+    for (Index i = 0; i < m.nodes().size(); ++i)
+      if (m.nodes().is_alive(i)) {
+        const Vector3d r = m.rest_position(i);
+        m.nodes().set_position(i, r + Vector3d(r.x() > 0.35 ? dx * (r.x() - 0.3) / 0.1 : 0, 0, 0));
+      }
+  };
+  stretch(0.005);
+  CHECK(adapter.update(m).refined.elements == 1);
+  CHECK(adapter.update(m).refined.elements == 0);  // at the maximum level
+  stretch(0.0);                                     // released: calm from now on
+  for (int s = 0; s < 2; ++s) CHECK(adapter.update(m).coarsened == 0);
+  const auto r = adapter.update(m);
+  CHECK(r.coarsened == 1);
+  CHECK(m.nodes().num_alive() == particles0);
+  CHECK(check_hierarchy(m).ok());
+}

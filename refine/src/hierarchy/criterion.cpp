@@ -51,6 +51,31 @@ RefineReport adapt(MssModel<D>& m, const Criterion<D>& criterion, const RefineOp
   return refine_elements(m, std::span<const Index>(chosen), options);
 }
 
+template <int D>
+typename Adapter<D>::Report Adapter<D>::update(MssModel<D>& m) {
+  Report r;
+  r.refined = adapt(m, criterion_, options_.refine);
+  if (!options_.coarsen) return r;
+  calm_.resize(m.elements().size(), 0);
+  for (Index e = 0; e < m.elements().size(); ++e) {
+    const physics::Element& el = m.elements()[e];
+    calm_[e] = el.alive && criterion_.allows_coarsening(m, e) ? calm_[e] + 1 : 0;
+  }
+  for (Index p = 0; p < m.elements().size(); ++p) {
+    if (!can_coarsen(m, p)) continue;
+    const Index first = m.elements()[p].first_child;
+    bool calm = true;
+    for (Index c = first; c < first + 4; ++c) calm = calm && calm_[c] >= options_.calm_steps;
+    if (!calm) continue;
+    r.dissipated_energy += coarsen(m, p).dissipated_energy;
+    ++r.coarsened;
+    calm_[p] = 0;
+  }
+  return r;
+}
+
+template class Adapter<2>;
+template class Adapter<3>;
 template class DiagonalStrain<2>;
 template class DiagonalStrain<3>;
 template RefineReport adapt(MssModel<2>&, const Criterion<2>&, const RefineOptions&);

@@ -4,9 +4,11 @@
 // never past the maximum level. The 2014 paper's criterion is the strain of the diagonals;
 // others (strain energy, distance to a tool, a user region) implement Criterion.
 
+#include <cstdint>
 #include <vector>
 
 #include "sewn/physics/mss_model.hpp"
+#include "sewn/refine/coarsen.hpp"
 #include "sewn/refine/subdivide.hpp"
 
 namespace sewn::refine {
@@ -44,5 +46,33 @@ class DiagonalStrain : public Criterion<D> {
 /// the refinements.
 template <int D>
 RefineReport adapt(MssModel<D>& m, const Criterion<D>& criterion, const RefineOptions& options = {});
+
+/// Refinement and coarsening driven step by step (PHYSICS_NOTES §2.7-2.8): call update() after
+/// each accepted step. It refines what the criterion wants (adapt()), then counts, per live leaf,
+/// the consecutive updates the criterion allowed coarsening (hysteresis), and coarsens every
+/// family whose children have all been calm for `calm_steps` updates and that can_coarsen().
+/// Families of hexahedra are not coarsened (not available yet). O(elements · criterion) plus the
+/// operations.
+template <int D>
+class Adapter {
+ public:
+  struct Options {
+    RefineOptions refine;
+    int calm_steps = 20;
+    bool coarsen = true;
+  };
+  struct Report {
+    RefineReport refined;
+    std::uint32_t coarsened = 0;
+    double dissipated_energy = 0;  ///< J, by the coarsenings
+  };
+  Adapter(const Criterion<D>& criterion, Options options) : criterion_(criterion), options_(options) {}
+  Report update(MssModel<D>& m);
+
+ private:
+  const Criterion<D>& criterion_;
+  Options options_;
+  std::vector<int> calm_;  // per element
+};
 
 }  // namespace sewn::refine
