@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "sewn/physics/integrators.hpp"
+#include "sewn/refine/cut.hpp"
 #include "sewn/refine/hierarchy.hpp"
 #include "sewn/refine/subdivide.hpp"
 
@@ -262,6 +263,12 @@ TEST_CASE("refine: bad requests are refused with the reason, the model unchanged
   RefineOptions silly;
   silly.max_level = 0;
   refused(1, silly, "max_level 0");
+
+  MssModel<2> pierced(grid(3, 1, 0.2, 0.2), {material}, {}, no_gravity());
+  const std::vector<Index> gone{1};
+  (void)pierce(pierced, gone, true);
+  CHECK_THROWS_WITH_AS(refine_element(pierced, 1), doctest::Contains("was removed"), InputError);
+  CHECK(pierced.map().validate().ok());
 
   MssModel<2> tris(tri_grid(2, 2), {material}, {}, no_gravity());
   CHECK_THROWS_WITH_AS(refine_element(tris, 0), doctest::Contains("triangle"), InputError);
