@@ -14,6 +14,7 @@
 #include "hierarchy/refiner_base.hpp"
 #include "hierarchy/segment_walk.hpp"
 #include "hierarchy/sides.hpp"
+#include "hierarchy/hex_codes.hpp"
 
 namespace sewn::refine::detail {
 
@@ -34,14 +35,6 @@ int corner_of(const Lat& p) {
   for (int v = 0; v < 8; ++v)
     if (corner_lattice[static_cast<std::size_t>(v)] == p) return v;
   throw std::logic_error("refine: not a corner of the lattice");
-}
-
-// Where the rest point r lies on the segment [a, b]: its parameter, or -1 if off the segment.
-double on_segment(const Eigen::Vector3d& r, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const Eigen::Vector3d u = b - a, w = r - a;
-  const double l2 = u.squaredNorm(), t = w.dot(u) / l2;
-  if (t < -1e-9 || t > 1 + 1e-9 || (w - t * u).squaredNorm() > 1e-18 * l2) return -1;
-  return t;
 }
 
 class HexRefiner : RefinerBase<3> {
@@ -188,31 +181,9 @@ class HexRefiner : RefinerBase<3> {
       const Dart dart = walk_segment(m_, std::span<const Dart>(vol.data(), vol.size()), corner[0], corner[1]).front();
       elements.push_back(make_child(parent, e, dart, corner));
       map_.template set_attribute<3>(dart, physics::ElementRef{first + static_cast<Index>(v)});
-      code_volume(vol, corner);
+      code_hex_volume(m_, vol, corner);
     }
     retire(e, first, 8);
-  }
-
-  // Codes every dart of a child: its corner (or none), and the child edge it lies on, flagged on
-  // the dart running from the lower to the higher local vertex (MssModel's convention); a dart
-  // inside a face (a finer neighbour's) lies on no edge of the child.
-  void code_volume(const DartList& vol, const std::array<Index, 8>& corner) {
-    for (Dart x : vol) {
-      const Index s = m_.node_of(x), t = end_node(m_, x);
-      std::uint8_t vertex = physics::not_a_corner, code = 0;
-      for (std::size_t w = 0; w < 8; ++w)
-        if (corner[w] == s) vertex = static_cast<std::uint8_t>(w);
-      for (std::size_t k = 0; k < 12; ++k) {
-        const auto [a, b] = hex_edges[k];
-        const Eigen::Vector3d ra = m_.rest_position(corner[a]), rb = m_.rest_position(corner[b]);
-        const double ts = on_segment(m_.rest_position(s), ra, rb), tt = on_segment(m_.rest_position(t), ra, rb);
-        if (ts < 0 || tt < 0) continue;
-        code = static_cast<std::uint8_t>(k | ((tt > ts) == (a < b) ? 0x80 : 0));
-        break;
-      }
-      A::set_codes(m_, x, vertex, code);
-      A::mark_vertex_dirty(m_, x);
-    }
   }
 
   Element make_child(const Element& parent, Index e, Dart dart, const std::array<Index, 8>& corner) const {
