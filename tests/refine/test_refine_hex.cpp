@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "sewn/physics/integrators.hpp"
+#include "sewn/refine/coarsen.hpp"
 #include "sewn/refine/cut.hpp"
 #include "sewn/refine/hierarchy.hpp"
 #include "sewn/refine/subdivide.hpp"
@@ -237,4 +238,80 @@ TEST_CASE("refine hexahedra and cut: seeded random refine / cut sequences") {
     }
     CHECK(cuts > 0);
   }
+}
+
+TEST_CASE("coarsen hexahedra: refine then coarsen gives back the model, momentum kept") {
+  MssModel<3> m(grid(3, 2, 1, 1.0), {material}, {}, no_gravity());
+  const Snapshot original = snapshot(m);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (Index i = 0; i < m.nodes().size(); ++i) m.nodes().set_velocity(i, Vector3d(u(rng), u(rng), u(rng)));
+  const RefineReport r0 = refine_element(m, 1);
+  (void)refine_element(m, 0);  // the neighbour: shares a split face with element 1
+  (void)refine_element(m, r0.children[0]);
+  check_all(m);
+  for (Index i = 0; i < m.nodes().size(); ++i)
+    if (m.nodes().is_alive(i)) m.nodes().set_velocity(i, m.nodes().velocity(i) + 0.2 * Vector3d(u(rng), u(rng), u(rng)));
+  m.system().slaves().after_step(m.nodes());
+  const double mass0 = m.node_mass();
+  const Vector3d p0 = momentum(m.nodes());
+  std::string why;
+  CHECK(!can_coarsen(m, 1, &why));
+  CHECK(why.find("refined further") != std::string::npos);
+  for (Index e : {r0.children[0], Index{1}, Index{0}}) {
+    CAPTURE(e);
+    const CoarsenReport c = coarsen(m, e);
+    check_all(m);
+    CHECK(c.dissipated_energy >= 0);
+    CHECK(std::abs(m.node_mass() - mass0) <= 1e-13 * mass0);
+    CHECK((momentum(m.nodes()) - p0).norm() <= 1e-12 * p0.norm());
+  }
+
+  const Snapshot back = snapshot(m);
+  REQUIRE(back.node.size() == original.node.size());
+  REQUIRE(back.spring.size() == original.spring.size());
+  for (const auto& [k, v] : back.spring) {
+    REQUIRE(original.spring.count(k) == 1);
+    CHECK(close(v[0], original.spring.at(k)[0]));
+    CHECK(close(v[1], original.spring.at(k)[1]));
+  }
+  CHECK(t_junctions(m).empty());
+}
+
+TEST_CASE("coarsen hexahedra: seeded random refine / coarsen sequences end where they began") {
+  MssModel<3> m(grid(2, 2, 1, 1.0), {material}, {}, no_gravity());
+  const Snapshot original = snapshot(m);
+  const double mass0 = m.node_mass();
+  std::mt19937 rng(4);
+  RefineOptions o;
+  o.max_level = 3;
+  for (int step = 0; step < 14; ++step) {
+    CAPTURE(step);
+    std::vector<Index> leaves, families;
+    for (Index e = 0; e < m.elements().size(); ++e) {
+      if (m.elements()[e].alive && level_index(m.elements()[e].level) < o.max_level) leaves.push_back(e);
+      if (can_coarsen(m, e)) families.push_back(e);
+    }
+    if (families.empty() || (!leaves.empty() && std::uniform_int_distribution<int>(0, 2)(rng) > 0)) {
+      const Index e = leaves[std::uniform_int_distribution<std::size_t>(0, leaves.size() - 1)(rng)];
+      (void)refine_element(m, e, o);
+    } else {
+      const Index e = families[std::uniform_int_distribution<std::size_t>(0, families.size() - 1)(rng)];
+      (void)coarsen(m, e);
+    }
+    check_all(m);
+    CHECK(std::abs(m.node_mass() - mass0) <= 1e-13 * mass0);
+  }
+  for (bool any = true; any;) {
+    any = false;
+    for (Index e = 0; e < m.elements().size(); ++e)
+      if (can_coarsen(m, e)) {
+        (void)coarsen(m, e);
+        check_all(m);
+        any = true;
+      }
+  }
+  const Snapshot back = snapshot(m);
+  CHECK(back.node.size() == original.node.size());
+  CHECK(back.spring.size() == original.spring.size());
 }

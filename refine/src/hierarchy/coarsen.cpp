@@ -5,6 +5,7 @@
 #include <map>
 #include <string>
 
+#include "hierarchy/coarsen_detail.hpp"
 #include "hierarchy/model_access.hpp"
 #include "sewn/physics/errors.hpp"
 #include "sewn/refine/hierarchy.hpp"
@@ -45,12 +46,21 @@ bool can_coarsen(const MssModel<D>& m, Index p, std::string* why) {
   if (p >= m.elements().size()) return no("does not exist");
   const Element& el = m.elements()[p];
   if (el.first_child == physics::invalid_index) return no("is not refined (no family to merge)");
-  if constexpr (D == 3) return no("is a hexahedron: coarsening 1:8 families is not available yet");
-  if (el.kind != ElementKind::quad) return no("is not a quad");
-  for (Index c = el.first_child; c < el.first_child + 4; ++c) {
+  const bool hex = el.kind == ElementKind::hexahedron;
+  if (el.kind != ElementKind::quad && !hex) return no("is neither a quad nor a hexahedron");
+  const Index n = hex ? 8 : 4;
+  for (Index c = el.first_child; c < el.first_child + n; ++c) {
     const Element& ch = m.elements()[c];
     if (ch.first_child != physics::invalid_index) return no("has child " + std::to_string(c) + " refined further: coarsen it first");
     if (!ch.alive) return no("has child " + std::to_string(c) + " removed");
+  }
+  if constexpr (D == 3) {  // a cut between siblings: an interior face (all hold the centre) left free
+    const Index centre = m.element_nodes(el.first_child)[6];
+    for (Index c = el.first_child; c < el.first_child + 8; ++c)
+      for (Dart x : m.map().template cell<3>(m.elements()[c].dart))
+        if (m.node_of(x) == centre && m.map().beta(x, 3).is_null())
+          return no("has a cut between its children (child " + std::to_string(c) + "): a cut family stays refined");
+    return true;
   }
   // a cut between siblings: an interior edge (from the centre) left free
   const Index centre = m.element_nodes(el.first_child)[2];
@@ -71,7 +81,10 @@ CoarsenReport coarsen(MssModel<D>& m, Index p) {
   std::string why;
   if (!can_coarsen(m, p, &why)) throw physics::InputError(why);
   CoarsenReport report;
-  if constexpr (D == 2) {
+  if constexpr (D == 3) {
+    report = detail::coarsen_hex(m, p);
+    constrain_t_junctions(m, m.system().slaves().treatment());
+  } else {
     using A = detail::ModelAccess<2>;
     auto& map = A::map(m);
     physics::NodeTable& nodes = m.nodes();
@@ -92,9 +105,7 @@ CoarsenReport coarsen(MssModel<D>& m, Index p) {
         if (before.emplace(n, std::make_pair(nodes.mass(n), nodes.velocity(n))).second)
           ke_before += 0.5 * nodes.mass(n) * nodes.velocity(n).squaredNorm();
     std::array<bool, 4> mid_kept{};
-    A::set_refining(m, true);
-    try {
-      m.edit([&](auto&) {
+    detail::A_edit(m, [&] {
         const Dart ring0 = m.elements()[first].dart;
         // 1) the edges centre-midpoint 1 and centre-midpoint 3 (the last inserted), merging the
         //    children pairwise, 2) the centre, joining the two halves of the middle edge, 3) that edge
@@ -108,21 +119,8 @@ CoarsenReport coarsen(MssModel<D>& m, Index p) {
           if (m.node_of(map.beta(y, 1)) == mid[2]) across = y;
         map.template remove_cell<1>(across);
         // 4) the parent back: its face, its corners' codes, its diagonals
-        A::grow_darts(m);
-        auto& elements = A::elements(m);
-        for (Index c = first; c < first + 4; ++c) {
-          elements[c].alive = false;
-          for (Index& s : elements[c].diagonal)
-            if (s != physics::invalid_index) {
-              m.springs().remove(s);
-              s = physics::invalid_index;
-            }
-        }
-        Element& el = elements[p];
-        el.alive = true;
-        el.first_child = physics::invalid_index;
-        for (std::size_t d = 0; d < 2; ++d) el.diagonal[d] = m.springs().add(0, 1, el.diagonal_k, 0.0, physics::SpringKind::diagonal);
-        A::set_live_elements(m, m.num_live_elements() - 3);
+        detail::revive_parent(m, p, 4, 2);
+        Element& el = A::elements(m)[p];
         {
           HooksPaused<typename A::Map> quiet(map);
           map.template set_attribute<2>(el.dart, physics::ElementRef{p});
@@ -156,12 +154,7 @@ CoarsenReport coarsen(MssModel<D>& m, Index p) {
           x = map.beta(x, 1);
         } while (x != el.dart);
         A::attach_diagonals(m, p);
-      });
-    } catch (...) {
-      A::set_refining(m, false);
-      throw;
-    }
-    A::set_refining(m, false);
+    });
     // 7) momentum to the corners by the parent's shape functions, kept midpoints slaved
     std::array<Vec3, 4> p_corner{};
     std::array<double, 4> lumped{};

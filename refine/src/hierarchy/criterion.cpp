@@ -65,7 +65,8 @@ typename Adapter<D>::Report Adapter<D>::update(MssModel<D>& m) {
     if (!can_coarsen(m, p)) continue;
     const Index first = m.elements()[p].first_child;
     bool calm = true;
-    for (Index c = first; c < first + 4; ++c) calm = calm && calm_[c] >= options_.calm_steps;
+    const Index n = m.elements()[p].kind == physics::ElementKind::hexahedron ? 8 : 4;
+    for (Index c = first; c < first + n; ++c) calm = calm && calm_[c] >= options_.calm_steps;
     if (!calm) continue;
     r.dissipated_energy += coarsen(m, p).dissipated_energy;
     ++r.coarsened;

@@ -60,6 +60,9 @@ class RefinerBase {
   /// length and ends are set by the model's resync.
   void new_spring(Dart d, std::uint32_t level) {
     A::grow_darts(m_);
+    // the new edge's darts may reuse slots of erased darts: clear their codes (no corner, no
+    // side) for the elements around it that are not recoded afterwards
+    for (Dart y : map_.template cell<1>(d)) A::set_codes(m_, y, physics::not_a_corner, 0);
     const Index s = m_.springs().add(m_.node_of(d), m_.node_of(map_.beta(d, 1)), 0.0, 0.0, physics::SpringKind::edge);
     map_.template set_attribute<1>(d, physics::SpringRef{s, physics::invalid_index, level});
     A::mark_edge_dirty(m_, d);

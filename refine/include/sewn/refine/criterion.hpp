@@ -51,8 +51,7 @@ RefineReport adapt(MssModel<D>& m, const Criterion<D>& criterion, const RefineOp
 /// each accepted step. It refines what the criterion wants (adapt()), then counts, per live leaf,
 /// the consecutive updates the criterion allowed coarsening (hysteresis), and coarsens every
 /// family whose children have all been calm for `calm_steps` updates and that can_coarsen().
-/// Families of hexahedra are not coarsened (not available yet). O(elements · criterion) plus the
-/// operations.
+/// O(elements · criterion) plus the operations.
 template <int D>
 class Adapter {
  public:
