@@ -315,3 +315,23 @@ TEST_CASE("coarsen hexahedra: seeded random refine / coarsen sequences end where
   CHECK(back.node.size() == original.node.size());
   CHECK(back.spring.size() == original.spring.size());
 }
+
+TEST_CASE("coarsen hexahedra: a family with a cut between siblings is refused, the model unchanged") {
+  MssModel<3> m(grid(2, 1, 1, 1.0), {material}, {}, no_gravity());
+  const RefineReport r = refine_element(m, 0);
+  std::vector<Facet> between;
+  for (const Facet& f : inner_facets(m)) {
+    const Index a = m.element_of(f.dart), b = m.element_of(m.map().beta(f.dart, 3));
+    if (m.elements()[a].parent == 0 && m.elements()[b].parent == 0) between.push_back(f);
+  }
+  REQUIRE(between.size() == 12);  // the family's interior faces
+  (void)cut(m, std::vector<Facet>{between[5]});
+  check_all(m);
+  const auto before = std::make_tuple(m.map().num_darts(), m.nodes().num_alive(), m.springs().size());
+  std::string why;
+  CHECK(!can_coarsen(m, 0, &why));
+  CHECK(why.find("cut") != std::string::npos);
+  CHECK_THROWS_WITH_AS(coarsen(m, 0), doctest::Contains("cut"), InputError);
+  CHECK(before == std::make_tuple(m.map().num_darts(), m.nodes().num_alive(), m.springs().size()));
+  CHECK(r.children.size() == 8);
+}
