@@ -111,12 +111,14 @@ StepReport SymplecticEuler::step(System& sys, double h) {
   if (opt_.health.check_finite) check_finite(nodes, "SymplecticEuler::step");
   double max_speed = 0;
   bool finite = true;  // else the next step's check names the value; energies of a NaN state mean nothing
+  SlaveNodes& slaves = sys.slaves();  // T-junctions: forces to their masters, masses lumped there
+  if (!slaves.empty()) slaves.pass_forces(nodes.f());
   {
     const std::size_t n3 = nodes.x().size();
     double* __restrict x = nodes.x().data();
     double* __restrict v = nodes.v().data();
     const double* __restrict f = nodes.f().data();
-    const double* __restrict im = nodes.inverse_mass_dof().data();
+    const double* __restrict im = (slaves.empty() ? nodes.inverse_mass_dof() : slaves.inverse_mass_dof(nodes)).data();
     std::uint64_t bad = 0, speed = 0;
     for (std::size_t k = 0; k < n3; ++k) {
       v[k] += h * im[k] * f[k];
@@ -128,6 +130,7 @@ StepReport SymplecticEuler::step(System& sys, double h) {
     finite = bad == 0;
     max_speed = std::bit_cast<double>(speed);
   }
+  if (!slaves.empty()) slaves.after_step(nodes);
   ++steps_;
   sys.step_accepted();
   if (watch && finite)
@@ -192,6 +195,8 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
   // 1) forces at the start of the step, checked before anything is changed
   sys.compute_forces();
   if (opt_.health.check_finite) check_finite(nodes, "LinearlyImplicitEuler::step");
+  SlaveNodes& slaves = sys.slaves();  // T-junctions: the paper's shares here, or the reduced solve below
+  if (!slaves.empty() && !slaves.reduces()) slaves.pass_forces(nodes.f());
 
   // 2) A = M - h ∂F/∂V - h² ∂F/∂P into the reused pattern, and ∂F/∂P·V₀ in the same pass
   BlockMatrix& A = sys.matrix();
@@ -223,7 +228,18 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
   }
   solve::SolveReport sr;
   try {
-    sr = solver_->solve(A, b_, dv_, free_, mass3_);
+    if (slaves.reduces()) {
+      // T-junctions: block-Jacobi CG on the reduced system WᵀAW (the layer's backends take the
+      // full pattern; a reduced pattern for them is future work).
+      AlignedVector<double> precond(9 * static_cast<std::size_t>(A.size()));
+      block_jacobi_inverse(A, free_, precond);
+      const CgResult cg = slaves.solve_reduced(A, b_, dv_, free_, precond, opt_.cg_tolerance, opt_.cg_max_iterations);
+      sr.iterations = cg.iterations;
+      sr.relative_residual = cg.relative_residual;
+      sr.converged = cg.converged;
+    } else {
+      sr = solver_->solve(A, b_, dv_, free_, mass3_);
+    }
   } catch (const SolverError& e) {
     std::fill(dv_.begin(), dv_.end(), 0.0);
     throw SolverError("LinearlyImplicitEuler::step " + std::to_string(steps_ + 1) + ": " + e.what() +
@@ -262,6 +278,7 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
     finite = bad == 0;
     max_speed = std::bit_cast<double>(speed);
   }
+  if (!slaves.empty()) slaves.after_step(nodes);
   ++steps_;
   sys.step_accepted();
   if (watch && finite)

@@ -497,7 +497,10 @@ double MssModel<D>::edge_stiffness(Dart edge_dart) const {
     const std::uint8_t code = dart_edge_[y];
     if (!(code & 0x80)) return;
     const Index e = element_of(Dart(y));  // segments carry none: counted above through their spring
-    if (e != invalid_index && elements_[e].alive) k += elements_[e].edge_k[code & 0x7f];
+    if (e == invalid_index || !elements_[e].alive) return;
+    const Element& el = elements_[e];
+    // a side of E split into sub-edges in series: each carries k_E · l_e / l_E (PHYSICS_NOTES §2.5)
+    k += el.edge_k[code & 0x7f] * (static_cast<double>(ref.level) / el.level);  // a power of two: exact
   };
   for_each_edge_dart(edge_dart.index(), add);
   return k;
@@ -512,7 +515,8 @@ double MssModel<D>::walk_vertex(std::uint32_t v, std::vector<std::uint32_t>& edg
     Index e = element_of(y);
     const std::uint32_t edge = map_.template attribute_index<1>(y.index());
     if (e == invalid_index && edge != null) e = edge_refs.value(edge).segment;
-    if (e != invalid_index && elements_[e].alive) {
+    // a T-junction takes mass only from the elements it is a corner of (PHYSICS_NOTES §2.5)
+    if (e != invalid_index && elements_[e].alive && dart_vertex_[y.index()] != not_a_corner) {
       const Element& el = elements_[e];
       m += materials_[el.material].density * el.measure / (corners(el.kind) * darts_per_corner(el.kind));
       if (first_visit(seen_element_, e, generation_)) elems.push_back(e);
@@ -532,17 +536,27 @@ std::vector<Index> MssModel<D>::element_nodes(Index e) const {
     static const CornerPaths hex = corner_paths(template_of(ElementKind::hexahedron));
     static const CornerPaths tet = corner_paths(template_of(ElementKind::tetrahedron));
     const CornerPaths& paths = el.kind == ElementKind::hexahedron ? hex : tet;
-    for (std::size_t v = 0; v < out.size(); ++v) {
+    bool on_template = true;
+    for (std::size_t v = 0; v < out.size() && on_template; ++v) {
       std::uint32_t x = el.dart.index();
       for (std::uint8_t op : paths[v]) x = map_.b(x, op);
+      on_template = dart_vertex_[x] == v;
       out[v] = node_of(Dart(x));
     }
+    if constexpr (D == 3)
+      if (!on_template)  // a refined neighbour split its faces: find the corners by their codes
+        for (Dart y : map_.template cell<3>(el.dart))
+          if (dart_vertex_[y.index()] != not_a_corner) out[dart_vertex_[y.index()]] = node_of(y);
   } else if (el.kind == ElementKind::segment) {
     out[0] = node_of(el.dart);
     out[1] = end_node(el.dart);
   } else {
+    // a refined neighbour may have put T-junctions on the sides: the ring is longer than the corners
     std::uint32_t x = el.dart.index();
-    for (std::size_t k = 0; k < out.size(); ++k, x = map_.b(x, 1)) out[dart_vertex_[x]] = node_of(Dart(x));
+    do {
+      if (dart_vertex_[x] != not_a_corner) out[dart_vertex_[x]] = node_of(Dart(x));
+      x = map_.b(x, 1);
+    } while (x != el.dart.index() && x != Dart::null_index);
   }
   return out;
 }
@@ -643,12 +657,20 @@ void MssModel<D>::install_hooks() {
       unsupported_ = std::string("the mass-spring model cannot follow this edit: ") + what +
                      " (cutting and piercing unsew faces between elements; splitting or merging elements is refinement)";
   };
-  map_.template on_split<2>([unsupported](AttrId<2>, AttrId<2>) { unsupported("an element was split in two"); });
-  map_.template on_merge<2>([unsupported](AttrId<2>, AttrId<2>) { unsupported("two elements were merged"); });
+  map_.template on_split<2>([this, unsupported](AttrId<2>, AttrId<2>) {
+    if (!refining_) unsupported("an element was split in two");
+  });
+  map_.template on_merge<2>([this, unsupported](AttrId<2>, AttrId<2>) {
+    if (!refining_) unsupported("two elements were merged");
+  });
   map_.template on_erase<2>([this, element_erased](AttrId<2> gone) { element_erased(map_.value(gone).element); });
   if constexpr (D == 3) {
-    map_.template on_split<3>([unsupported](AttrId<3>, AttrId<3>) { unsupported("an element was split in two"); });
-    map_.template on_merge<3>([unsupported](AttrId<3>, AttrId<3>) { unsupported("two elements were merged"); });
+    map_.template on_split<3>([this, unsupported](AttrId<3>, AttrId<3>) {
+      if (!refining_) unsupported("an element was split in two");
+    });
+    map_.template on_merge<3>([this, unsupported](AttrId<3>, AttrId<3>) {
+      if (!refining_) unsupported("two elements were merged");
+    });
     map_.template on_erase<3>([this, element_erased](AttrId<3> gone) { element_erased(map_.value(gone).element); });
   }
 }

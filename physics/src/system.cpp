@@ -159,6 +159,7 @@ std::vector<Index> System::compact_nodes() {
   for (const auto& t : terms_) t->check_nodes(nodes_);
   std::vector<Index> old_to_new = nodes_.compact();
   for (const auto& t : terms_) t->remap_nodes(old_to_new);
+  slaves_.remap(old_to_new);
   refresh();
   return old_to_new;
 }

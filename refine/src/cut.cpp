@@ -1,4 +1,5 @@
 #include "sewn/refine/cut.hpp"
+#include "sewn/refine/hierarchy.hpp"
 
 #include <algorithm>
 #include <map>
@@ -168,6 +169,19 @@ std::vector<Index> elements_in(const MssModel<D>& m, const Region& region) {
 
 template <int D>
 CutReport cut(MssModel<D>& m, std::span<const Facet> facets) {
+  // A facet on a level jump holds T-junctions of the coarser element: separating them would leave
+  // particles that no element weighs. Refused before anything changes.
+  for (const Facet& f : facets) {
+    if (!m.map().is_alive(f.dart)) throw InputError("cut: dart " + std::to_string(f.dart.index()) + " is not a live dart");
+    const Dart other = m.map().beta(f.dart, f.index);
+    if (other.is_null()) continue;
+    const Index a = m.element_of(f.dart), b = m.element_of(other);
+    if (a != physics::invalid_index && b != physics::invalid_index && m.elements()[a].level != m.elements()[b].level)
+      throw InputError("cut: the facet at dart " + std::to_string(f.dart.index()) + " lies between element " + std::to_string(a) +
+                       " (level " + std::to_string(m.elements()[a].level) + ") and element " + std::to_string(b) + " (level " +
+                       std::to_string(m.elements()[b].level) +
+                       "): cutting across a level jump is not supported yet; refine the coarser element first");
+  }
   const Counts<D> before(m);
   std::uint32_t done = 0;
   // One batch per facet dimension: a vertex or an edge shared by several of the facets is then
@@ -179,6 +193,8 @@ CutReport cut(MssModel<D>& m, std::span<const Facet> facets) {
     if constexpr (D == 3) done += map.template unsew_all<3>(faces);
     done += map.template unsew_all<2>(edges);
   });
+  // a particle duplicated by the cut may be a T-junction or a master of one
+  if (!m.system().slaves().empty()) constrain_t_junctions(m, m.system().slaves().treatment());
   return difference(before, m, done);
 }
 

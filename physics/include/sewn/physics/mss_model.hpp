@@ -34,6 +34,11 @@
 #include "sewn/physics/springs.hpp"
 #include "sewn/physics/system.hpp"
 
+namespace sewn::refine::detail {
+template <int D>
+struct ModelAccess;  // hierarchical refinement (sewn::refine) edits the model's rest data and darts
+}  // namespace sewn::refine::detail
+
 namespace sewn::physics {
 
 /// Attribute values stored in the map.
@@ -43,6 +48,9 @@ struct NodeRef {
 struct SpringRef {
   Index spring = invalid_index;
   Index segment = invalid_index;  ///< the element of a polyline segment (rods), else invalid_index
+  /// Subdivision level l_e of the edge (1, 2, 4, ...: rest length = root edge's / l_e). An
+  /// element E of level l_E gives each edge of its sides k_E · l_e / l_E (series springs).
+  std::uint32_t level = 1;
 };
 struct ElementRef {
   Index element = invalid_index;
@@ -92,7 +100,17 @@ struct Element {
   std::array<double, 12> edge_k{};  ///< stiffness contribution to each local edge (see local_edges())
   double diagonal_k = 0;            ///< stiffness of each internal diagonal (hexahedra, quads)
   std::array<Index, 4> diagonal{invalid_index, invalid_index, invalid_index, invalid_index};
+  /// Subdivision level l_E (1 for a built element, doubled by each refinement: rest size =
+  /// root size / l_E), the element it was refined from and the first of its children (the
+  /// children of one element are consecutive); invalid_index when none.
+  std::uint32_t level = 1;
+  Index parent = invalid_index;
+  Index first_child = invalid_index;
 };
+
+/// Local vertex code of a dart that does not start at a corner of its element: it starts at a
+/// T-junction, a particle strictly inside one of the element's sides (hierarchical refinement).
+inline constexpr std::uint8_t not_a_corner = 0xFF;
 
 template <int D>
 class MssModel {
@@ -158,6 +176,13 @@ class MssModel {
   }
   /// The element of the cell of dart d (its volume in 3D, else its face; invalid_index if none).
   [[nodiscard]] Index element_of(Dart d) const;
+  /// True if dart d starts at a corner of its element (a hierarchical dart: the first dart of
+  /// one of the element's sides); false if it starts at a T-junction. O(1).
+  [[nodiscard]] bool is_corner_dart(Dart d) const { return dart_vertex_[d.index()] != not_a_corner; }
+  /// The local vertex of its element that dart d starts at (not_a_corner for a T-junction). O(1).
+  [[nodiscard]] int corner_of_dart(Dart d) const { return dart_vertex_[d.index()]; }
+  /// The local side (local edge, see local_edges()) of its element that dart d lies on. O(1).
+  [[nodiscard]] int side_of(Dart d) const { return dart_edge_[d.index()] & 0x7f; }
   /// Rest position of node i.
   [[nodiscard]] Eigen::Vector3d rest_position(Index i) const { return rest_[i]; }
   /// The mesh point node i stands for (a particle duplicated by a cut keeps its original's).
@@ -227,6 +252,9 @@ class MssModel {
   std::uint32_t generation_ = 0;
   std::vector<std::uint32_t> seen_edge_, seen_element_, seen_node_, seen_spring_;
   std::string unsupported_;  // an edit the model cannot follow (element merge), reported by resync
+  bool refining_ = false;    // element splits and merges are refinement and coarsening, which set up the elements
+
+  friend struct refine::detail::ModelAccess<D>;
 };
 
 extern template class MssModel<2>;

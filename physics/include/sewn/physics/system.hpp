@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sewn/physics/block_matrix.hpp"
+#include "sewn/physics/constraints/slave_nodes.hpp"
 #include "sewn/physics/force_term.hpp"
 #include "sewn/physics/nodes.hpp"
 
@@ -101,6 +102,11 @@ class System {
   /// Invalidates node indices held by the caller (the map's 0-attributes must be remapped). O(n + elements).
   std::vector<Index> compact_nodes();
 
+  /// Particles tied to others (T-junctions of refinement), which both integrators honour;
+  /// empty by default. compact_nodes() renumbers them.
+  [[nodiscard]] SlaveNodes& slaves() { return slaves_; }
+  [[nodiscard]] const SlaveNodes& slaves() const { return slaves_; }
+
   /// Changes whenever a node or term parameter or topology changes, or a term is added
   /// (integrators cache the stable step and the energy baseline against it). It is a sum of
   /// counters that only increase, so any change increases it. O(terms).
@@ -110,6 +116,7 @@ class System {
   NodeTable nodes_;
   std::vector<std::unique_ptr<ForceTerm>> terms_;
   BlockMatrix matrix_;
+  SlaveNodes slaves_;
   std::uint64_t seen_topology_ = ~std::uint64_t{0};    // topology last checked by refresh()
   std::uint64_t pattern_topology_ = ~std::uint64_t{0};  // topology the matrix pattern was built for
 };

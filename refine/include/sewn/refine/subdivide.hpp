@@ -1,0 +1,58 @@
+#pragma once
+// Regular refinement of the 2014 paper (PHYSICS_NOTES §2.2-2.5): a quad of level l splits 1:4 and
+// a hexahedron 1:8 into children of level 2l. Side midpoints (and, in 3D, face centres) that a
+// finer neighbour already made are found by the middle-dart search (integer dyadic sums of 1/l_e)
+// and reused; missing ones are inserted with the map's own insertions, splitting the edge into two
+// springs of level 2·l_e and leaving T-junctions in the neighbours. The physics follows exactly:
+// the parent's mass ρV/c per corner becomes ρ(V/k)/c per child corner (c = 4 or 8 corners, k = 4
+// or 8 children), new particles take the multilinear interpolation of the corners' rest
+// positions, positions and velocities (so linear momentum is conserved), rest lengths come from
+// the rest configuration (refining under load keeps the stress), each child adds Baudet's
+// stiffness at its own size to its sides by the series rule k_E·l_e/l_E, and the parent's
+// diagonals are replaced by 2 (4) per child. After each call the system's T-junction
+// constraints are rebuilt (constrain_t_junctions, hierarchy.hpp).
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "sewn/physics/mss_model.hpp"
+
+namespace sewn::refine {
+
+using physics::Index;
+using physics::MssModel;
+
+struct RefineOptions {
+  int max_level = 6;  ///< the finest level allowed, as an index (1 + log2 l): 6 is l = 32
+};
+
+/// What a refinement changed.
+struct RefineReport {
+  std::uint32_t elements = 0;   ///< elements refined
+  std::uint32_t particles = 0;  ///< particles created (side midpoints and centres)
+  std::vector<Index> children;  ///< the new elements, 4 per refined element, in refinement order
+};
+
+/// Refines element e: a quad of a 2-map 1:4, a hexahedron of a 3-map 1:8. Returns its children
+/// (Element::first_child .. +3 or +7; quad child k has the parent's k-th corner in β1 order as
+/// its local vertex 0, hexahedron child v holds the parent's corner v as its local vertex v).
+/// Throws physics::InputError, the model unchanged, for an element that does not exist, was removed or refined, is not a quad
+/// (2D) or hexahedron (3D) — triangles, tetrahedra, quads of a 3-map have no regular refinement
+/// here — or whose children would pass options.max_level. Invalidates nothing held by the
+/// caller (particles, springs and elements are appended; the parent stays, not alive).
+/// O(darts of the element and of the paths its insertions walk) plus the model's resync of the
+/// touched particles and an O(model) rebuild of the T-junction constraints.
+template <int D>
+RefineReport refine_element(MssModel<D>& m, Index e, const RefineOptions& options = {});
+
+/// Refines each listed element in turn (each must be refinable when its turn comes; an element
+/// refined earlier in the list is an error). O(Σ of the above).
+template <int D>
+RefineReport refine_elements(MssModel<D>& m, std::span<const Index> elements, const RefineOptions& options = {});
+
+/// Refines every live element once: a uniform refinement. O(model).
+template <int D>
+RefineReport refine_all(MssModel<D>& m, const RefineOptions& options = {});
+
+}  // namespace sewn::refine

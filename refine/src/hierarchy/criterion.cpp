@@ -1,0 +1,85 @@
+#include "sewn/refine/criterion.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "sewn/physics/errors.hpp"
+#include "sewn/refine/hierarchy.hpp"
+
+namespace sewn::refine {
+
+template <int D>
+DiagonalStrain<D>::DiagonalStrain(double threshold_percent) : threshold_(threshold_percent) {
+  if (!(threshold_percent > 0 && threshold_percent < 100))
+    throw physics::InputError("refinement criterion: the diagonal strain threshold must be in (0, 100) percent (got " +
+                              std::to_string(threshold_percent) + ")");
+}
+
+template <int D>
+double DiagonalStrain<D>::strain_percent(const MssModel<D>& m, Index e) {
+  const physics::Element& el = m.elements()[e];
+  const physics::Springs& s = m.springs();
+  double worst = 0;
+  for (Index d : el.diagonal) {
+    if (d == physics::invalid_index) continue;
+    const double l = (m.nodes().position(s.node_j(d)) - m.nodes().position(s.node_i(d))).norm();
+    worst = std::max(worst, 100 * std::abs(l - s.rest_length(d)) / s.rest_length(d));
+  }
+  return worst;
+}
+
+template <int D>
+bool DiagonalStrain<D>::wants_refinement(const MssModel<D>& m, Index e) const {
+  return strain_percent(m, e) > threshold_;
+}
+
+template <int D>
+bool DiagonalStrain<D>::allows_coarsening(const MssModel<D>& m, Index e) const {
+  return strain_percent(m, e) < threshold_ / 2;
+}
+
+template <int D>
+RefineReport adapt(MssModel<D>& m, const Criterion<D>& criterion, const RefineOptions& options) {
+  const physics::ElementKind regular = D == 2 ? physics::ElementKind::quad : physics::ElementKind::hexahedron;
+  std::vector<Index> chosen;
+  for (Index e = 0; e < m.elements().size(); ++e) {
+    const physics::Element& el = m.elements()[e];
+    if (el.alive && el.kind == regular && level_index(el.level) < options.max_level && criterion.wants_refinement(m, e))
+      chosen.push_back(e);
+  }
+  return refine_elements(m, std::span<const Index>(chosen), options);
+}
+
+template <int D>
+typename Adapter<D>::Report Adapter<D>::update(MssModel<D>& m) {
+  Report r;
+  r.refined = adapt(m, criterion_, options_.refine);
+  if (!options_.coarsen) return r;
+  calm_.resize(m.elements().size(), 0);
+  for (Index e = 0; e < m.elements().size(); ++e) {
+    const physics::Element& el = m.elements()[e];
+    calm_[e] = el.alive && criterion_.allows_coarsening(m, e) ? calm_[e] + 1 : 0;
+  }
+  for (Index p = 0; p < m.elements().size(); ++p) {
+    if (!can_coarsen(m, p)) continue;
+    const Index first = m.elements()[p].first_child;
+    bool calm = true;
+    const Index n = m.elements()[p].kind == physics::ElementKind::hexahedron ? 8 : 4;
+    for (Index c = first; c < first + n; ++c) calm = calm && calm_[c] >= options_.calm_steps;
+    if (!calm) continue;
+    r.dissipated_energy += coarsen(m, p).dissipated_energy;
+    ++r.coarsened;
+    calm_[p] = 0;
+  }
+  return r;
+}
+
+template class Adapter<2>;
+template class Adapter<3>;
+template class DiagonalStrain<2>;
+template class DiagonalStrain<3>;
+template RefineReport adapt(MssModel<2>&, const Criterion<2>&, const RefineOptions&);
+template RefineReport adapt(MssModel<3>&, const Criterion<3>&, const RefineOptions&);
+
+}  // namespace sewn::refine
