@@ -102,6 +102,7 @@ TEST_CASE("a ball: the solid cube") {
   REQUIRE(t.boundary.size() == 1);
   CHECK(t.boundary[0].euler == 2);
   CHECK(t.boundary[0].genus == 0);
+  CHECK(t.boundary[0].surface);
   CHECK(t.boundary[0].cells[2] == 54);
   CHECK(t.nonmanifold.empty());
   // the same with cells identified by points: nothing changes on a glued manifold mesh
@@ -247,6 +248,12 @@ TEST_CASE("a pinched vertex: two bodies sharing one point") {
     CHECK(t.nonmanifold[0].dim == 0);
     CHECK(b.res.vertex_of_dart[t.nonmanifold[0].dart.index()] == 3);
     CHECK(t.nonmanifold[0].why.find("2 pieces") != std::string::npos);
+    // the two spheres bounding them touch at the point: one boundary piece, not a surface
+    REQUIRE(t.boundary.size() == 1);
+    CHECK_FALSE(t.boundary[0].surface);
+    CHECK(t.boundary[0].genus == -1);
+    CHECK(own.boundary.size() == 2);
+    CHECK(own.boundary[0].surface);
   }
   SUBCASE("two triangles") {
     IndexedMesh m;

@@ -154,7 +154,50 @@ void compute_boundary(const Complex& c, const std::vector<std::uint32_t>& comp_o
     }
     (void)solve_signs(static_cast<std::uint32_t>(facet_dart.size()), cons,
                       [&](std::uint32_t i) { out.boundary[bc_of_facet[i]].orientable = false; });
-    for (auto& b : out.boundary) b.genus = b.orientable ? (2 - b.euler) / 2 : 2 - b.euler;
+    // a closed surface: every edge in two of its faces, the face corners at every vertex one cycle
+    std::vector<std::uint8_t> surface(out.boundary.size(), 1);
+    for (std::size_t i = 0; i < sides.size();) {
+      std::size_t j = i;
+      while (j < sides.size() && sides[j].edge == sides[i].edge) ++j;
+      if (j - i != 2) surface[bc_of_facet[sides[i].face]] = 0;
+      i = j;
+    }
+    struct Corner {
+      std::uint32_t vertex, from, to, bc;
+      bool operator<(const Corner& o) const { return vertex < o.vertex; }
+    };
+    std::vector<Corner> corners;
+    for (std::uint32_t i = 0; i < facet_dart.size(); ++i)
+      for_each_side_dart(facet_dart[i], [&](std::uint32_t y) {
+        corners.push_back({c.cell[0][y], c.end_key(c.b(y, 0)), c.start_key(y), bc_of_facet[i]});
+      });
+    std::stable_sort(corners.begin(), corners.end());
+    std::vector<std::uint32_t> keys;
+    for (std::size_t i = 0; i < corners.size();) {
+      std::size_t j = i;
+      while (j < corners.size() && corners[j].vertex == corners[i].vertex) ++j;
+      keys.clear();
+      for (std::size_t k = i; k < j; ++k) keys.insert(keys.end(), {corners[k].from, corners[k].to});
+      std::vector<std::uint32_t> nodes = keys;
+      sort_unique(nodes);
+      std::vector<std::uint32_t> degree(nodes.size(), 0);
+      UnionFind local(static_cast<std::uint32_t>(nodes.size()));
+      auto pieces = static_cast<std::uint32_t>(nodes.size());
+      for (std::size_t k = 0; k < keys.size(); k += 2) {
+        const std::uint32_t a = index_of(nodes, keys[k]), b = index_of(nodes, keys[k + 1]);
+        ++degree[a];
+        ++degree[b];
+        if (local.unite(a, b)) --pieces;
+      }
+      if (pieces != 1 || std::any_of(degree.begin(), degree.end(), [](std::uint32_t d) { return d != 2; }))
+        surface[corners[i].bc] = 0;
+      i = j;
+    }
+    for (std::size_t k = 0; k < out.boundary.size(); ++k) {
+      auto& b = out.boundary[k];
+      b.surface = surface[k] != 0;
+      if (b.surface) b.genus = b.orientable ? (2 - b.euler) / 2 : 2 - b.euler;
+    }
   } else {
     for (auto& comp : out.components) {
       const std::int64_t k = 2 - comp.euler - comp.boundary_components;

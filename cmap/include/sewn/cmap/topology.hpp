@@ -79,8 +79,11 @@ struct BoundaryComponent {
   std::array<std::int64_t, 3> cells{};  ///< vertices, edges, faces (faces: 0 for a 2-map)
   std::int64_t euler = 0;
   bool orientable = true;
-  /// 3-map: the genus of the boundary surface (2 - χ)/2, or its number of cross-caps 2 - χ when
-  /// non-orientable. 2-map: -1 (a boundary curve).
+  /// 3-map: true if the piece is a closed surface (every edge in two of its faces, the face
+  /// corners around every vertex one cycle). 2-map: false (a boundary curve).
+  bool surface = false;
+  /// The genus of a closed surface (2 - χ)/2, or its number of cross-caps 2 - χ when
+  /// non-orientable; -1 when the piece is not a closed surface (pinched) or is a curve.
   std::int64_t genus = -1;
   Dart dart;  ///< a dart of one of its facets (the side inside the top cell)
 };
