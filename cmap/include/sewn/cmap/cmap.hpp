@@ -285,8 +285,9 @@ class CMap {
   [[nodiscard]] std::vector<Dart> component(Dart d) const;
   /// Range yielding the smallest dart of each I-cell, in increasing order. Holds a mark while
   /// alive (released on destruction, early break included), except for the cells it recognises
-  /// without one (every cell of a 1- or 2-map, edges and faces of a 3-map). Do not modify the
-  /// map while iterating.
+  /// without one (every cell of a 1- or 2-map, edges and faces of a 3-map). Iterable through a
+  /// const& and more than once (each begin() starts a new pass). Do not modify the map while
+  /// iterating.
   template <int I>
   [[nodiscard]] auto cells() const;
   /// One dart per J-cell incident to the I-cell of d (J < I: its faces; J > I: the cells it
