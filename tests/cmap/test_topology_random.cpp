@@ -1,7 +1,8 @@
 // Property-based test of the topology invariants: seeded random sequences of every map operation
-// (sew, unsew, unsew of several facets at once as a cut does, insertions, removals, contractions,
-// new cells) on 2- and 3-maps. After each: validate(); the Betti numbers of topology() against an
-// independent computation (cells found through the public traversal API, ranks by dense Gaussian
+// (sew, unsew, unsew of several facets at once as a cut does, insertions of vertices in edges and
+// faces, edges in faces, faces in volumes and in holes, removals, contractions, new cells) on 2-
+// and 3-maps. After each: validate(); the Betti numbers of topology() against an independent
+// computation (cells found through the public traversal API, ranks by dense Gaussian
 // elimination over GF(2)); b0 against count_components(), χ against euler_characteristic() and
 // Σ(-1)^i b_i; the orientation found against every sew; and what each operation must do:
 // insertions keep every Betti number, so do removals between two distinct cells and contractions
@@ -173,6 +174,13 @@ struct Driver {
                      m.insert_edge_in_face(a, cyc[1 + uniform(static_cast<std::uint32_t>(cyc.size() - 1))]);
                      return done(Expect::keep);
                    }});
+    ops.push_back({"insert_vertex_in_face", [=, this] {
+                     if (m.num_darts() > max_darts) return skip();
+                     const Dart d = random_dart();
+                     if (!m.is_insertable_vertex_in_face(d)) return skip();
+                     m.insert_vertex_in_face(d);
+                     return done(Expect::keep);
+                   }});
     ops.push_back({"remove_cell<0>", [=, this] {
                      const Dart d = random_dart_where([&](Dart x) { return m.template is_removable<0>(x); });
                      if (!d) return skip();
@@ -243,6 +251,53 @@ struct Driver {
                      else m.make_hexahedron();
                      return done(Expect::add_component);
                    }});
+    if constexpr (D == 3)
+      ops.push_back({"remove a boundary face, insert_face_in_hole", [=, this] {
+                       // the hole's ring is the faces' β2 partners, in reverse order
+                       const Dart f = random_dart_where([&](Dart x) { return m.is_free(x, 3); });
+                       if (!f) return skip();
+                       std::vector<Dart> ring;
+                       for (Dart x : face_cycle(f)) {
+                         const Dart r = m.beta(x, 2);
+                         if (m.template same_cell<2>(r, f) || std::find(ring.begin(), ring.end(), r) != ring.end()) return skip();
+                         ring.insert(ring.begin(), r);
+                       }
+                       auto expected = m.count_all();
+                       --expected[2];
+                       m.template remove_cell<2>(f);
+                       if (m.count_all() == expected) {
+                         if (!m.is_insertable_face_in_hole(ring)) {
+                           std::string why;
+                           for (std::size_t k = 0; k < ring.size(); ++k) {
+                             const Dart r = ring[k];
+                             why += " r" + std::to_string(r.index()) + (m.is_alive(r) ? "" : " dead") +
+                                    (m.is_alive(r) && !m.is_free(r, 2) ? " sewn" : "");
+                             if (m.is_alive(r) && !m.template same_cell<0>(m.beta(r, 1), ring[(k + 1) % ring.size()])) why += " vertex";
+                             if (m.is_alive(r) && !m.template same_cell<3>(r, ring[0])) why += " volume";
+                           }
+                           FAIL("the ring left by removing a boundary face cannot be closed:", why);
+                         }
+                         m.insert_face_in_hole(ring);
+                         return done(Expect::keep);
+                       }
+                       // the face was all that held a vertex, an edge or the volume together
+                       // (a pinch): the map split it, and the hole has several rings, each closed
+                       // by a face of its own
+                       for (Dart r : ring) {
+                         if (!m.is_free(r, 2)) continue;
+                         std::vector<Dart> sub;
+                         Dart x = r;
+                         do {
+                           sub.push_back(x);
+                           Dart y = m.beta(x, 1);
+                           while (m.beta(y, 2)) y = m.beta(y, 2, 1);
+                           x = y;
+                         } while (x != r && sub.size() <= ring.size());
+                         if (!m.is_insertable_face_in_hole(sub)) FAIL("a ring of a pinched hole cannot be closed");
+                         m.insert_face_in_hole(sub);
+                       }
+                       return done(Expect::any);
+                     }});
     if constexpr (D == 3)
       ops.push_back({"insert_face_in_volume", [=, this] {
                        if (m.num_darts() > max_darts) return skip();
@@ -324,7 +379,7 @@ TEST_CASE("random operation sequences keep the invariants they must (2-maps)") {
   std::int64_t total = 0, kept = 0, pinched = 0;
   for (unsigned seed : {11u, 12u, 13u, 14u, 15u}) {
     Driver<2> d(seed, 200);
-    d.run(seed, 15000);
+    d.run(seed, 16500);
     total += d.ops_applied;
     kept += d.kept;
     pinched += d.pinched;
