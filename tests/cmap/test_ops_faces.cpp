@@ -142,3 +142,51 @@ TEST_CASE("insert_face_in_hole closes an open volume with one face") {
     CHECK(m.validate().ok());
   }
 }
+
+TEST_CASE("insert_dangling_edge_in_face adds an edge to a new vertex inside the face") {
+  SUBCASE("2-map, attributes") {
+    CMap<2, int, int, int> m;
+    build(m, quad_grid(2, 2));
+    int next = 0;
+    m.create_attributes<0>([&](Dart) { return next++; });
+    m.create_attributes<2>([&](Dart) { return next++; });
+    int hooks = 0;
+    m.on_split<2>([&](AttrId<2>, AttrId<2>) { ++hooks; });
+    m.on_merge<0>([&](AttrId<0>, AttrId<0>) { ++hooks; });
+    const auto n = m.count_all();
+    const Dart d = *m.cells<2>().begin();
+    const Dart a = m.insert_dangling_edge_in_face(d);
+    CHECK(m.validate().ok());
+    CHECK(hooks == 0);
+    CHECK(m.count_all() == std::array<std::uint32_t, 3>{n[0] + 1, n[1] + 1, n[2]});
+    CHECK(m.same_cell<0>(a, d));
+    CHECK(m.attribute<0>(a) == m.attribute<0>(d));
+    CHECK(m.attribute<0>(m.beta(a, 1)).is_null());
+    CHECK(m.attribute<2>(a) == m.attribute<2>(d));
+    CHECK(m.beta(a, 1, 1) == d);
+    CHECK(face_size(m, d) == 6);
+    CHECK(topology(m).total.betti == std::array<std::int64_t, 4>{1, 0, 0, 0});
+  }
+  SUBCASE("3-map, a face between two volumes, then a vertex in the same face") {
+    CMap<3> m;
+    build(m, hex_grid(2, 1, 1));
+    Dart inner;
+    for (Dart x : m.darts())
+      if (m.beta(x, 3)) inner = x;
+    const auto n = m.count_all();
+    const Dart a = m.insert_dangling_edge_in_face(inner);
+    CHECK(m.validate().ok());
+    CHECK(m.count_all() == std::array<std::uint32_t, 4>{n[0] + 1, n[1] + 1, n[2], n[3]});
+    CHECK(m.cell<1>(a).size() == 4);
+    CHECK(topology(m).total.betti == std::array<std::int64_t, 4>{1, 0, 0, 0});
+    m.insert_vertex_in_face(inner);
+    CHECK(m.validate().ok());
+    CHECK(topology(m).total.betti == std::array<std::int64_t, 4>{1, 0, 0, 0});
+  }
+  SUBCASE("refused: a dead dart") {
+    CMap<2> m;
+    m.make_polygon(3);
+    CHECK_FALSE(m.is_insertable_dangling_edge_in_face(Dart(40)));
+    CHECK_THROWS_AS(m.insert_dangling_edge_in_face(Dart(40)), TopologyError);
+  }
+}

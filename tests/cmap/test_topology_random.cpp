@@ -1,8 +1,8 @@
 // Property-based test of the topology invariants: seeded random sequences of every map operation
 // (sew, unsew, unsew of several facets at once as a cut does, insertions of vertices in edges and
-// faces, edges in faces, faces in volumes and in holes, removals, contractions, new cells) on 2-
-// and 3-maps. After each: validate(); the Betti numbers of topology() against an independent
-// computation (cells found through the public traversal API, ranks by dense Gaussian
+// faces, edges and dangling edges in faces, faces in volumes and in holes, removals, contractions,
+// new cells) on 2- and 3-maps. After each: validate(); the Betti numbers of topology() against an
+// independent computation (cells found through the public traversal API, ranks by dense Gaussian
 // elimination over GF(2)); b0 against count_components(), χ against euler_characteristic() and
 // Σ(-1)^i b_i; the orientation found against every sew; and what each operation must do:
 // insertions keep every Betti number, so do removals between two distinct cells and contractions
@@ -179,6 +179,13 @@ struct Driver {
                      const Dart d = random_dart();
                      if (!m.is_insertable_vertex_in_face(d)) return skip();
                      m.insert_vertex_in_face(d);
+                     return done(Expect::keep);
+                   }});
+    ops.push_back({"insert_dangling_edge_in_face", [=, this] {
+                     if (m.num_darts() > max_darts) return skip();
+                     const Dart d = random_dart();
+                     if (!m.is_insertable_dangling_edge_in_face(d)) return skip();
+                     m.insert_dangling_edge_in_face(d);
                      return done(Expect::keep);
                    }});
     ops.push_back({"remove_cell<0>", [=, this] {
@@ -379,7 +386,7 @@ TEST_CASE("random operation sequences keep the invariants they must (2-maps)") {
   std::int64_t total = 0, kept = 0, pinched = 0;
   for (unsigned seed : {11u, 12u, 13u, 14u, 15u}) {
     Driver<2> d(seed, 200);
-    d.run(seed, 16500);
+    d.run(seed, 18500);
     total += d.ops_applied;
     kept += d.kept;
     pinched += d.pinched;
@@ -394,7 +401,7 @@ TEST_CASE("random operation sequences keep the invariants they must (3-maps)") {
   std::int64_t total = 0, kept = 0, pinched = 0;
   for (unsigned seed : {21u, 22u, 23u, 24u, 25u}) {
     Driver<3> d(seed, 300);
-    d.run(seed, 20000);
+    d.run(seed, 23000);
     total += d.ops_applied;
     kept += d.kept;
     pinched += d.pinched;

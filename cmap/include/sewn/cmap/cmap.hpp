@@ -439,6 +439,16 @@ class CMap {
   /// Throws TopologyError if not insertable. O(k · face).
   Dart insert_vertex_in_face(Dart d);
 
+  /// True if insert_dangling_edge_in_face(d) may be called: D is 2 or 3, d live with a β0. O(1).
+  [[nodiscard]] bool is_insertable_dangling_edge_in_face(Dart d) const;
+  /// Inserts an edge inside the face of d from d's start vertex to a new vertex (CGAL's
+  /// insert_dangling_cell_1_in_cell_2), on both sides of a 3-sewn face: two darts per side,
+  /// placed before d. The face stays one face; no cell splits or merges, so no hook fires; the
+  /// new darts keep the face's and volume's attributes and the start vertex's; the new edge and
+  /// vertex have none. Returns the new dart from d's start to the new vertex. Throws
+  /// TopologyError if not insertable. O(1).
+  Dart insert_dangling_edge_in_face(Dart d);
+
   // ---------------------------------------------------------------- removal, contraction
   /// True if the I-cell of d can be removed: I ≥ D-1, or it is incident to at most two
   /// (I+1)-cells (β_{I+1}∘β_{I+2} is an involution on its darts); and removing it does not fold

@@ -267,4 +267,47 @@ Dart CMap<D, A...>::insert_vertex_in_face(Dart d) {
   return w;
 }
 
+
+template <int D, class... A>
+bool CMap<D, A...>::is_insertable_dangling_edge_in_face(Dart d) const {
+  if constexpr (D < 2 || D > 3) return false;
+  return is_alive(d) && b(d.index(), 0) != detail::null_index;
+}
+
+template <int D, class... A>
+Dart CMap<D, A...>::insert_dangling_edge_in_face(Dart d) {
+  static_assert(D == 2 || D == 3, "a dangling edge in a face is inserted in 2- and 3-maps");
+  if (!is_insertable_dangling_edge_in_face(d))
+    throw TopologyError("cmap::insert_dangling_edge_in_face: dart " + std::to_string(d.index()) +
+                        (is_alive(d) ? " has no β0 (an open face)" : " is not a live dart"));
+  // In d's face: β0(d) -> a (s -> v) -> b (v -> s) -> d, with s = d's start and v the new vertex.
+  // On the other side d3 = β3(d) ends at s: d3 -> a3 (s -> v) -> b3 (v -> s) -> old β1(d3), with
+  // β3(a) = b3 and β3(b) = a3, which keeps β1∘β3 = β3∘β0.
+  const std::uint32_t x = d.index(), p = b(x, 0);
+  const std::uint32_t a = new_dart(), bb = new_dart();
+  inherit_attributes(x, a, ~3u);
+  inherit_attributes(x, a, 1u);
+  inherit_attributes(x, bb, ~3u);
+  raw_link(p, 1, a);
+  raw_link(a, 1, bb);
+  raw_link(bb, 1, x);
+  raw_link(a, 2, bb);
+  if constexpr (D == 3) {
+    if (const std::uint32_t x3 = b(x, 3); x3 != detail::null_index) {
+      const std::uint32_t n3 = b(x3, 1);
+      const std::uint32_t a3 = new_dart(), b3 = new_dart();
+      inherit_attributes(x3, a3, ~3u);
+      inherit_attributes(x, a3, 1u);
+      inherit_attributes(x3, b3, ~3u);
+      raw_link(x3, 1, a3);
+      raw_link(a3, 1, b3);
+      raw_link(b3, 1, n3);
+      raw_link(a3, 2, b3);
+      raw_link(a, 3, b3);
+      raw_link(bb, 3, a3);
+    }
+  }
+  return Dart(a);
+}
+
 }  // namespace sewn
