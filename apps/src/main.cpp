@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "sewn/apps/check_topology.hpp"
 #include "sewn/apps/runner.hpp"
 #include "sewn/apps/scene.hpp"
 #include "sewn/cmap/build.hpp"
@@ -28,8 +29,10 @@ usage:
   sewn run [SCENE.json] [--out DIR] [--frames N] [--until T] [--quiet]
                           run a scene (with no scene: the built-in default, a cantilever
                           beam sagging under gravity and cut part-way through)
-  sewn check MESH         load a mesh (.msh 2.2/4.1, .mesh, .vtk), check its geometry, build the
-                          combinatorial map and print its validation report and cell counts
+  sewn check MESH [--json]
+                          load a mesh (.msh 2.2/4.1, .mesh, .vtk), check its geometry, build the
+                          combinatorial map and print its validation report, cell counts and
+                          topology (Betti numbers, orientability, boundary, non-manifold cells)
   sewn scene-doc          print the scene file reference (docs/scenes.md)
   sewn --help | sewn <command> --help
 
@@ -53,12 +56,16 @@ Runs a scene (docs/scenes.md) and writes, in DIR (default out/<scene name>/):
 The progress bar is drawn only when standard error is a terminal.
 )";
 
-constexpr const char* check_usage = R"(usage: sewn check MESH
+constexpr const char* check_usage = R"(usage: sewn check MESH [--json]
 
 Loads MESH (Gmsh .msh 2.2 or 4.1 ASCII, MEDIT .mesh, legacy VTK .vtk), lists every geometric
 problem (non-finite coordinates, inverted or degenerate cells), builds the combinatorial map
-and prints its validation report, cell counts, components and boundary. Exit 0 when the mesh
-is sound, 2 otherwise.
+and prints its validation report, cell counts, components and boundary, then the topology of
+the mesh's cell complex (cells identified by their points; meshes of volumes only or of surface
+cells only): per component its cell counts, χ, Betti numbers over Z/2, orientability and (for
+surfaces) genus; each boundary component with its genus; every vertex or edge whose link is not
+a sphere or disc. --json prints the topology as JSON on stdout (the text goes to stderr).
+Exit 0 when the mesh is sound, 2 otherwise (non-manifold or non-orientable meshes are sound).
 )";
 
 int cmd_run(const std::vector<std::string>& args) {
@@ -123,15 +130,17 @@ int cmd_check(const std::vector<std::string>& args) {
     std::fputs(check_usage, stdout);
     return ok;
   }
-  if (args.size() != 1) {
-    std::fprintf(stderr, "usage: sewn check MESH (see sewn check --help)\n");
+  const bool json = args.size() == 2 && args[1] == "--json";
+  if (args.size() != 1 && !json) {
+    std::fprintf(stderr, "usage: sewn check MESH [--json] (see sewn check --help)\n");
     return bad_input;
   }
   const std::string& path = args[0];
+  std::FILE* out = json ? stderr : stdout;  // with --json, stdout holds the JSON document only
   const sewn::io::MeshFile file = sewn::io::read_mesh_file(path);
   const sewn::IndexedMesh& mesh = file.mesh;
   const auto by_dim = mesh.count_by_dimension();
-  std::printf("%s: %u points, %u cells (%u volumes, %u surface cells, %u segments)\n", path.c_str(), mesh.num_points(),
+  std::fprintf(out, "%s: %u points, %u cells (%u volumes, %u surface cells, %u segments)\n", path.c_str(), mesh.num_points(),
               mesh.num_cells(), by_dim[3], by_dim[2], by_dim[1]);
   // what `sewn run` refuses, refused here with the same reason
   if (mesh.num_cells() == 0) {
@@ -140,7 +149,7 @@ int cmd_check(const std::vector<std::string>& args) {
   }
   bool sound = true;
   const auto issues = sewn::io::find_geometry_issues(mesh, path);
-  for (const auto& issue : issues) std::printf("  geometry: %s\n", issue.message.c_str());
+  for (const auto& issue : issues) std::fprintf(out, "  geometry: %s\n", issue.message.c_str());
   if (!issues.empty()) sound = false;
   // the map builder would only restate a duplicate as a clash of orientations
   if (std::any_of(issues.begin(), issues.end(), [](const auto& i) { return i.kind == sewn::io::GeometryProblem::duplicate; })) {
@@ -154,13 +163,16 @@ int cmd_check(const std::vector<std::string>& args) {
   map.create_attributes<0>([&](sewn::Dart d) { return built.vertex_of_dart[d.index()]; });
   const auto report = map.validate();
   const auto n = map.count_all();
-  std::printf("map: %u darts; %u vertices, %u edges, %u faces, %u volumes; %u component%s; %zu boundary faces\n",
+  std::fprintf(out, "map: %u darts; %u vertices, %u edges, %u faces, %u volumes; %u component%s; %zu boundary faces\n",
               map.num_darts(), n[0], n[1], n[2], n[3], map.count_components(), map.count_components() == 1 ? "" : "s",
               map.boundary_facets().size());
-  std::printf("sewing: %u facets glued, %u non-manifold facets left unsewn, %u edges with clashing orientation\n",
+  std::fprintf(out, "sewing: %u facets glued, %u non-manifold facets left unsewn, %u edges with clashing orientation\n",
               built.sewn_facets, built.nonmanifold_facets, built.unorientable_edges);
-  std::printf("validation: %s\n", report.str().c_str());
+  std::fprintf(out, "validation: %s\n", report.str().c_str());
   if (!report.ok()) sound = false;
+  const sewn::app::MeshTopology topo = sewn::app::mesh_topology(mesh, path);
+  std::fputs(sewn::app::topology_text(topo).c_str(), out);
+  if (json) std::cout << sewn::app::topology_json(topo).dump(1) << "\n";
   return sound ? ok : bad_input;
 }
 

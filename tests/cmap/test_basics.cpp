@@ -286,3 +286,36 @@ TEST_CASE("the darts of an edge of a 3-map come in chain order, closed or open")
   CHECK(closed > 0);
   CHECK(open > 0);
 }
+
+namespace {
+// A generic size over a range held by const&, as a user's template would write it.
+template <class R>
+std::size_t size_of(const R& r) {
+  std::size_t n = 0;
+  for (Dart d : r) n += d ? 1 : 0;
+  return n;
+}
+}  // namespace
+
+TEST_CASE("cells<I>() of every dimension iterates through const&, more than once") {
+  Map3 m;
+  build(m, hex_grid(2, 3, 1));
+  const auto want = m.count_all();
+  [&]<int... I>(std::integer_sequence<int, I...>) {
+    (
+        [&] {
+          const auto& r = m.template cells<I>();
+          CHECK(size_of(r) == want[I]);
+          CHECK(size_of(r) == want[I]);  // a second pass sees every cell again
+        }(),
+        ...);
+  }(std::make_integer_sequence<int, 4>{});
+  CHECK(m.num_reserved_marks() == 0);
+  // a pass cut short, then a full one
+  const auto& v = m.cells<0>();
+  for (Dart d : v) {
+    (void)d;
+    break;
+  }
+  CHECK(size_of(v) == want[0]);
+}

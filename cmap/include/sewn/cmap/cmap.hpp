@@ -285,8 +285,9 @@ class CMap {
   [[nodiscard]] std::vector<Dart> component(Dart d) const;
   /// Range yielding the smallest dart of each I-cell, in increasing order. Holds a mark while
   /// alive (released on destruction, early break included), except for the cells it recognises
-  /// without one (every cell of a 1- or 2-map, edges and faces of a 3-map). Do not modify the
-  /// map while iterating.
+  /// without one (every cell of a 1- or 2-map, edges and faces of a 3-map). Iterable through a
+  /// const& and more than once (each begin() starts a new pass). Do not modify the map while
+  /// iterating.
   template <int I>
   [[nodiscard]] auto cells() const;
   /// One dart per J-cell incident to the I-cell of d (J < I: its faces; J > I: the cells it
@@ -415,6 +416,38 @@ class CMap {
   /// the new dart β2(path[0]). If the volume falls in two, the part holding path[0] keeps its
   /// attribute and the other gets a copy (on_split). The new face has no 2-attribute. O(path + volume).
   Dart insert_face_in_volume(std::span<const Dart> path);
+
+  /// True if insert_face_in_hole(path) may be called: D ≥ 3, path a closed chain of 2-free darts
+  /// of one volume (end of each = start of the next), 4..D-free, no dart twice. O(path · volume).
+  [[nodiscard]] bool is_insertable_face_in_hole(std::span<const Dart> path) const;
+  /// Closes the hole bounded by the 2-free path with one face (CGAL's insert_cell_2_in_cell_3 on
+  /// a 2-free path): a polygon of path.size() darts, each 2-sewn to its path dart and running
+  /// the other way, 3-free. The new darts take the edge and volume attributes of their path
+  /// dart and the vertex attribute of the vertex they start at; the face has none. No cell
+  /// splits or merges, so no hook fires. Returns the new dart β2(path[0]). Throws TopologyError
+  /// if not insertable. O(path).
+  Dart insert_face_in_hole(std::span<const Dart> path);
+  /// True if insert_vertex_in_face(d) may be called: D ≥ 2, d's face a closed β1 cycle of at
+  /// least two darts. O(face).
+  [[nodiscard]] bool is_insertable_vertex_in_face(Dart d) const;
+  /// Inserts a vertex inside the face of d joined to each of its k vertices (CGAL's
+  /// insert_cell_0_in_cell_2): the face becomes k triangles, across every βj-sewn copy (j ≥ 3).
+  /// Done as an edge from d's start to the next vertex, split by the new vertex, then an edge
+  /// to each remaining vertex; hooks fire as for those insertions: the triangle holding d keeps
+  /// the face's attribute, the k-1 others get copies (on_split); the new vertex and edges have
+  /// no attribute. Returns the new dart that starts at the new vertex and ends at β1(d)'s start.
+  /// Throws TopologyError if not insertable. O(k · face).
+  Dart insert_vertex_in_face(Dart d);
+
+  /// True if insert_dangling_edge_in_face(d) may be called: D is 2 or 3, d live with a β0. O(1).
+  [[nodiscard]] bool is_insertable_dangling_edge_in_face(Dart d) const;
+  /// Inserts an edge inside the face of d from d's start vertex to a new vertex (CGAL's
+  /// insert_dangling_cell_1_in_cell_2), on both sides of a 3-sewn face: two darts per side,
+  /// placed before d. The face stays one face; no cell splits or merges, so no hook fires; the
+  /// new darts keep the face's and volume's attributes and the start vertex's; the new edge and
+  /// vertex have none. Returns the new dart from d's start to the new vertex. Throws
+  /// TopologyError if not insertable. O(1).
+  Dart insert_dangling_edge_in_face(Dart d);
 
   // ---------------------------------------------------------------- removal, contraction
   /// True if the I-cell of d can be removed: I ≥ D-1, or it is incident to at most two

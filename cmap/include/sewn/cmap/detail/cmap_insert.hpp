@@ -193,4 +193,121 @@ Dart CMap<D, A...>::insert_face_in_volume(std::span<const Dart> path) {
   return Dart(p[0]);
 }
 
+
+template <int D, class... A>
+bool CMap<D, A...>::is_insertable_face_in_hole(std::span<const Dart> path) const {
+  if constexpr (D < 3) return false;
+  if (path.empty()) return false;
+  for (Dart d : path) {
+    if (!is_alive(d) || b(d.index(), 2) != detail::null_index) return false;
+    for (int j = 4; j <= D; ++j)
+      if (b(d.index(), j) != detail::null_index) return false;
+  }
+  const DartList vol = cell<3>(path[0]);
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    if (std::find(vol.begin(), vol.end(), path[k]) == vol.end()) return false;
+    if (std::find(path.begin(), path.begin() + static_cast<std::ptrdiff_t>(k), path[k]) != path.begin() + static_cast<std::ptrdiff_t>(k))
+      return false;
+    const std::uint32_t end = b(path[k].index(), 1);
+    if (end == detail::null_index || !same_cell<0>(Dart(end), path[(k + 1) % path.size()])) return false;
+  }
+  return true;
+}
+
+template <int D, class... A>
+Dart CMap<D, A...>::insert_face_in_hole(std::span<const Dart> path) {
+  static_assert(D >= 3, "closing a hole of a volume with a face needs D >= 3");
+  if (!is_insertable_face_in_hole(path))
+    throw TopologyError("cmap::insert_face_in_hole: the " + std::to_string(path.size()) +
+                        " darts are not a closed chain of distinct 2-free darts of one volume");
+  const std::size_t k = path.size();
+  // Path dart d_i goes v_i -> v_{i+1}; the new dart p_i goes v_{i+1} -> v_i, β2(d_i) = p_i. It
+  // lies on d_i's edge and in its volume and starts at d_{i+1}'s vertex: every cell it joins
+  // already exists, so attributes are inherited and nothing merges.
+  std::vector<std::uint32_t> p(k);
+  for (std::size_t i = 0; i < k; ++i) {
+    p[i] = new_dart();
+    inherit_attributes(path[i].index(), p[i], ~5u);
+    inherit_attributes(path[(i + 1) % k].index(), p[i], 1u);
+  }
+  for (std::size_t i = 0; i < k; ++i) {
+    raw_link(p[i], 1, p[(i + k - 1) % k]);
+    raw_link(path[i].index(), 2, p[i]);
+  }
+  return Dart(p[0]);
+}
+
+template <int D, class... A>
+bool CMap<D, A...>::is_insertable_vertex_in_face(Dart d) const {
+  if constexpr (D < 2) return false;
+  if (!is_alive(d)) return false;
+  const std::uint32_t n = b(d.index(), 1);
+  return n != detail::null_index && n != d.index() && is_insertable_edge_in_face(d, Dart(n));
+}
+
+template <int D, class... A>
+Dart CMap<D, A...>::insert_vertex_in_face(Dart d) {
+  if (!is_insertable_vertex_in_face(d))
+    throw TopologyError("cmap::insert_vertex_in_face: the face of dart " + std::to_string(d.index()) +
+                        " is not a closed cycle of at least two darts");
+  // 1) the face's vertices, in order from d
+  std::vector<Dart> c;
+  for (Dart x = d;;) {
+    c.push_back(x);
+    x = Dart(b(x.index(), 1));
+    if (x == d) break;
+  }
+  // 2) an edge from c0's start to c1's start (beside c0), split by the new vertex v
+  const Dart h = insert_edge_in_face(c[0], c[1]);  // c0's start -> c1's start, in c1's face
+  const Dart w = insert_vertex_in_edge(h);         // v -> c1's start
+  // 3) an edge from v to each remaining vertex; each returned dart starts at v and lies in the
+  //    face that holds the next vertex
+  Dart a = w;
+  for (std::size_t j = 2; j < c.size(); ++j) a = insert_edge_in_face(a, c[j]);
+  return w;
+}
+
+
+template <int D, class... A>
+bool CMap<D, A...>::is_insertable_dangling_edge_in_face(Dart d) const {
+  if constexpr (D < 2 || D > 3) return false;
+  return is_alive(d) && b(d.index(), 0) != detail::null_index;
+}
+
+template <int D, class... A>
+Dart CMap<D, A...>::insert_dangling_edge_in_face(Dart d) {
+  static_assert(D == 2 || D == 3, "a dangling edge in a face is inserted in 2- and 3-maps");
+  if (!is_insertable_dangling_edge_in_face(d))
+    throw TopologyError("cmap::insert_dangling_edge_in_face: dart " + std::to_string(d.index()) +
+                        (is_alive(d) ? " has no β0 (an open face)" : " is not a live dart"));
+  // In d's face: β0(d) -> a (s -> v) -> b (v -> s) -> d, with s = d's start and v the new vertex.
+  // On the other side d3 = β3(d) ends at s: d3 -> a3 (s -> v) -> b3 (v -> s) -> old β1(d3), with
+  // β3(a) = b3 and β3(b) = a3, which keeps β1∘β3 = β3∘β0.
+  const std::uint32_t x = d.index(), p = b(x, 0);
+  const std::uint32_t a = new_dart(), bb = new_dart();
+  inherit_attributes(x, a, ~3u);
+  inherit_attributes(x, a, 1u);
+  inherit_attributes(x, bb, ~3u);
+  raw_link(p, 1, a);
+  raw_link(a, 1, bb);
+  raw_link(bb, 1, x);
+  raw_link(a, 2, bb);
+  if constexpr (D == 3) {
+    if (const std::uint32_t x3 = b(x, 3); x3 != detail::null_index) {
+      const std::uint32_t n3 = b(x3, 1);
+      const std::uint32_t a3 = new_dart(), b3 = new_dart();
+      inherit_attributes(x3, a3, ~3u);
+      inherit_attributes(x, a3, 1u);
+      inherit_attributes(x3, b3, ~3u);
+      raw_link(x3, 1, a3);
+      raw_link(a3, 1, b3);
+      raw_link(b3, 1, n3);
+      raw_link(a3, 2, b3);
+      raw_link(a, 3, b3);
+      raw_link(bb, 3, a3);
+    }
+  }
+  return Dart(a);
+}
+
 }  // namespace sewn

@@ -454,18 +454,23 @@ auto CMap<D, A...>::cells() const {
       Range& operator=(const Range&) = delete;
       Range(Range&& o) noexcept : map_(o.map_), mark_(o.mark_), queue_(std::move(o.queue_)) { o.map_ = nullptr; }
 
+      // Iterating is logically const (the range still yields every cell once); the mark and
+      // the queue are its bookkeeping, so a range held by const& can be iterated too.
       struct It : Iter {
-        Range* r;
+        const Range* r;
         It& operator++() {
           this->x = r->next(this->x + 1);
           return *this;
         }
       };
-      It begin() { return It{{next(0)}, this}; }
-      It end() { return It{{map_->dart_capacity()}, this}; }
+      It begin() const {
+        map_->unmark_all(mark_);  // a new pass (O(1) after a full one)
+        return It{{next(0)}, this};
+      }
+      It end() const { return It{{map_->dart_capacity()}, this}; }
 
      private:
-      std::uint32_t next(std::uint32_t x) {
+      std::uint32_t next(std::uint32_t x) const {
         const std::uint32_t n = map_->dart_capacity();
         const MarkView mk = map_->marks_.view(mark_);
         x = mk.next_unmarked(x, n);
@@ -479,7 +484,7 @@ auto CMap<D, A...>::cells() const {
       }
       const CMap* map_;
       Mark mark_;
-      detail::DartBuffer<64> queue_;
+      mutable detail::DartBuffer<64> queue_;
     };
     return Range(this);
   }
