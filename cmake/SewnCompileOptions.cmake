@@ -9,6 +9,13 @@ endif()
 if(SEWN_NATIVE)
   target_compile_options(sewn_build_flags INTERFACE -march=native)
 endif()
+# GCC 12's basic-block (SLP) vectoriser miscompiles small aggregates when AVX-512 is enabled:
+# an inlined call taking std::array<int64_t, 4>{1, 1, 0, 0} receives {1, 1, 1, 1} (at -O2 and
+# -O3, -march=native on AVX-512 machines). Loop vectorisation and our explicit intrinsics are
+# not affected; tests/cmap/test_toolchain.cpp fails where the flag is missing.
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
+  target_compile_options(sewn_build_flags INTERFACE -fno-tree-slp-vectorize)
+endif()
 if(SEWN_SANITIZE)
   target_compile_options(sewn_build_flags INTERFACE -fsanitize=${SEWN_SANITIZE} -fno-omit-frame-pointer
                          -fno-sanitize-recover=all)
