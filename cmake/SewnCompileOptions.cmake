@@ -1,5 +1,6 @@
 # Warning, optimisation and sanitizer flags shared by every Sewn target.
-# sewn_module(<name>) turns a library into an exported, installable sewn::<name> module.
+# sewn_module(<name>) turns a library into an exported, installable sewn::<name> module, a
+# component of the installed package (cmake/SewnConfig.cmake.in lists what each one needs).
 
 add_library(sewn_build_flags INTERFACE)
 target_compile_options(sewn_build_flags INTERFACE -Wall -Wextra -Wpedantic)
@@ -22,6 +23,19 @@ if(SEWN_SANITIZE)
   target_link_options(sewn_build_flags INTERFACE -fsanitize=${SEWN_SANITIZE})
 endif()
 
+# libFuzzer needs clang; with another compiler the fuzz targets are skipped, not an error, so
+# one preset list works on every machine.
+if(SEWN_FUZZ AND NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+  message(STATUS "SEWN_FUZZ: libFuzzer needs clang (this is ${CMAKE_CXX_COMPILER_ID}): fuzz targets skipped")
+  set(SEWN_FUZZ OFF)
+endif()
+if(SEWN_FUZZ)
+  # Every library the targets link gets coverage instrumentation; tests/fuzz adds the driver.
+  target_compile_options(sewn_build_flags INTERFACE -fsanitize=fuzzer-no-link,address,undefined
+                         -fno-omit-frame-pointer -fno-sanitize-recover=all)
+  target_link_options(sewn_build_flags INTERFACE -fsanitize=address,undefined)
+endif()
+
 function(sewn_module name)
   add_library(sewn::${name} ALIAS sewn_${name})
   set_target_properties(sewn_${name} PROPERTIES EXPORT_NAME ${name} POSITION_INDEPENDENT_CODE ON)
@@ -30,8 +44,12 @@ function(sewn_module name)
     $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   target_compile_features(sewn_${name} PUBLIC cxx_std_20)
   target_link_libraries(sewn_${name} PRIVATE $<BUILD_INTERFACE:sewn_build_flags>)
-  install(TARGETS sewn_${name} EXPORT SewnTargets
+  # One export file per module, so that find_package(Sewn COMPONENTS <name>) loads only the
+  # modules asked for (and those they need) and finds only their dependencies (SewnConfig.cmake.in).
+  install(TARGETS sewn_${name} EXPORT Sewn_${name}Targets
           ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
           LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(EXPORT Sewn_${name}Targets NAMESPACE sewn:: FILE Sewn-${name}-targets.cmake
+          DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/Sewn)
   install(DIRECTORY include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 endfunction()

@@ -35,7 +35,8 @@ std::uint32_t hex_grid_faces(std::uint32_t x, std::uint32_t y, std::uint32_t z) 
 }  // namespace
 
 TEST_CASE("hexahedral grids of any size and spacing") {
-  for (auto [x, y, z] : {std::array<std::uint32_t, 3>{1, 1, 1}, {3, 2, 4}, {8, 8, 10}, {1, 5, 1}}) {
+  for (const auto& size : {std::array<std::uint32_t, 3>{1, 1, 1}, {3, 2, 4}, {8, 8, 10}, {1, 5, 1}}) {
+    const std::uint32_t x = size[0], y = size[1], z = size[2];  // CAPTURE cannot take bindings (clang 14)
     CAPTURE(x);
     CAPTURE(y);
     CAPTURE(z);

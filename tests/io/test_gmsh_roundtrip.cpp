@@ -87,7 +87,9 @@ TEST_CASE("structured meshes: counts from the .geo construction, in MSH 2.2, MSH
                                              {"square_tri", {CellType::triangle, 18, 16, 1.0, 3}},
                                              {"square_quad", {CellType::quad, 9, 16, 1.0, 3}},
                                              {"slab_prism", {CellType::prism, 36, 48, 0.5, 9}}};
-  for (const auto& [geo, e] : expect) {
+  for (const auto& entry : expect) {
+    const std::string& geo = entry.first;  // CAPTURE and lambdas cannot take bindings (clang 14)
+    const Expect& e = entry.second;
     const auto m22 = load(geo, "msh22");
     const auto m41 = load(geo, "msh41");
     for (const auto* f : {&m22, &m41}) {

@@ -71,7 +71,9 @@ void check_physics(const MssModel<D>& m) {
       REQUIRE(close(s.viscosity(sp), paper_viscosity(s.stiffness(sp), nodes.mass(s.node_i(sp)), nodes.mass(s.node_j(sp)))));
   }
   REQUIRE(spring_k.size() == edge_k.size());
-  for (const auto& [ij, k] : spring_k) {
+  for (const auto& entry : spring_k) {
+    const auto& ij = entry.first;  // CAPTURE cannot take bindings (clang 14)
+    const double k = entry.second;
     CAPTURE(ij.first);
     CAPTURE(ij.second);
     REQUIRE(edge_k.count(ij) == 1);

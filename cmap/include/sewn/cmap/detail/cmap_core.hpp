@@ -115,7 +115,10 @@ void CMap<D, A...>::flush_erased() {
   if (pending_erase_.empty()) return;
   auto pending = std::move(pending_erase_);
   pending_erase_.clear();
-  for (auto [k, a] : pending) {
+  // Plain variables, not a structured binding: clang 14 cannot capture bindings in the lambda.
+  for (const auto& entry : pending) {
+    const int k = entry.first;
+    const std::uint32_t a = entry.second;
     for_each_dim([&](auto kk) {
       constexpr int K = kk();
       if constexpr (has_attribute<K>) {
