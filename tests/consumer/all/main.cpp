@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "sewn/cmap/build.hpp"
+#include "sewn/connect/point.hpp"
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/render.hpp"
 #include "sewn/physics/integrators.hpp"
