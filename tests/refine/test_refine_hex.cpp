@@ -83,14 +83,18 @@ void same_model(const MssModel<3>& refined, const MssModel<3>& fine) {
   const Snapshot a = snapshot(refined), b = snapshot(fine);
   REQUIRE(a.node.size() == b.node.size());
   REQUIRE(a.spring.size() == b.spring.size());
-  for (const auto& [k, i] : a.node) {
+  for (const auto& node : a.node) {
+    const auto& k = node.first;
+    const Index i = node.second;
     REQUIRE(b.node.count(k) == 1);
     const Index j = b.node.at(k);
     CHECK(close(refined.nodes().mass(i), fine.nodes().mass(j)));
     CHECK((refined.nodes().position(i) - fine.nodes().position(j)).norm() <= 1e-12);
     CHECK((refined.nodes().velocity(i) - fine.nodes().velocity(j)).norm() <= 1e-12);
   }
-  for (const auto& [k, v] : a.spring) {
+  for (const auto& spring : a.spring) {
+    const auto& k = spring.first;
+    const auto& v = spring.second;
     REQUIRE(b.spring.count(k) == 1);
     const auto& w = b.spring.at(k);
     INFO("spring kind " << std::get<2>(k));

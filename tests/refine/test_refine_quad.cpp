@@ -87,7 +87,9 @@ void same_model(const MssModel<2>& refined, const MssModel<2>& fine, double hx, 
   const Snapshot a = snapshot(refined, hx, hy), b = snapshot(fine, hx, hy);
   REQUIRE(a.node.size() == b.node.size());
   REQUIRE(a.spring.size() == b.spring.size());
-  for (const auto& [k, i] : a.node) {
+  for (const auto& node : a.node) {
+    const auto& k = node.first;
+    const Index i = node.second;
     REQUIRE(b.node.count(k) == 1);
     const Index j = b.node.at(k);
     INFO("particle at (" << k[0] << ", " << k[1] << ")/64");
@@ -95,7 +97,9 @@ void same_model(const MssModel<2>& refined, const MssModel<2>& fine, double hx, 
     CHECK((refined.nodes().position(i) - fine.nodes().position(j)).norm() <= 1e-12);
     CHECK((refined.nodes().velocity(i) - fine.nodes().velocity(j)).norm() <= 1e-12);
   }
-  for (const auto& [k, v] : a.spring) {
+  for (const auto& spring : a.spring) {
+    const auto& k = spring.first;
+    const auto& v = spring.second;
     REQUIRE(b.spring.count(k) == 1);
     const auto& w = b.spring.at(k);
     INFO("spring kind " << std::get<2>(k));
