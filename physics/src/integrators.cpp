@@ -4,24 +4,17 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <sstream>
 #include <string>
 
 #include "sewn/physics/errors.hpp"
+#include "format.hpp"
 
 namespace sewn::physics {
 
 namespace {
 
-std::string fmt(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
-
 void check_step(double h, const char* who) {
-  if (!(std::isfinite(h) && h > 0)) throw InputError(std::string(who) + ": time step must be finite and > 0, got " + fmt(h));
+  if (!(std::isfinite(h) && h > 0)) throw InputError(std::string(who) + ": time step must be finite and > 0, got " + detail::format_number(h));
 }
 
 // 1 if x is an infinity or a NaN: an integer test of the exponent bits, which vectorises (as an
@@ -55,7 +48,7 @@ bool all_finite(std::span<const double> a, Spans... more) {
       const double* p = q.values.data() + 3 * std::size_t{i};
       if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) continue;
       std::string msg = std::string(who) + ": " + q.name + " of node " + std::to_string(i) + " is not finite (" +
-                        fmt(p[0]) + ", " + fmt(p[1]) + ", " + fmt(p[2]) + "); the step was not taken";
+                        detail::format_number(p[0]) + ", " + detail::format_number(p[1]) + ", " + detail::format_number(p[2]) + "); the step was not taken";
       if (std::string(q.name) == "force") msg += " (positions and velocities are finite: a force term overflowed)";
       throw BlowupError(msg, i, q.name);
     }
@@ -95,10 +88,10 @@ StepReport SymplecticEuler::step(System& sys, double h) {
     }
     rep.stable_step = bound_.h_max;
     if (!(h < bound_.h_max)) {
-      throw StabilityError("SymplecticEuler::step: h = " + fmt(h) + " s is not below the stable-step bound " +
-                               fmt(bound_.h_max) + " s (omega_max <= " + fmt(std::sqrt(bound_.stiffness_bound)) +
+      throw StabilityError("SymplecticEuler::step: h = " + detail::format_number(h) + " s is not below the stable-step bound " +
+                               detail::format_number(bound_.h_max) + " s (omega_max <= " + detail::format_number(std::sqrt(bound_.stiffness_bound)) +
                                " rad/s from node " + std::to_string(bound_.stiffness_node) + ", damping rate <= " +
-                               fmt(bound_.damping_bound) + " 1/s). Use a smaller step or LinearlyImplicitEuler, or "
+                               detail::format_number(bound_.damping_bound) + " 1/s). Use a smaller step or LinearlyImplicitEuler, or "
                                "set enforce_stable_step = false; the state is unchanged.",
                            h, bound_.h_max);
     }
@@ -136,9 +129,9 @@ StepReport SymplecticEuler::step(System& sys, double h) {
   if (watch && finite)
     if (auto blowup = watchdog_.after_step(sys, opt_.health, steps_, max_speed)) {
       const double suggested = 0.9 * bound_.h_max;
-      throw BlowupError("SymplecticEuler::step: " + blowup->message + ". The step h = " + fmt(h) +
+      throw BlowupError("SymplecticEuler::step: " + blowup->message + ". The step h = " + detail::format_number(h) +
                             " s is too large for the scheme: the stable-step bound at the start was " +
-                            fmt(bound_.h_max) + " s; suggested step " + fmt(suggested) + " s",
+                            detail::format_number(bound_.h_max) + " s; suggested step " + detail::format_number(suggested) + " s",
                         blowup->node, "energy", steps_, suggested);
     }
   return rep;
@@ -157,7 +150,7 @@ void LinearlyImplicitEuler::reset() {
 StepReport LinearlyImplicitEuler::step(System& sys, double h) {
   check_step(h, "LinearlyImplicitEuler::step");
   if (!(opt_.cg_tolerance > 0 && std::isfinite(opt_.cg_tolerance)))
-    throw InputError("LinearlyImplicitEuler::step: cg_tolerance must be finite and > 0, got " + fmt(opt_.cg_tolerance));
+    throw InputError("LinearlyImplicitEuler::step: cg_tolerance must be finite and > 0, got " + detail::format_number(opt_.cg_tolerance));
   if (opt_.cg_max_iterations < 1)
     throw InputError("LinearlyImplicitEuler::step: cg_max_iterations must be >= 1, got " +
                      std::to_string(opt_.cg_max_iterations));
@@ -188,7 +181,7 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
   so.max_iterations = opt_.cg_max_iterations;
   if (!(so.absolute_tolerance >= 0 && std::isfinite(so.absolute_tolerance)))
     throw InputError("LinearlyImplicitEuler::step: cg_absolute_tolerance must be finite and >= 0, got " +
-                     fmt(so.absolute_tolerance));
+                     detail::format_number(so.absolute_tolerance));
   const bool watch = opt_.health.energy_check_interval > 0;
   if (watch) watchdog_.baseline_if_needed(sys);
 
@@ -255,7 +248,7 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
     throw SolverError("LinearlyImplicitEuler::step " + std::to_string(steps_ + 1) + ": the " +
                           std::string(solve::to_string(sr.backend)) + " solve stopped after " +
                           std::to_string(sr.iterations) + " iterations at relative residual " +
-                          fmt(sr.relative_residual) + " (tolerance " + fmt(opt_.cg_tolerance) + ", limit " +
+                          detail::format_number(sr.relative_residual) + " (tolerance " + detail::format_number(opt_.cg_tolerance) + ", limit " +
                           std::to_string(opt_.cg_max_iterations) + " iterations); the state is unchanged",
                       sr.iterations, sr.relative_residual);
   }
@@ -287,7 +280,7 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
       // fails (fast rotation, large strain), which a smaller step makes smaller.
       const double suggested = h / 10;
       throw BlowupError("LinearlyImplicitEuler::step: " + blowup->message + ". The linearised step failed at h = " +
-                            fmt(h) + " s; suggested step " + fmt(suggested) +
+                            detail::format_number(h) + " s; suggested step " + detail::format_number(suggested) +
                             " s, or the momentum-conserving integrator for fast rotations",
                         blowup->node, "energy", steps_, suggested);
     }

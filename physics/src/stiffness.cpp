@@ -2,36 +2,29 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include <Eigen/Geometry>
 
 #include "sewn/physics/errors.hpp"
+#include "format.hpp"
 
 namespace sewn::physics {
 
 namespace {
 
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
-
 void check_material(const char* where, double E, double nu) {
-  if (!(std::isfinite(E) && E > 0)) throw InputError(std::string(where) + ": Young's modulus E must be finite and > 0, got " + num(E));
+  if (!(std::isfinite(E) && E > 0)) throw InputError(std::string(where) + ": Young's modulus E must be finite and > 0, got " + detail::format_number(E));
   if (!(std::isfinite(nu) && nu > -1.0 && nu < 0.5))
-    throw InputError(std::string(where) + ": Poisson ratio nu must lie in (-1, 0.5), got " + num(nu));
+    throw InputError(std::string(where) + ": Poisson ratio nu must lie in (-1, 0.5), got " + detail::format_number(nu));
 }
 
 void check_positive(const char* where, const char* what, double v) {
-  if (!(std::isfinite(v) && v > 0)) throw InputError(std::string(where) + ": " + what + " must be finite and > 0, got " + num(v));
+  if (!(std::isfinite(v) && v > 0)) throw InputError(std::string(where) + ": " + what + " must be finite and > 0, got " + detail::format_number(v));
 }
 
 void check_nu(const char* where, double nu) {
   if (!(std::isfinite(nu) && nu > -1.0 && nu < 0.5))
-    throw InputError(std::string(where) + ": Poisson ratio nu must lie in (-1, 0.5), got " + num(nu));
+    throw InputError(std::string(where) + ": Poisson ratio nu must lie in (-1, 0.5), got " + detail::format_number(nu));
 }
 
 }  // namespace
@@ -86,12 +79,12 @@ BoxStiffness baudet_box(double E, double nu, double lx, double ly, double lz) {
 }
 
 std::string describe(const BoxStiffness& s) {
-  return "edge stiffness along x = " + num(s.edge[0]) + ", along y = " + num(s.edge[1]) + ", along z = " + num(s.edge[2]) +
-         ", diagonal = " + num(s.diagonal);
+  return "edge stiffness along x = " + detail::format_number(s.edge[0]) + ", along y = " + detail::format_number(s.edge[1]) + ", along z = " + detail::format_number(s.edge[2]) +
+         ", diagonal = " + detail::format_number(s.diagonal);
 }
 
 std::string describe(const RectangleStiffness& s) {
-  return "edge stiffness along x = " + num(s.edge[0]) + ", along y = " + num(s.edge[1]) + ", diagonal = " + num(s.diagonal);
+  return "edge stiffness along x = " + detail::format_number(s.edge[0]) + ", along y = " + detail::format_number(s.edge[1]) + ", diagonal = " + detail::format_number(s.diagonal);
 }
 
 double baudet_rectangle_max_aspect(double nu) {
@@ -106,13 +99,13 @@ double baudet_box_max_aspect(double nu) {
 }
 
 BoxStiffness clamp_edges(BoxStiffness s, double floor) {
-  if (!(std::isfinite(floor) && floor >= 0)) throw InputError("clamp_edges: floor must be finite and >= 0, got " + num(floor));
+  if (!(std::isfinite(floor) && floor >= 0)) throw InputError("clamp_edges: floor must be finite and >= 0, got " + detail::format_number(floor));
   for (double& e : s.edge) e = std::max(e, floor);
   return s;
 }
 
 RectangleStiffness clamp_edges(RectangleStiffness s, double floor) {
-  if (!(std::isfinite(floor) && floor >= 0)) throw InputError("clamp_edges: floor must be finite and >= 0, got " + num(floor));
+  if (!(std::isfinite(floor) && floor >= 0)) throw InputError("clamp_edges: floor must be finite and >= 0, got " + detail::format_number(floor));
   for (double& e : s.edge) e = std::max(e, floor);
   return s;
 }
@@ -163,7 +156,7 @@ std::array<double, 6> van_gelder_tet(double E, const Eigen::Vector3d& p0, const 
   for (const auto& e : edges) lmax = std::max(lmax, (*p[e[1]] - *p[e[0]]).norm());
   const double vol = tet_volume(p0, p1, p2, p3);
   if (!(std::isfinite(vol) && vol > 1e-14 * lmax * lmax * lmax))
-    throw InputError("van_gelder_tet: degenerate tetrahedron (volume " + num(vol) + ", longest edge " + num(lmax) + ")");
+    throw InputError("van_gelder_tet: degenerate tetrahedron (volume " + detail::format_number(vol) + ", longest edge " + detail::format_number(lmax) + ")");
   std::array<double, 6> k{};
   for (int e = 0; e < 6; ++e) k[e] = van_gelder_tet_edge(E, vol, (*p[edges[e][1]] - *p[edges[e][0]]).norm());
   return k;
@@ -176,7 +169,7 @@ std::array<double, 3> van_gelder_triangle(double E, const Eigen::Vector3d& p0, c
   for (int e = 0; e < 3; ++e) lmax = std::max(lmax, (*p[(e + 1) % 3] - *p[e]).norm());
   const double area = triangle_area(p0, p1, p2);
   if (!(std::isfinite(area) && area > 1e-14 * lmax * lmax))
-    throw InputError("van_gelder_triangle: degenerate triangle (area " + num(area) + ", longest edge " + num(lmax) + ")");
+    throw InputError("van_gelder_triangle: degenerate triangle (area " + detail::format_number(area) + ", longest edge " + detail::format_number(lmax) + ")");
   std::array<double, 3> k{};
   for (int e = 0; e < 3; ++e) k[e] = van_gelder_triangle_edge(E, area, (*p[(e + 1) % 3] - *p[e]).norm());
   return k;

@@ -2,22 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <string>
 
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/springs.hpp"
+#include "../format.hpp"
 
 namespace sewn::physics {
 
 namespace {
-
-std::string fmt(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
 
 double norm2(std::span<const double> a) {
   double s = 0;
@@ -72,7 +65,7 @@ void ImplicitMidpoint::restore(NodeTable& nodes) const {
 }
 
 StepReport ImplicitMidpoint::step(System& sys, double h) {
-  if (!(std::isfinite(h) && h > 0)) throw InputError("ImplicitMidpoint::step: time step must be finite and > 0, got " + fmt(h));
+  if (!(std::isfinite(h) && h > 0)) throw InputError("ImplicitMidpoint::step: time step must be finite and > 0, got " + detail::format_number(h));
   if (!(opt_.newton_tolerance > 0 && opt_.cg_tolerance > 0 && opt_.max_newton_iterations >= 1 && opt_.cg_max_iterations >= 1))
     throw InputError("ImplicitMidpoint::step: tolerances must be > 0 and iteration limits >= 1");
   for (const auto& t : sys.terms())
@@ -131,7 +124,7 @@ StepReport ImplicitMidpoint::step(System& sys, double h) {
     if (!finite) {
       restore(nodes);
       throw BlowupError("ImplicitMidpoint::step: non-finite forces at the midpoint state after " +
-                            std::to_string(newton_iterations_) + " Newton iterations (h = " + fmt(h) +
+                            std::to_string(newton_iterations_) + " Newton iterations (h = " + detail::format_number(h) +
                             " s); the state is unchanged",
                         invalid_index, "force", steps_ + 1, h / 10);
     }
@@ -145,8 +138,8 @@ StepReport ImplicitMidpoint::step(System& sys, double h) {
     if (newton_iterations_ == opt_.max_newton_iterations) {
       restore(nodes);
       throw SolverError("ImplicitMidpoint::step: Newton stopped after " + std::to_string(newton_iterations_) +
-                            " iterations at residual " + fmt(residual) + " (" + fmt(residual / scale) +
-                            " of the momentum and impulse in play, tolerance " + fmt(opt_.newton_tolerance) +
+                            " iterations at residual " + detail::format_number(residual) + " (" + detail::format_number(residual / scale) +
+                            " of the momentum and impulse in play, tolerance " + detail::format_number(opt_.newton_tolerance) +
                             "); try a smaller step; the state is unchanged",
                         newton_iterations_, residual / scale);
     }
@@ -167,8 +160,8 @@ StepReport ImplicitMidpoint::step(System& sys, double h) {
     if (!cg.converged) {
       restore(nodes);
       throw SolverError("ImplicitMidpoint::step: CG stopped after " + std::to_string(cg.iterations) +
-                            " iterations at relative residual " + fmt(cg.relative_residual) + " (tolerance " +
-                            fmt(opt_.cg_tolerance) + ") in Newton iteration " + std::to_string(newton_iterations_ + 1) +
+                            " iterations at relative residual " + detail::format_number(cg.relative_residual) + " (tolerance " +
+                            detail::format_number(opt_.cg_tolerance) + ") in Newton iteration " + std::to_string(newton_iterations_ + 1) +
                             (cg.breakdown ? "; breakdown: the matrix is not positive definite" : "") +
                             "; the state is unchanged",
                         cg.iterations, cg.relative_residual);
@@ -195,8 +188,8 @@ StepReport ImplicitMidpoint::step(System& sys, double h) {
   if (watch && finite)
     if (auto blowup = watchdog_.after_step(sys, opt_.health, steps_, max_speed)) {
       const double suggested = h / 10;
-      throw BlowupError("ImplicitMidpoint::step: " + blowup->message + " at h = " + fmt(h) + " s; suggested step " +
-                            fmt(suggested) + " s",
+      throw BlowupError("ImplicitMidpoint::step: " + blowup->message + " at h = " + detail::format_number(h) + " s; suggested step " +
+                            detail::format_number(suggested) + " s",
                         blowup->node, "energy", steps_, suggested);
     }
   return rep;

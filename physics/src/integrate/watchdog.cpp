@@ -1,22 +1,11 @@
 #include "sewn/physics/integrate/watchdog.hpp"
+#include "../format.hpp"
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <sstream>
 
 namespace sewn::physics {
-
-namespace {
-
-std::string fmt(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
-
-}  // namespace
 
 double max_abs_component(std::span<const double> values) {
   std::uint64_t m = 0;
@@ -69,10 +58,10 @@ std::optional<EnergyBlowup> EnergyWatchdog::check(const System& sys, const Healt
       fastest = i;
     }
   }
-  return EnergyBlowup{"energy blow-up at step " + std::to_string(step) + ": kinetic + internal energy " + fmt(internal) +
-                          " J exceeds " + fmt(opt.energy_growth_factor) + " x its budget " + fmt(budget) +
-                          " J (baseline energy plus work of external fields) + floor " + fmt(floor) +
-                          " J; fastest node " + std::to_string(fastest) + " has speed " + fmt(vmax) + " m/s",
+  return EnergyBlowup{"energy blow-up at step " + std::to_string(step) + ": kinetic + internal energy " + detail::format_number(internal) +
+                          " J exceeds " + detail::format_number(opt.energy_growth_factor) + " x its budget " + detail::format_number(budget) +
+                          " J (baseline energy plus work of external fields) + floor " + detail::format_number(floor) +
+                          " J; fastest node " + std::to_string(fastest) + " has speed " + detail::format_number(vmax) + " m/s",
                       fastest};
 }
 

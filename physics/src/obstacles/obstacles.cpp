@@ -11,18 +11,13 @@
 #include <Eigen/Geometry>
 
 #include "sewn/physics/errors.hpp"
+#include "../format.hpp"
 
 namespace sewn::physics::obstacles {
 
 namespace {
 
 constexpr double smooth_min_power = 8;
-
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 // One face's depth d_f > 0 with its gradient and Hessian.
 struct Face {
@@ -151,9 +146,9 @@ std::string_view type_name(const Shape& shape) {
 }
 
 Obstacles::Obstacles(double stiffness, double friction_velocity) : k_(stiffness), eps_v_(friction_velocity) {
-  if (!(std::isfinite(k_) && k_ > 0)) throw InputError("obstacles: stiffness must be finite and > 0 N/m, got " + num(k_));
+  if (!(std::isfinite(k_) && k_ > 0)) throw InputError("obstacles: stiffness must be finite and > 0 N/m, got " + detail::format_number(k_));
   if (!(std::isfinite(eps_v_) && eps_v_ > 0))
-    throw InputError("obstacles: friction velocity must be finite and > 0 m/s, got " + num(eps_v_));
+    throw InputError("obstacles: friction velocity must be finite and > 0 m/s, got " + detail::format_number(eps_v_));
 }
 
 Index Obstacles::add(const Shape& shape_in) {
@@ -167,7 +162,7 @@ Index Obstacles::add(const Shape& shape_in) {
     if (!v.allFinite()) throw InputError(who + what + " must be finite");
   };
   auto positive = [&](double v, const char* what) {
-    if (!(std::isfinite(v) && v > 0)) throw InputError(who + what + " must be finite and > 0, got " + num(v));
+    if (!(std::isfinite(v) && v > 0)) throw InputError(who + what + " must be finite and > 0, got " + detail::format_number(v));
   };
   std::visit(
       [&](auto& s) {
@@ -175,7 +170,7 @@ Index Obstacles::add(const Shape& shape_in) {
         if constexpr (std::is_same_v<T, Plane>) {
           point(s.point, "point");
           unit(s.normal, "normal");
-          if (!(std::isfinite(s.friction) && s.friction >= 0)) throw InputError(who + "friction must be finite and >= 0, got " + num(s.friction));
+          if (!(std::isfinite(s.friction) && s.friction >= 0)) throw InputError(who + "friction must be finite and >= 0, got " + detail::format_number(s.friction));
         } else if constexpr (std::is_same_v<T, Sphere>) {
           point(s.center, "center");
           positive(s.radius, "radius");
@@ -189,7 +184,7 @@ Index Obstacles::add(const Shape& shape_in) {
           point(s.apex, "apex");
           unit(s.axis, "axis");
           if (!(std::isfinite(s.half_angle) && s.half_angle > 0 && s.half_angle < std::numbers::pi / 2))
-            throw InputError(who + "half angle must be in (0, pi/2) rad, got " + num(s.half_angle));
+            throw InputError(who + "half angle must be in (0, pi/2) rad, got " + detail::format_number(s.half_angle));
           positive(s.height, "height");
         }
       },

@@ -8,16 +8,11 @@
 #include <Eigen/SparseCholesky>
 
 #include "sewn/physics/errors.hpp"
+#include "../format.hpp"
 
 namespace sewn::physics::rods {
 
 namespace {
-
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 // LDLᵀ solve of (T + shift·I) p = −g for a tridiagonal T (diagonal `diag`, `sub[k]` coupling
 // k and k+1). False if a pivot is not positive (the shifted matrix is not positive definite).
@@ -132,7 +127,7 @@ void Rod::refresh_stencil_frames(int s) {
 void Rod::set_natural_strains(int s, double kappa1, double kappa2, double twist) {
   if (s < 0 || s >= num_stencils() || !std::isfinite(kappa1) || !std::isfinite(kappa2) || !std::isfinite(twist))
     throw InputError("rods::Rod::set_natural_strains: stencil " + std::to_string(s) + " of " +
-                     std::to_string(num_stencils()) + ", values " + num(kappa1) + ", " + num(kappa2) + ", " + num(twist));
+                     std::to_string(num_stencils()) + ", values " + detail::format_number(kappa1) + ", " + detail::format_number(kappa2) + ", " + detail::format_number(twist));
   BendTwistRest& r = stencils_[static_cast<std::size_t>(s)].rest;
   r.kappa1 = kappa1;
   r.kappa2 = kappa2;
@@ -142,7 +137,7 @@ void Rod::set_natural_strains(int s, double kappa1, double kappa2, double twist)
 void Rod::set_theta(int edge, double value) {
   if (edge < 0 || edge >= num_edges() || !std::isfinite(value))
     throw InputError("rods::Rod::set_theta: edge " + std::to_string(edge) + " of " + std::to_string(num_edges()) +
-                     ", value " + num(value));
+                     ", value " + detail::format_number(value));
   theta_[static_cast<std::size_t>(edge)] = value;
 }
 
@@ -291,7 +286,7 @@ int Rod::solve_twist(const Points& x) {
       theta_ = start;
       if (step.lpNorm<Eigen::Infinity>() < 1e-8) return it;
       throw SolveError("rods::Rod::solve_twist: no descent along the Newton direction (|step| = " +
-                       num(step.lpNorm<Eigen::Infinity>()) + " rad)");
+                       detail::format_number(step.lpNorm<Eigen::Infinity>()) + " rad)");
     }
     if (alpha * step.lpNorm<Eigen::Infinity>() < 1e-13) return it + 1;
   }

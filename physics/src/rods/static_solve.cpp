@@ -8,6 +8,7 @@
 #include <Eigen/SparseCholesky>
 
 #include "sewn/physics/errors.hpp"
+#include "../format.hpp"
 
 namespace sewn::physics::rods {
 
@@ -117,12 +118,6 @@ Eigen::SparseMatrix<double> reduce(const Trips& full, const std::vector<int>& ma
   return A;
 }
 
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
 }  // namespace
 
 StaticResult solve_static(Rod& rod, Points& x, const StaticProblem& problem) {
@@ -204,7 +199,7 @@ StaticResult solve_static(Rod& rod, Points& x, const StaticProblem& problem) {
     }
     if (!accepted) {
       apply(0);
-      throw SolveError("rods::solve_static: no descent at iteration " + std::to_string(it) + " (step size " + num(size) + ")");
+      throw SolveError("rods::solve_static: no descent at iteration " + std::to_string(it) + " (step size " + detail::format_number(size) + ")");
     }
     if (alpha * size < problem.tolerance) {
       res.iterations = it + 1;
