@@ -8,6 +8,7 @@
 
 #include "sewn/physics/errors.hpp"
 #include "format.hpp"
+#include "integrate/require_symmetric.hpp"
 
 namespace sewn::physics {
 
@@ -154,11 +155,7 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
   if (opt_.cg_max_iterations < 1)
     throw InputError("LinearlyImplicitEuler::step: cg_max_iterations must be >= 1, got " +
                      std::to_string(opt_.cg_max_iterations));
-  for (const auto& t : sys.terms())
-    if (!t->jacobian_symmetric(opt_.jacobian))
-      throw InputError("LinearlyImplicitEuler::step: term '" + std::string(t->name()) +
-                       "' gives a non-symmetric matrix with these JacobianOptions (set "
-                       "drop_viscous_position_terms = true); CG needs a symmetric matrix");
+  detail::require_symmetric_jacobians(sys, opt_.jacobian, "LinearlyImplicitEuler::step");
   StepReport rep;
   rep.pattern_rebuilt = sys.refresh();
   NodeTable& nodes = sys.nodes();

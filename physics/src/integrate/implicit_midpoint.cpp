@@ -7,6 +7,7 @@
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/springs.hpp"
 #include "../format.hpp"
+#include "require_symmetric.hpp"
 
 namespace sewn::physics {
 
@@ -68,11 +69,7 @@ StepReport ImplicitMidpoint::step(System& sys, double h) {
   if (!(std::isfinite(h) && h > 0)) throw InputError("ImplicitMidpoint::step: time step must be finite and > 0, got " + detail::format_number(h));
   if (!(opt_.newton_tolerance > 0 && opt_.cg_tolerance > 0 && opt_.max_newton_iterations >= 1 && opt_.cg_max_iterations >= 1))
     throw InputError("ImplicitMidpoint::step: tolerances must be > 0 and iteration limits >= 1");
-  for (const auto& t : sys.terms())
-    if (!t->jacobian_symmetric(opt_.jacobian))
-      throw InputError("ImplicitMidpoint::step: term '" + std::string(t->name()) +
-                       "' gives a non-symmetric matrix with these JacobianOptions (set drop_viscous_position_terms = "
-                       "true); CG needs a symmetric matrix");
+  detail::require_symmetric_jacobians(sys, opt_.jacobian, "ImplicitMidpoint::step");
   StepReport rep;
   rep.pattern_rebuilt = sys.refresh();
   NodeTable& nodes = sys.nodes();
