@@ -10,30 +10,17 @@
 #include "sewn/refine/cut.hpp"
 #include "sewn/refine/hierarchy.hpp"
 #include "sewn/refine/subdivide.hpp"
+#include "support.hpp"
 
 using namespace sewn;
 using namespace sewn::physics;
 using namespace sewn::refine;
+using namespace refine_test;
 using Eigen::Vector3d;
 
 namespace {
 
 const MaterialParams material{1e5, 0.3, 100, 0.5};
-
-MssOptions options() {
-  MssOptions o;
-  o.gravity.setZero();
-  return o;
-}
-
-void check_all(const MssModel<2>& m) {
-  const auto report = m.map().validate();
-  INFO(report.str());
-  REQUIRE(report.ok());
-  const HierarchyReport h = check_hierarchy(m);
-  INFO(h.str());
-  REQUIRE(h.ok());
-}
 
 // Live particles by rest point, live springs by their ends' rest points and kind.
 using Key = std::array<long, 2>;
@@ -79,7 +66,7 @@ Vector3d momentum(const NodeTable& n) {
 }  // namespace
 
 TEST_CASE("coarsen: refine then coarsen gives back the model, with momentum kept and energy reported") {
-  MssModel<2> m(quad_grid(3, 3, {{0.1, 0.1, 1}, {}}), {material}, {}, options());
+  MssModel<2> m(quad_grid(3, 3, {{0.1, 0.1, 1}, {}}), {material}, {}, no_gravity());
   const Snapshot original = snapshot(m);
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1, 1);
@@ -108,7 +95,7 @@ TEST_CASE("coarsen: refine then coarsen gives back the model, with momentum kept
 }
 
 TEST_CASE("coarsen: a uniform motion loses no energy") {
-  MssModel<2> m(quad_grid(2, 2, {{0.1, 0.1, 1}, {}}), {material}, {}, options());
+  MssModel<2> m(quad_grid(2, 2, {{0.1, 0.1, 1}, {}}), {material}, {}, no_gravity());
   (void)refine_element(m, 0);
   for (Index i = 0; i < m.nodes().size(); ++i) m.nodes().set_velocity(i, Vector3d(0.5, -0.25, 0));
   const CoarsenReport c = coarsen(m, 0);
@@ -120,7 +107,7 @@ TEST_CASE("coarsen: a uniform motion loses no energy") {
 TEST_CASE("coarsen: seeded random refine / coarsen sequences keep every invariant and end where they began") {
   for (unsigned seed : {1u, 2u, 3u}) {
     CAPTURE(seed);
-    MssModel<2> m(quad_grid(3, 2, {{0.1, 0.1, 1}, {}}), {material}, {}, options());
+    MssModel<2> m(quad_grid(3, 2, {{0.1, 0.1, 1}, {}}), {material}, {}, no_gravity());
     const Snapshot original = snapshot(m);
     const double mass0 = m.node_mass();
     std::mt19937 rng(seed);
@@ -152,7 +139,7 @@ TEST_CASE("coarsen: seeded random refine / coarsen sequences keep every invarian
 }
 
 TEST_CASE("coarsen: refused with the reason, the model unchanged") {
-  MssModel<2> m(quad_grid(2, 2, {{0.1, 0.1, 1}, {}}), {material}, {}, options());
+  MssModel<2> m(quad_grid(2, 2, {{0.1, 0.1, 1}, {}}), {material}, {}, no_gravity());
   const RefineReport r = refine_element(m, 0);
   (void)refine_element(m, r.children[1]);
   auto state = [&] { return std::make_tuple(m.map().num_darts(), m.nodes().num_alive(), m.node_mass()); };
@@ -180,7 +167,7 @@ TEST_CASE("coarsen: refused with the reason, the model unchanged") {
 TEST_CASE("cut and refine: seeded random refine / coarsen / cut sequences") {
   for (unsigned seed : {1u, 2u, 3u, 4u}) {
     CAPTURE(seed);
-    MssModel<2> m(quad_grid(3, 3, {{0.1, 0.1, 1}, {}}), {material}, {}, options());
+    MssModel<2> m(quad_grid(3, 3, {{0.1, 0.1, 1}, {}}), {material}, {}, no_gravity());
     const double mass0 = m.node_mass();
     std::mt19937 rng(seed);
     RefineOptions o;

@@ -13,35 +13,22 @@
 #include "sewn/refine/cut.hpp"
 #include "sewn/refine/hierarchy.hpp"
 #include "sewn/refine/subdivide.hpp"
+#include "support.hpp"
 
 using namespace sewn;
 using namespace sewn::physics;
 using namespace sewn::refine;
+using namespace refine_test;
 using Eigen::Vector3d;
 
 namespace {
 
 const MaterialParams material{1e5, 0.3, 100};
 
-MssOptions no_gravity() {
-  MssOptions o;
-  o.gravity.setZero();
-  return o;
-}
-
 const Vector3d h{0.2, 0.15, 0.125};
 
 IndexedMesh grid(std::uint32_t nx, std::uint32_t ny, std::uint32_t nz, double scale) {
   return hex_grid(nx, ny, nz, {{h.x() * scale, h.y() * scale, h.z() * scale}, {0.1, -0.2, 0.3}});
-}
-
-void check_all(const MssModel<3>& m) {
-  const auto report = m.map().validate();
-  INFO(report.str());
-  REQUIRE(report.ok());
-  const HierarchyReport hr = check_hierarchy(m);
-  INFO(hr.str());
-  REQUIRE(hr.ok());
 }
 
 Vector3d momentum(const NodeTable& n) {

@@ -12,33 +12,20 @@
 #include "sewn/refine/cut.hpp"
 #include "sewn/refine/hierarchy.hpp"
 #include "sewn/refine/subdivide.hpp"
+#include "support.hpp"
 
 using namespace sewn;
 using namespace sewn::physics;
 using namespace sewn::refine;
+using namespace refine_test;
 using Eigen::Vector3d;
 
 namespace {
 
 const MaterialParams material{1e5, 0.3, 100, 0.5};
 
-MssOptions no_gravity() {
-  MssOptions o;
-  o.gravity.setZero();
-  return o;
-}
-
 IndexedMesh grid(std::uint32_t nx, std::uint32_t ny, double hx, double hy) {
   return quad_grid(nx, ny, {{hx, hy, 1.0}, {0.1, -0.2, 0.0}});
-}
-
-void check_all(const MssModel<2>& m) {
-  const auto report = m.map().validate();
-  INFO(report.str());
-  REQUIRE(report.ok());
-  const HierarchyReport h = check_hierarchy(m);
-  INFO(h.str());
-  REQUIRE(h.ok());
 }
 
 Vector3d momentum(const NodeTable& n) {
