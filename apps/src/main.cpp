@@ -10,10 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "sewn/apps/cell_models.hpp"
 #include "sewn/apps/check_topology.hpp"
 #include "sewn/apps/runner.hpp"
 #include "sewn/apps/scene.hpp"
 #include "sewn/cmap/build.hpp"
+#include "sewn/io/cleanup.hpp"
 #include "sewn/io/errors.hpp"
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/read.hpp"
@@ -30,9 +32,11 @@ usage:
                           run a scene (with no scene: the built-in default, a cantilever
                           beam sagging under gravity and cut part-way through)
   sewn check MESH [--json]
-                          load a mesh (.msh 2.2/4.1, .mesh, .vtk), check its geometry, build the
-                          combinatorial map and print its validation report, cell counts and
-                          topology (Betti numbers, orientability, boundary, non-manifold cells)
+                          load a mesh (.msh 2.2/4.1, .mesh, .vtk), report what `sewn run` would
+                          simulate (cells per dimension, components, boundary labels), check its
+                          geometry, build the combinatorial map and print its validation report,
+                          cell counts and topology (Betti numbers, orientability, boundary,
+                          non-manifold cells)
   sewn scene-doc          print the scene file reference (docs/scenes.md)
   sewn --help | sewn <command> --help
 
@@ -58,8 +62,12 @@ The progress bar is drawn only when standard error is a terminal.
 
 constexpr const char* check_usage = R"(usage: sewn check MESH [--json]
 
-Loads MESH (Gmsh .msh 2.2 or 4.1 ASCII, MEDIT .mesh, legacy VTK .vtk), lists every geometric
-problem (non-finite coordinates, inverted or degenerate cells), builds the combinatorial map
+Loads MESH (Gmsh .msh 2.2 or 4.1 ASCII, MEDIT .mesh, legacy VTK .vtk) and reports what
+`sewn run` would simulate: triangles that are faces of volumes and segments that are edges of
+higher-dimensional cells (tetgen's face list, Gmsh's boundary groups) are labels, listed by tag,
+and the rest is the simulated complex (cells per dimension, components: cells sharing a point).
+On that complex it lists every geometric problem (non-finite coordinates, inverted or degenerate
+cells), builds the combinatorial map
 and prints its validation report, cell counts, components and boundary, then the topology of
 the mesh's cell complex (cells identified by their points; meshes of volumes only or of surface
 cells only): per component its cell counts, χ, Betti numbers over Z/2, orientability and (for
@@ -125,6 +133,43 @@ int cmd_run(const std::vector<std::string>& args) {
   return ok;
 }
 
+// What `sewn run` simulates of a mesh file with no model.groups: every cell that is not a face
+// or edge of a higher-dimensional cell; those are labels.
+std::vector<sewn::app::CellModel> default_models(const sewn::IndexedMesh& read) {
+  const sewn::app::Scene defaults;  // mass-spring, no groups: labels by the embedding rule alone
+  return sewn::app::cell_models(read, sewn::io::embedded_cells(read), defaults, "mesh");
+}
+
+sewn::IndexedMesh simulated_cells(const sewn::IndexedMesh& read, const std::vector<sewn::app::CellModel>& models) {
+  sewn::IndexedMesh mesh;
+  mesh.points = read.points;
+  for (std::uint32_t c = 0; c < read.num_cells(); ++c)
+    if (models[c] != sewn::app::CellModel::label) mesh.add_cell(read.types[c], read.cell(c), read.tags[c]);
+  return mesh;
+}
+
+std::string tag_name(const sewn::io::MeshFile& file, std::int32_t tag, int dim) {
+  for (const auto& n : file.tag_names)
+    if (n.tag == tag && n.dimension == dim) return " \"" + n.name + "\"";
+  return "";
+}
+
+void print_simulated(const sewn::app::SimulatedComplex& sc, const sewn::io::MeshFile& file, std::FILE* out) {
+  std::fprintf(out, "simulated: %u volumes, %u surface cells, %u segments on %u points; %u component%s (cells sharing a point)\n",
+               sc.cells[3], sc.cells[2], sc.cells[1], sc.points, sc.components, sc.components == 1 ? "" : "s");
+  if (!sc.labels.empty())
+    std::fprintf(out, "labels (faces and edges of higher-dimensional cells, simulated only where a scene's model.groups says so):\n");
+  static const char* kinds[] = {"", "segments", "surface cells", "volumes"};
+  for (const auto& l : sc.labels)
+    std::fprintf(out, "  tag %d%s: %u %s\n", l.tag, tag_name(file, l.tag, l.dimension).c_str(), l.cells, kinds[l.dimension]);
+}
+
+nlohmann::json simulated_json(const sewn::app::SimulatedComplex& sc) {
+  nlohmann::json labels = nlohmann::json::array();
+  for (const auto& l : sc.labels) labels.push_back({{"tag", l.tag}, {"dimension", l.dimension}, {"cells", l.cells}});
+  return {{"cells", {sc.cells[1], sc.cells[2], sc.cells[3]}}, {"points", sc.points}, {"components", sc.components}, {"labels", labels}};
+}
+
 int cmd_check(const std::vector<std::string>& args) {
   if (args.size() == 1 && (args[0] == "--help" || args[0] == "-h")) {
     std::fputs(check_usage, stdout);
@@ -138,15 +183,22 @@ int cmd_check(const std::vector<std::string>& args) {
   const std::string& path = args[0];
   std::FILE* out = json ? stderr : stdout;  // with --json, stdout holds the JSON document only
   const sewn::io::MeshFile file = sewn::io::read_mesh_file(path);
-  const sewn::IndexedMesh& mesh = file.mesh;
-  const auto by_dim = mesh.count_by_dimension();
-  std::fprintf(out, "%s: %u points, %u cells (%u volumes, %u surface cells, %u segments)\n", path.c_str(), mesh.num_points(),
-              mesh.num_cells(), by_dim[3], by_dim[2], by_dim[1]);
+  const sewn::IndexedMesh& read = file.mesh;
+  const auto by_dim = read.count_by_dimension();
+  std::fprintf(out, "%s: %u points, %u cells (%u volumes, %u surface cells, %u segments)\n", path.c_str(), read.num_points(),
+              read.num_cells(), by_dim[3], by_dim[2], by_dim[1]);
   // what `sewn run` refuses, refused here with the same reason
-  if (mesh.num_cells() == 0) {
+  if (read.num_cells() == 0) {
     std::fprintf(stderr, "sewn: bad mesh: %s: the mesh has no cell\n", path.c_str());
     return bad_input;
   }
+  read.check_indices(path);
+  // What `sewn run` simulates: faces and edges of higher-dimensional cells are boundary labels
+  // (unless a scene's model.groups says otherwise); the rest is checked below.
+  const auto models = default_models(read);
+  const sewn::app::SimulatedComplex simulated = sewn::app::simulated_complex(read, models);
+  print_simulated(simulated, file, out);
+  const sewn::IndexedMesh mesh = simulated_cells(read, models);
   bool sound = true;
   const auto issues = sewn::io::find_geometry_issues(mesh, path);
   for (const auto& issue : issues) std::fprintf(out, "  geometry: %s\n", issue.message.c_str());
@@ -172,7 +224,11 @@ int cmd_check(const std::vector<std::string>& args) {
   if (!report.ok()) sound = false;
   const sewn::app::MeshTopology topo = sewn::app::mesh_topology(mesh, path);
   std::fputs(sewn::app::topology_text(topo).c_str(), out);
-  if (json) std::cout << sewn::app::topology_json(topo).dump(1) << "\n";
+  if (json) {
+    nlohmann::json j = sewn::app::topology_json(topo);
+    j["simulated"] = simulated_json(simulated);
+    std::cout << j.dump(1) << "\n";
+  }
   return sound ? ok : bad_input;
 }
 

@@ -17,6 +17,7 @@
 
 #include <Eigen/Geometry>
 
+#include "sewn/apps/continuum.hpp"
 #include "sewn/io/cleanup.hpp"
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/read.hpp"
@@ -26,8 +27,6 @@
 #include "sewn/physics/integrate/implicit_midpoint.hpp"
 #include "sewn/physics/integrate/newton_euler.hpp"
 #include "sewn/physics/integrators.hpp"
-#include "sewn/physics/shells/shell_terms.hpp"
-#include "sewn/physics/solids/tets.hpp"
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/solids/inversion.hpp"
 #include "sewn/refine/cut.hpp"
@@ -106,9 +105,6 @@ IndexedMesh generate(const MeshSpec& spec, const std::string& file, const std::s
     }
   } else if (spec.type == "file") {
     m = io::read_mesh(spec.path);
-    // Gmsh and MEDIT files saved without physical groups repeat the faces and edges of volumes
-    // as cells of their own; built as read they would become shells glued onto the solid.
-    io::drop_embedded_cells(m);
     io::drop_unused_points(m);
     transform(m, spec.scale, spec.translate);
     io::check_mesh_geometry(m, spec.path);
@@ -135,6 +131,7 @@ struct Snapshot {
   std::vector<CellType> types;
   std::vector<std::uint32_t> offsets{0}, conn;
   std::vector<std::int32_t> material, level, mesh_cell;
+  std::vector<Index> element;  // per output cell, its element
 
   void take(const physics::MssModel<3>& m) {
     *this = Snapshot{};
@@ -164,6 +161,7 @@ struct Snapshot {
       material.push_back(static_cast<std::int32_t>(el.material));
       level.push_back(0);  // refinement level: every element is a root element until refinement lands
       mesh_cell.push_back(static_cast<std::int32_t>(el.mesh_cell));
+      element.push_back(e);
     }
   }
   [[nodiscard]] io::CellsView cells() const { return {types, offsets, conn}; }
@@ -250,16 +248,20 @@ std::string format_seconds(double s) {
   return buf;
 }
 
-// The particles a selector picks: those of tagged cells, listed mesh points, or those whose
-// rest position lies in the region. Throws SceneError (at `path`) for a point of no cell or an
+// The particles a selector picks: those of tagged cells (simulated or labels; a label's points
+// that no simulated cell uses carry no particle), listed mesh points, or those whose rest
+// position lies in the region. Throws SceneError (at `path`) for a point of no cell or an
 // empty selection.
-std::set<Index> selected_nodes(const Selector& where, const IndexedMesh& mesh, const physics::MssModel<3>& model,
+std::set<Index> selected_nodes(const Selector& where, const Assembly& assembly, const physics::MssModel<3>& model,
                                const std::string& file, const std::string& path) {
+  const IndexedMesh& mesh = assembly.mesh;
   std::set<Index> nodes;
   if (where.type == Selector::Type::tag) {
-    for (std::uint32_t c = 0; c < mesh.num_cells(); ++c)
-      if (mesh.tags[c] == where.tag)
-        for (std::uint32_t q : mesh.cell(c)) nodes.insert(model.node_of_point(q));
+    for (const IndexedMesh* cells : {&assembly.mesh, &assembly.labels})
+      for (std::uint32_t c = 0; c < cells->num_cells(); ++c)
+        if (cells->tags[c] == where.tag)
+          for (std::uint32_t q : cells->cell(c))
+            if (model.node_of_point(q) != physics::invalid_index) nodes.insert(model.node_of_point(q));
   } else if (where.type == Selector::Type::points) {
     for (std::uint32_t q : where.points) {
       if (q >= mesh.num_points() || model.node_of_point(q) == physics::invalid_index)
@@ -283,98 +285,45 @@ Assembly assemble(const Scene& scene) {
   auto material_index = [&](const std::string& name) {
     return static_cast<std::uint32_t>(std::find(a.material_names.begin(), a.material_names.end(), name) - a.material_names.begin());
   };
+  std::vector<std::int32_t> tags_seen;
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     const MeshSpec& spec = scene.meshes[i];
     const std::string path = "meshes[" + std::to_string(i) + "]";
-    IndexedMesh piece = generate(spec, scene.file, path);
-    if (piece.num_cells() == 0) throw SceneError(scene.file, path, "the mesh has no cell");
+    const IndexedMesh whole = generate(spec, scene.file, path);
+    const std::vector<CellModel> models = cell_models(whole, io::embedded_cells(whole), scene, path);
+    tags_seen.insert(tags_seen.end(), whole.tags.begin(), whole.tags.end());
+    // the simulated cells and the labels, on the same points
+    IndexedMesh piece, labels;
+    piece.points = whole.points;
+    std::vector<CellModel> piece_models;
+    for (std::uint32_t c = 0; c < whole.num_cells(); ++c) {
+      if (models[c] == CellModel::label) {
+        labels.add_cell(whole.types[c], whole.cell(c), whole.tags[c]);
+      } else {
+        piece.add_cell(whole.types[c], whole.cell(c), whole.tags[c]);
+        piece_models.push_back(models[c]);
+      }
+    }
+    if (piece.num_cells() == 0)
+      throw SceneError(scene.file, path, whole.num_cells() == 0 ? "the mesh has no cell" : "every cell of the mesh is a label: nothing to simulate");
     a.first_cell.push_back(a.mesh.num_cells());
     std::vector<std::uint32_t> mat(piece.num_cells(), material_index(spec.material));
     for (const auto& [where, name] : spec.regions)
       for (std::uint32_t c = 0; c < piece.num_cells(); ++c)
         if (selects_cell(where, piece, c)) mat[c] = material_index(name);
-    append(a.mesh, piece);
+    const std::uint32_t first_point = append(a.mesh, piece);
+    for (std::uint32_t c = 0; c < labels.num_cells(); ++c) {
+      std::vector<std::uint32_t> v(labels.cell(c).begin(), labels.cell(c).end());
+      for (auto& q : v) q += first_point;
+      a.labels.add_cell(labels.types[c], v, labels.tags[c]);
+    }
     a.material_of_cell.insert(a.material_of_cell.end(), mat.begin(), mat.end());
+    a.model_of_cell.insert(a.model_of_cell.end(), piece_models.begin(), piece_models.end());
   }
+  check_groups_used(scene, tags_seen);
+  a.labels.points = a.mesh.points;
   return a;
 }
-
-namespace {
-
-// Replaces the springs by finite-element tetrahedra on the same nodes (masses stay the lumped
-// ones the model computed).
-// Checks what a continuum model cannot take and removes the springs it replaces.
-void drop_springs(const Scene& scene, physics::MssModel<3>& model) {
-  const std::string m = "model \"" + scene.model + "\"";
-  if (!scene.cuts.empty()) throw SceneError(scene.file, "cuts", "cutting is not supported with " + m + " yet");
-  if (scene.damping == "viscous")
-    throw SceneError(scene.file, "damping.model", "\"viscous\" is per-spring damping, which " + m + " has none of: use \"rayleigh\" (alpha) or \"none\"");
-  if (scene.damping == "rayleigh" && scene.rayleigh_beta != 0.0)
-    throw SceneError(scene.file, "damping.beta", "stiffness-proportional damping acts on springs, which " + m + " has none of: use alpha");
-  physics::Springs& springs = model.springs();
-  for (Index s = 0; s < springs.size(); ++s)
-    if (springs.is_alive(s)) springs.remove(s);
-}
-
-// Replaces the springs by membrane triangles and hinges on the interior edges.
-void use_shell_model(const Scene& scene, const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh,
-                     physics::MssModel<3>& model) {
-  drop_springs(scene, model);
-  auto& membranes = model.system().add<physics::shells::Membranes>();
-  std::vector<std::array<Index, 3>> triangles;
-  std::vector<double> k_b;
-  for (const auto& el : model.elements()) {
-    if (!el.alive) continue;
-    const auto cell = mesh.cell(el.mesh_cell);
-    if (el.kind != physics::ElementKind::triangle || cell.size() != 3)
-      throw SceneError(scene.file, "model.type", "\"shell\" needs triangles only, but mesh cell " + std::to_string(el.mesh_cell) +
-                                                     " has " + std::to_string(cell.size()) + " points (use a tri_grid or a triangle mesh file)");
-    std::array<Index, 3> nodes{};
-    physics::shells::TriPositions X;
-    for (int a = 0; a < 3; ++a) {
-      nodes[a] = model.node_of_point(cell[a]);
-      X.col(a) = model.rest_position(nodes[a]);
-    }
-    const auto& mat = materials[el.material];
-    membranes.add(nodes, X, mat.young, mat.poisson, mat.thickness);
-    triangles.push_back(nodes);
-    k_b.push_back(physics::shells::hinge_stiffness(mat.young, mat.poisson, mat.thickness));
-  }
-  std::vector<double> rest_x;
-  for (Index i = 0; i < model.nodes().size(); ++i) {
-    const Vec3d p = model.rest_position(i);
-    rest_x.insert(rest_x.end(), {p.x(), p.y(), p.z()});
-  }
-  try {
-    model.system().add<physics::shells::Hinges>().add_interior_edges(triangles, rest_x, k_b);
-  } catch (const physics::InputError& e) {
-    throw SceneError(scene.file, "meshes", e.what());
-  }
-}
-
-void use_solid_model(const Scene& scene, const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh,
-                     physics::MssModel<3>& model) {
-  drop_springs(scene, model);
-  auto& tets = model.system().add<physics::solids::Tets>(scene.law == "stvk" ? physics::solids::TetLaw::stvk
-                                                                                  : physics::solids::TetLaw::stable_neo_hookean);
-  for (const auto& el : model.elements()) {
-    if (!el.alive) continue;
-    const auto cell = mesh.cell(el.mesh_cell);
-    if (el.kind != physics::ElementKind::tetrahedron || cell.size() != 4)
-      throw SceneError(scene.file, "model.type", "\"solid\" needs tetrahedra only, but mesh cell " + std::to_string(el.mesh_cell) +
-                                                     " has " + std::to_string(cell.size()) + " points (use a tet_grid or a tetrahedral mesh file)");
-    std::array<Index, 4> nodes{};
-    physics::solids::TetPositions X;
-    for (int a = 0; a < 4; ++a) {
-      nodes[a] = model.node_of_point(cell[a]);
-      X.col(a) = model.rest_position(nodes[a]);
-    }
-    const auto& mat = materials[el.material];
-    tets.add(nodes, X, mat.young, mat.poisson);
-  }
-}
-
-}  // namespace
 
 RunSummary run(const Scene& scene, const RunOptions& options) {
   RunSummary sum;
@@ -382,13 +331,14 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   prepare_output(sum.out);
 
   // 1) the bodies and the model
-  const Assembly assembly = assemble(scene);
+  Assembly assembly = assemble(scene);
   std::vector<physics::MaterialParams> materials;
   for (const auto& name : assembly.material_names) {
     const MaterialSpec& ms = scene.materials.at(name);
     materials.push_back({ms.young, ms.poisson, ms.density, ms.thickness, ms.area,
                          ms.clamp_elongated ? physics::ElongatedPolicy::clamp : physics::ElongatedPolicy::refuse});
   }
+  apply_rod_sections(scene, assembly.mesh, assembly.model_of_cell, materials, assembly.material_of_cell);
   physics::MssOptions mo;
   mo.gravity = Vec3d(scene.gravity[0], scene.gravity[1], scene.gravity[2]);
   mo.damping = scene.damping == "viscous" ? physics::DampingModel::viscous
@@ -414,8 +364,8 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
 
   // 2) fixed particles, then initial velocities of the free axes
   const IndexedMesh& mesh = assembly.mesh;
-  if (scene.model == "solid") use_solid_model(scene, materials, mesh, *model);
-  if (scene.model == "shell") use_shell_model(scene, materials, mesh, *model);
+  ContinuumParts continuum;
+  if (scene.model != "mass-spring") continuum = build_continuum(scene, materials, mesh, assembly.model_of_cell, *model);
 
   // 2) fixed particles
   for (std::size_t k = 0; k < scene.fixed.size(); ++k) {
@@ -424,14 +374,14 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     if (fix.axes[0]) axes |= physics::axis_x;
     if (fix.axes[1]) axes |= physics::axis_y;
     if (fix.axes[2]) axes |= physics::axis_z;
-    for (Index i : selected_nodes(fix.where, mesh, *model, scene.file, "fixed[" + std::to_string(k) + "].where"))
+    for (Index i : selected_nodes(fix.where, assembly, *model, scene.file, "fixed[" + std::to_string(k) + "].where"))
       model->nodes().fix(i, axes);
   }
   for (std::size_t k = 0; k < scene.velocities.size(); ++k) {
     const VelocitySpec& vel = scene.velocities[k];
     const Vec3d linear(vel.linear[0], vel.linear[1], vel.linear[2]), angular(vel.angular[0], vel.angular[1], vel.angular[2]),
         center(vel.center[0], vel.center[1], vel.center[2]);
-    for (Index i : selected_nodes(vel.where, mesh, *model, scene.file, "velocities[" + std::to_string(k) + "].where")) {
+    for (Index i : selected_nodes(vel.where, assembly, *model, scene.file, "velocities[" + std::to_string(k) + "].where")) {
       Vec3d v = linear + angular.cross(model->rest_position(i) - center);
       // a velocity on a fixed axis would make it kinematic: fixed stays fixed
       for (int a = 0; a < 3; ++a)
@@ -506,9 +456,12 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
       const io::DataArray point_data[] = {
           io::DataArray::vectors("velocity", snap.velocity), io::DataArray::vectors("force", snap.force),
           io::DataArray::vectors("displacement", snap.displacement), io::DataArray::flags("fixed", snap.fixed)};
+      // rods' material frames: m1 per segment (m2 = t × m1), zero on other cells
+      const std::vector<Point3> director = rod_directors(continuum, *model, snap.element);
       const io::DataArray cell_data[] = {io::DataArray::ints("material", snap.material),
                                          io::DataArray::ints("refinement_level", snap.level),
-                                         io::DataArray::ints("mesh_cell", snap.mesh_cell)};
+                                         io::DataArray::ints("mesh_cell", snap.mesh_cell),
+                                         io::DataArray::vectors("rod_director", director)};
       // the frame is complete on disk before the series lists it
       writing([&] {
         io::write_vtu(sum.out / name, snap.points, snap.cells(), point_data, cell_data);

@@ -172,13 +172,24 @@ Field build_schema() {
                 field("beta", Kind::number).unit("s").fallback(0.0).at_least(0).doc("Rayleigh stiffness coefficient β."),
                 field("environment", Kind::number).unit("1/s").fallback(0.0).at_least(0).at_most(1e6).doc("Drag −c·m·v on every particle.")});
 
+  Field group = field("group", Kind::object);
+  group.doc("How the cells of one mesh tag (Gmsh physical group, MEDIT reference) are simulated; overrides `model.type` and the boundary-label rule for them.")
+      .members({field("tag", Kind::integer).required().at_least(-2147483647).at_most(2147483647).doc("The mesh tag (every mesh of the scene)."),
+                field("as", Kind::string).one_of({"solid", "shell", "rod", "label"}).required()
+                    .doc("`solid`: tetrahedra; `shell`: triangles (membrane + hinges); `rod`: segments, chained into discrete elastic rods wherever exactly two meet; `label`: not simulated, only a name for `tag` selectors (fixed, velocities)."),
+                field("radius", Kind::number).unit("m").above(0).doc("`rod`: a solid circular section of this radius (default: the circle of the material's `area`)."),
+                field("semi_axes", Kind::number_list).unit("m").items(2, 2).above(0)
+                    .doc("`rod`: a solid elliptic section, semi-axis a along the first material director and b along the second (instead of `radius`).")});
+
   Field model = field("model", Kind::object);
-  model.doc("What the bodies' elasticity is made of (docs/elastic.md).")
+  model.doc("What the bodies' elasticity is made of (docs/elastic.md, docs/mixed.md). In every model, a triangle that is a face of a tetrahedron (a segment that is an edge of a triangle or tetrahedron) is a boundary label, not simulated, unless `groups` says otherwise: mesh generators list such faces (tetgen's face list, Gmsh's boundary groups) to name boundaries.")
       .fallback(nlohmann::json::object())
-      .members({field("type", Kind::string).one_of({"mass-spring", "solid", "shell"}).fallback("mass-spring")
-                    .doc("`mass-spring`: the 2013 paper's springs on the map's edges; `solid`: finite-element tetrahedra (tetrahedral meshes only); `shell`: CST membranes with Green strain plus hinge bending with k_B = D/6 on the interior edges, thickness from the material (triangle meshes only). `solid` and `shell` take no cuts yet, and their damping comes from `rayleigh` α or `environment`, as spring damping does not apply."),
+      .members({field("type", Kind::string).one_of({"mass-spring", "solid", "shell", "mixed"}).fallback("mass-spring")
+                    .doc("`mass-spring`: the 2013 paper's springs on the map's edges; `solid`: finite-element tetrahedra (tetrahedral meshes only); `shell`: CST membranes with Green strain plus hinge bending with k_B = D/6 on the interior edges, thickness from the material (triangle meshes only); `mixed`: each cell by its dimension (tetrahedra solid, triangles shell, segments rod), components touching at points or curves sharing their nodes. `solid`, `shell` and `mixed` take no cuts yet, and their damping comes from `rayleigh` α or `environment`, as spring damping does not apply."),
                 field("law", Kind::string).one_of({"stvk", "stable_neo_hookean"}).fallback("stable_neo_hookean")
-                    .doc("`solid`: St. Venant–Kirchhoff, or the inversion-safe stable neo-Hookean (Smith et al. 2018).")});
+                    .doc("`solid` cells: St. Venant–Kirchhoff, or the inversion-safe stable neo-Hookean (Smith et al. 2018)."),
+                field("groups", Kind::array).of(group).items(0, 4096).fallback(nlohmann::json::array())
+                    .doc("Per mesh tag, what its cells are (later entries win). With `mass-spring`, only `label` is accepted.")});
 
   Field integrator = field("integrator", Kind::object);
   integrator.doc("Time integration.")
@@ -506,6 +517,25 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     Reader m(r["model"], *schema.member("model"));
     s.model = m.string("type");
     s.law = m.string("law");
+    const Field& group_schema = *schema.member("model")->member("groups")->element_;
+    for (std::size_t k = 0; k < m["groups"].size(); ++k) {
+      const auto& gj = m["groups"][k];
+      const std::string gpath = "model.groups[" + std::to_string(k) + "]";
+      Reader g(gj, group_schema);
+      ModelGroup mg;
+      mg.tag = static_cast<int>(g.integer("tag"));
+      mg.as = g.string("as");
+      if (g.has("radius")) mg.semi_axes = {g.number("radius"), g.number("radius")};
+      if (g.has("semi_axes")) {
+        if (g.has("radius")) throw SceneError(file, gpath + ".semi_axes", "give either radius or semi_axes, not both");
+        mg.semi_axes = {g["semi_axes"][0].get<double>(), g["semi_axes"][1].get<double>()};
+      }
+      if (mg.as != "rod" && mg.semi_axes[0] > 0)
+        throw SceneError(file, gpath + (g.has("radius") ? ".radius" : ".semi_axes"), "a section applies to rods only, not to \"" + mg.as + "\"");
+      if (s.model == "mass-spring" && mg.as != "label")
+        throw SceneError(file, gpath + ".as", "\"" + mg.as + "\" cannot be combined with model.type \"mass-spring\" (use \"mixed\", or \"label\")");
+      s.model_groups.push_back(mg);
+    }
   }
   {
     Reader in(r["integrator"], *schema.member("integrator"));

@@ -21,7 +21,7 @@ Key key_of(It first, It last) {
 
 }  // namespace
 
-std::size_t drop_embedded_cells(IndexedMesh& mesh) {
+std::vector<bool> embedded_cells(const IndexedMesh& mesh) {
   std::vector<Key> faces, edges;  // faces of volumes; edges of volumes and 2D cells
   for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
     const auto v = mesh.cell(c);
@@ -45,22 +45,29 @@ std::size_t drop_embedded_cells(IndexedMesh& mesh) {
   }
   std::sort(faces.begin(), faces.end());
   std::sort(edges.begin(), edges.end());
+  std::vector<bool> embedded(mesh.num_cells(), false);
+  for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
+    const auto v = mesh.cell(c);
+    const int dim = cell_dimension(mesh.types[c]);
+    if (dim == 3) continue;  // volumes are never embedded, and have more points than a key holds
+    const Key k = key_of(v.begin(), v.end());
+    const auto& pool = dim == 2 ? faces : edges;
+    embedded[c] = std::binary_search(pool.begin(), pool.end(), k);
+  }
+  return embedded;
+}
+
+std::size_t drop_embedded_cells(IndexedMesh& mesh) {
+  const std::vector<bool> embedded = embedded_cells(mesh);
   IndexedMesh kept;
   kept.points = std::move(mesh.points);
   std::size_t removed = 0;
   for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
-    const auto v = mesh.cell(c);
-    const int dim = cell_dimension(mesh.types[c]);
-    if (dim <= 2) {  // volumes are never embedded, and have more points than a key holds
-      const Key k = key_of(v.begin(), v.end());
-      const bool embedded = std::binary_search(dim == 2 ? faces.begin() : edges.begin(),
-                                               dim == 2 ? faces.end() : edges.end(), k);
-      if (embedded) {
-        ++removed;
-        continue;
-      }
+    if (embedded[c]) {
+      ++removed;
+      continue;
     }
-    kept.add_cell(mesh.types[c], v, mesh.tags[c]);
+    kept.add_cell(mesh.types[c], mesh.cell(c), mesh.tags[c]);
   }
   mesh = std::move(kept);
   return removed;

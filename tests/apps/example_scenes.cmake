@@ -24,6 +24,7 @@ set(expect_newton_cantilever     "189;80")   # backward Euler by Newton on the m
 set(expect_solid_cantilever      "189;480")  # the same beam as finite-element tetrahedra
 set(expect_shell_plate           "85;128")   # membranes and hinges on 16x4x2 triangles
 set(expect_obstacles_spike       "81;32")    # rigid obstacles: no cut
+set(expect_mixed_fin             "177;449")  # 411 tetrahedra, 34 shell triangles, 4 rod segments; the top face a label
 
 foreach(v SEWN SCENES WORK)
   if(NOT DEFINED ${v})

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "sewn/apps/cell_models.hpp"
 #include "sewn/apps/scene.hpp"
 #include "sewn/cmap/mesh.hpp"
 
@@ -40,9 +41,12 @@ class OutputError : public std::runtime_error {
   std::filesystem::path path_;
 };
 
-/// All bodies of a scene in one mesh, each cell with its material index (materials in name order).
+/// All bodies of a scene in one mesh, each cell with its material index (materials in name order)
+/// and its model; the cells that are only labels (cell_models.hpp) apart, on the same points.
 struct Assembly {
   IndexedMesh mesh;
+  IndexedMesh labels;
+  std::vector<CellModel> model_of_cell;
   std::vector<std::uint32_t> material_of_cell;
   std::vector<std::string> material_names;
   std::vector<std::uint32_t> first_cell;  ///< per scene mesh, its first cell in `mesh`

@@ -81,6 +81,13 @@ struct CutSpec {
   bool remove = true;                            // pierce: remove the freed volumes
 };
 
+/// model.groups[k]: the cells of one mesh tag simulated as a solid, shell or rod, or a label.
+struct ModelGroup {
+  int tag = 0;
+  std::string as;                     // solid, shell, rod, label
+  std::array<double, 2> semi_axes{};  // rod section (a = b: circular); 0: from the material's area
+};
+
 struct Scene {
   std::string file;  // where it was read from ("(default)" for the embedded scene)
   std::string name, description;
@@ -90,6 +97,7 @@ struct Scene {
   std::vector<VelocitySpec> velocities;  // later entries win
   Vec3 gravity{0, 0, -9.81};
   std::string model = "mass-spring", law = "stable_neo_hookean";  // model.type, model.law
+  std::vector<ModelGroup> model_groups;                             // model.groups
   std::string damping = "viscous";
   double rayleigh_alpha = 0, rayleigh_beta = 0, environment_damping = 0;
   std::string integrator = "implicit";

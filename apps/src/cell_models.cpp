@@ -1,0 +1,120 @@
+#include "sewn/apps/cell_models.hpp"
+
+#include <algorithm>
+#include <map>
+#include <numeric>
+
+namespace sewn::app {
+
+namespace {
+
+// The cell type a model takes, and how the scene's documentation calls that kind of mesh.
+CellType cell_type_of(CellModel m) {
+  switch (m) {
+    case CellModel::solid: return CellType::tetrahedron;
+    case CellModel::shell: return CellType::triangle;
+    default: return CellType::segment;
+  }
+}
+
+const char* plural(CellType t) {
+  switch (t) {
+    case CellType::tetrahedron: return "tetrahedra";
+    case CellType::triangle: return "triangles";
+    default: return "segments";
+  }
+}
+
+CellModel parse_model(const std::string& s) {
+  if (s == "solid") return CellModel::solid;
+  if (s == "shell") return CellModel::shell;
+  if (s == "rod") return CellModel::rod;
+  if (s == "label") return CellModel::label;
+  return CellModel::mass_spring;
+}
+
+// model.type's choice for a cell that no group names.
+CellModel default_model(const std::string& type, CellType t) {
+  if (type == "mixed") return cell_dimension(t) == 3 ? CellModel::solid : cell_dimension(t) == 2 ? CellModel::shell : CellModel::rod;
+  return parse_model(type);
+}
+
+std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t x) {
+  while (parent[x] != x) x = parent[x] = parent[parent[x]];
+  return x;
+}
+
+}  // namespace
+
+const char* to_string(CellModel m) {
+  switch (m) {
+    case CellModel::label: return "label";
+    case CellModel::mass_spring: return "mass-spring";
+    case CellModel::solid: return "solid";
+    case CellModel::shell: return "shell";
+    case CellModel::rod: return "rod";
+  }
+  return "?";
+}
+
+std::vector<CellModel> cell_models(const IndexedMesh& mesh, const std::vector<bool>& embedded, const Scene& scene,
+                                   const std::string& path) {
+  std::vector<CellModel> out(mesh.num_cells());
+  for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
+    const CellType t = mesh.types[c];
+    std::size_t group = scene.model_groups.size();
+    for (std::size_t k = 0; k < scene.model_groups.size(); ++k)
+      if (scene.model_groups[k].tag == mesh.tags[c]) group = k;
+    const bool by_group = group < scene.model_groups.size();
+    const CellModel m = by_group ? parse_model(scene.model_groups[group].as)
+                        : embedded[c] ? CellModel::label
+                                      : default_model(scene.model, t);
+    out[c] = m;
+    if (m == CellModel::label || m == CellModel::mass_spring || t == cell_type_of(m)) continue;
+    const std::string where = path + " cell " + std::to_string(c) + " (tag " + std::to_string(mesh.tags[c]) + ") is a " + to_string(t);
+    if (by_group)
+      throw SceneError(scene.file, "model.groups[" + std::to_string(group) + "].as",
+                       "\"" + std::string(to_string(m)) + "\" takes " + plural(cell_type_of(m)) + " only, but " + where);
+    const std::string hint = m == CellModel::solid ? " (use a tet_grid or a tetrahedral mesh file)"
+                             : m == CellModel::shell ? " (use a tri_grid or a triangle mesh file)"
+                                                     : " (segments only)";
+    throw SceneError(scene.file, "model.type", "\"" + scene.model + "\" needs " + plural(cell_type_of(m)) + " only, but " + where +
+                                                  (scene.model == "mixed" ? "; name its tag in model.groups" : hint));
+  }
+  return out;
+}
+
+void check_groups_used(const Scene& scene, const std::vector<std::int32_t>& tags_seen) {
+  for (std::size_t k = 0; k < scene.model_groups.size(); ++k)
+    if (std::find(tags_seen.begin(), tags_seen.end(), scene.model_groups[k].tag) == tags_seen.end())
+      throw SceneError(scene.file, "model.groups[" + std::to_string(k) + "].tag",
+                       "no cell of any mesh carries tag " + std::to_string(scene.model_groups[k].tag));
+}
+
+SimulatedComplex simulated_complex(const IndexedMesh& mesh, const std::vector<CellModel>& models) {
+  SimulatedComplex out;
+  std::vector<std::uint32_t> parent(mesh.num_points());
+  std::iota(parent.begin(), parent.end(), 0u);
+  std::vector<bool> used(mesh.num_points(), false);
+  std::map<std::pair<std::int32_t, int>, std::uint32_t> labels;
+  for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
+    const int dim = cell_dimension(mesh.types[c]);
+    if (models[c] == CellModel::label) {
+      ++labels[{mesh.tags[c], dim}];
+      continue;
+    }
+    ++out.cells[static_cast<std::size_t>(dim)];
+    const auto v = mesh.cell(c);
+    for (std::uint32_t p : v) used[p] = true;
+    for (std::size_t k = 1; k < v.size(); ++k) parent[find_root(parent, v[k])] = find_root(parent, v[0]);
+  }
+  for (std::uint32_t p = 0; p < mesh.num_points(); ++p) {
+    if (!used[p]) continue;
+    ++out.points;
+    if (find_root(parent, p) == p) ++out.components;
+  }
+  for (const auto& [key, n] : labels) out.labels.push_back({key.first, key.second, n});
+  return out;
+}
+
+}  // namespace sewn::app

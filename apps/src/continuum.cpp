@@ -1,0 +1,235 @@
+#include "sewn/apps/continuum.hpp"
+
+#include <cmath>
+#include <map>
+#include <numbers>
+
+#include "sewn/physics/shells/shell_terms.hpp"
+#include "sewn/physics/solids/tets.hpp"
+
+namespace sewn::app {
+
+namespace {
+
+using physics::Index;
+using Vec3d = Eigen::Vector3d;
+
+// The last group naming `tag`, or -1.
+int group_of(const Scene& scene, std::int32_t tag) {
+  int g = -1;
+  for (std::size_t k = 0; k < scene.model_groups.size(); ++k)
+    if (scene.model_groups[k].tag == tag) g = static_cast<int>(k);
+  return g;
+}
+
+// Checks what a continuum model cannot take and removes the springs it replaces.
+void drop_springs(const Scene& scene, physics::MssModel<3>& model) {
+  const std::string m = "model \"" + scene.model + "\"";
+  if (!scene.cuts.empty()) throw SceneError(scene.file, "cuts", "cutting is not supported with " + m + " yet");
+  if (scene.damping == "viscous")
+    throw SceneError(scene.file, "damping.model", "\"viscous\" is per-spring damping, which " + m + " has none of: use \"rayleigh\" (alpha) or \"none\"");
+  if (scene.damping == "rayleigh" && scene.rayleigh_beta != 0.0)
+    throw SceneError(scene.file, "damping.beta", "stiffness-proportional damping acts on springs, which " + m + " has none of: use alpha");
+  physics::Springs& springs = model.springs();
+  for (Index s = 0; s < springs.size(); ++s)
+    if (springs.is_alive(s)) springs.remove(s);
+}
+
+template <int N>
+std::array<Index, N> corner_nodes(const physics::MssModel<3>& model, std::span<const std::uint32_t> cell, Eigen::Matrix<double, 3, N>& X) {
+  std::array<Index, N> nodes{};
+  for (int a = 0; a < N; ++a) {
+    nodes[static_cast<std::size_t>(a)] = model.node_of_point(cell[static_cast<std::size_t>(a)]);
+    X.col(a) = model.rest_position(nodes[static_cast<std::size_t>(a)]);
+  }
+  return nodes;
+}
+
+std::vector<double> rest_state(const physics::MssModel<3>& model) {
+  std::vector<double> rest_x;
+  for (Index i = 0; i < model.nodes().size(); ++i) {
+    const Vec3d p = model.rest_position(i);
+    rest_x.insert(rest_x.end(), {p.x(), p.y(), p.z()});
+  }
+  return rest_x;
+}
+
+// A rod segment: its two nodes, its element, and what must agree for two segments to chain.
+struct Segment {
+  std::array<Index, 2> node;
+  Index element;
+  std::pair<std::uint32_t, int> kind;  // (material, group)
+};
+
+// Maximal chains of segments through nodes where exactly two segments of one kind meet:
+// (element list, node list, closed) per chain.
+struct Chain {
+  std::vector<Index> elements, nodes;
+  bool closed = false;
+};
+
+std::vector<Chain> chain_segments(const std::vector<Segment>& segs, Index num_nodes) {
+  std::vector<std::vector<std::uint32_t>> at(num_nodes);
+  for (std::uint32_t s = 0; s < segs.size(); ++s)
+    for (Index n : segs[s].node) at[n].push_back(s);
+  auto passes = [&](Index n) { return at[n].size() == 2 && segs[at[n][0]].kind == segs[at[n][1]].kind; };
+  std::vector<bool> used(segs.size(), false);
+  std::vector<Chain> chains;
+  auto walk = [&](Index start, std::uint32_t s) {
+    Chain c;
+    c.nodes.push_back(start);
+    Index n = start;
+    while (true) {
+      used[s] = true;
+      c.elements.push_back(segs[s].element);
+      n = segs[s].node[0] == n ? segs[s].node[1] : segs[s].node[0];
+      if (n == start) {
+        c.closed = true;
+        break;
+      }
+      c.nodes.push_back(n);
+      if (!passes(n)) break;
+      s = at[n][0] == s ? at[n][1] : at[n][0];
+    }
+    chains.push_back(std::move(c));
+  };
+  for (Index n = 0; n < num_nodes; ++n)
+    if (!passes(n))
+      for (std::uint32_t s : at[n])
+        if (!used[s]) walk(n, s);
+  for (std::uint32_t s = 0; s < segs.size(); ++s)
+    if (!used[s]) walk(segs[s].node[0], s);  // what is left are closed loops
+  return chains;
+}
+
+// A rod straight at rest with a round section has the same energy when all its material angles
+// turn together; with no end held in twist (a free end, or a joint that passes no moment) the
+// twist solve's θ block is then singular, and Rod::solve_twist wanders along that direction
+// without converging. Holding one angle removes the direction and changes no energy or force.
+void fix_twist_gauge(physics::rods::Rod& rod) {
+  if (rod.section().EI1 != rod.section().EI2) return;
+  for (int s = 0; s < rod.num_stencils(); ++s)
+    if (std::abs(rod.stencil_rest(s).kappa1) > 1e-12 || std::abs(rod.stencil_rest(s).kappa2) > 1e-12) return;
+  rod.fix_theta(0);
+}
+
+physics::rods::Section rod_section(const Scene& scene, const physics::MaterialParams& mat, int group) {
+  const auto axes = group >= 0 ? scene.model_groups[static_cast<std::size_t>(group)].semi_axes : std::array<double, 2>{};
+  if (axes[0] > 0) return physics::rods::Section::elliptic(mat.young, mat.poisson, axes[0], axes[1]);
+  return physics::rods::Section::circular(mat.young, mat.poisson, std::sqrt(mat.area / std::numbers::pi));
+}
+
+void add_rods(const Scene& scene, const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh,
+              const std::vector<CellModel>& models, physics::MssModel<3>& model, ContinuumParts& parts) {
+  std::vector<Segment> segs;
+  for (Index e = 0; e < model.elements().size(); ++e) {
+    const auto& el = model.elements()[e];
+    if (!el.alive || models[el.mesh_cell] != CellModel::rod) continue;
+    const auto cell = mesh.cell(el.mesh_cell);
+    segs.push_back({{model.node_of_point(cell[0]), model.node_of_point(cell[1])}, e, {el.material, group_of(scene, mesh.tags[el.mesh_cell])}});
+  }
+  if (segs.empty()) return;
+  parts.rods = &model.system().add<physics::rods::Rods>();
+  parts.rod_edge_of_element.assign(model.elements().size(), {physics::invalid_index, 0});
+  const std::vector<double> rest_x = rest_state(model);
+  for (const Chain& c : chain_segments(segs, model.nodes().size())) {
+    const auto& first = model.elements()[c.elements[0]];
+    const int group = group_of(scene, mesh.tags[first.mesh_cell]);
+    const std::string key = group >= 0 ? "model.groups[" + std::to_string(group) + "]" : "model.type";
+    Index r = 0;
+    try {
+      r = parts.rods->add_rod(c.nodes, rest_x, c.closed, rod_section(scene, materials[first.material], group));
+    } catch (const physics::InputError& e) {
+      throw SceneError(scene.file, key, "the rod through mesh cell " + std::to_string(first.mesh_cell) + " cannot be built: " + e.what());
+    }
+    fix_twist_gauge(parts.rods->rod(r));
+    for (std::size_t j = 0; j < c.elements.size(); ++j) parts.rod_edge_of_element[c.elements[j]] = {r, static_cast<int>(j)};
+  }
+}
+
+void add_shells(const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh, const std::vector<CellModel>& models,
+                physics::MssModel<3>& model, const Scene& scene) {
+  std::vector<std::array<Index, 3>> triangles;
+  std::vector<double> k_b;
+  physics::shells::Membranes* membranes = nullptr;
+  for (const auto& el : model.elements()) {
+    if (!el.alive || models[el.mesh_cell] != CellModel::shell) continue;
+    if (!membranes) membranes = &model.system().add<physics::shells::Membranes>();
+    physics::shells::TriPositions X;
+    const auto nodes = corner_nodes<3>(model, mesh.cell(el.mesh_cell), X);
+    const auto& mat = materials[el.material];
+    membranes->add(nodes, X, mat.young, mat.poisson, mat.thickness);
+    triangles.push_back(nodes);
+    k_b.push_back(physics::shells::hinge_stiffness(mat.young, mat.poisson, mat.thickness));
+  }
+  if (triangles.empty()) return;
+  try {
+    model.system().add<physics::shells::Hinges>().add_interior_edges(triangles, rest_state(model), k_b);
+  } catch (const physics::InputError& e) {
+    throw SceneError(scene.file, "meshes", e.what());
+  }
+}
+
+void add_solids(const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh, const std::vector<CellModel>& models,
+                physics::MssModel<3>& model, const Scene& scene) {
+  physics::solids::Tets* tets = nullptr;
+  for (const auto& el : model.elements()) {
+    if (!el.alive || models[el.mesh_cell] != CellModel::solid) continue;
+    if (!tets)
+      tets = &model.system().add<physics::solids::Tets>(scene.law == "stvk" ? physics::solids::TetLaw::stvk
+                                                                            : physics::solids::TetLaw::stable_neo_hookean);
+    physics::solids::TetPositions X;
+    const auto nodes = corner_nodes<4>(model, mesh.cell(el.mesh_cell), X);
+    const auto& mat = materials[el.material];
+    tets->add(nodes, X, mat.young, mat.poisson);
+  }
+}
+
+}  // namespace
+
+void apply_rod_sections(const Scene& scene, const IndexedMesh& mesh, const std::vector<CellModel>& models,
+                        std::vector<physics::MaterialParams>& materials, std::vector<std::uint32_t>& material_of_cell) {
+  std::map<std::pair<std::uint32_t, int>, std::uint32_t> copy;  // (material, group) -> its copy
+  for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
+    if (models[c] != CellModel::rod) continue;
+    const int g = group_of(scene, mesh.tags[c]);
+    if (g < 0 || scene.model_groups[static_cast<std::size_t>(g)].semi_axes[0] <= 0) continue;
+    const auto [it, added] = copy.try_emplace({material_of_cell[c], g}, static_cast<std::uint32_t>(materials.size()));
+    if (added) {
+      physics::MaterialParams m = materials[material_of_cell[c]];
+      const auto& axes = scene.model_groups[static_cast<std::size_t>(g)].semi_axes;
+      m.area = std::numbers::pi * axes[0] * axes[1];
+      materials.push_back(m);
+    }
+    material_of_cell[c] = it->second;
+  }
+}
+
+ContinuumParts build_continuum(const Scene& scene, const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh,
+                               const std::vector<CellModel>& models, physics::MssModel<3>& model) {
+  drop_springs(scene, model);
+  ContinuumParts parts;
+  add_solids(materials, mesh, models, model, scene);
+  add_shells(materials, mesh, models, model, scene);
+  add_rods(scene, materials, mesh, models, model, parts);
+  return parts;
+}
+
+std::vector<Point3> rod_directors(const ContinuumParts& parts, const physics::MssModel<3>& model,
+                                  std::span<const physics::Index> elements) {
+  std::vector<Point3> out(elements.size(), Point3{0, 0, 0});
+  if (!parts.rods) return out;
+  const auto x = model.nodes().x();
+  std::map<Index, physics::rods::Points> positions;  // per rod, gathered once
+  for (std::size_t k = 0; k < elements.size(); ++k) {
+    const auto [r, edge] = parts.rod_edge_of_element[elements[k]];
+    if (r == physics::invalid_index) continue;
+    auto it = positions.find(r);
+    if (it == positions.end()) it = positions.emplace(r, parts.rods->gather(r, x)).first;
+    const Vec3d m1 = parts.rods->rod(r).material_directors(it->second, edge).first;
+    out[k] = {m1.x(), m1.y(), m1.z()};
+  }
+  return out;
+}
+
+}  // namespace sewn::app

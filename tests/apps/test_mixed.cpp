@@ -1,0 +1,284 @@
+// Mixed-dimensional meshes: which cells a scene simulates (solids, shells, rods) and which are
+// boundary labels, the continuum terms built on shared nodes, and `sewn check` reporting the
+// simulated complex of a tetgen-style mesh with a face list.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "sewn/apps/cell_models.hpp"
+#include "sewn/apps/continuum.hpp"
+#include "sewn/apps/runner.hpp"
+#include "sewn/apps/scene.hpp"
+#include "sewn/io/cleanup.hpp"
+#include "sewn/physics/rods/rods_term.hpp"
+#include "sewn/physics/shells/shell_terms.hpp"
+#include "sewn/physics/solids/tets.hpp"
+
+using namespace sewn;
+using namespace sewn::app;
+
+namespace mixed_test {
+
+// A block of 12 tetrahedra (tag 1); a flap of 4 triangles hanging from its bottom front edge
+// (tag 2), sharing that edge's 3 nodes; a rod of 3 segments hanging from the flap's bottom
+// middle point (tag 3); and two labels: a face of a tetrahedron (tag 4) and an edge of one (tag 5).
+IndexedMesh block_flap_rod() {
+  GridSpec g;
+  g.spacing = {0.1, 0.1, 0.1};
+  IndexedMesh m = tet_grid(2, 1, 1, TetSplit::kuhn6, g);
+  for (auto& t : m.tags) t = 1;
+  // grid point (i, j, k) = i + 3(j + 2k); the bottom front edge is points 0, 1, 2 (y = 0, z = 0)
+  const std::uint32_t f0 = m.num_points();
+  for (int i = 0; i < 3; ++i) m.points.push_back({0.1 * i, 0.0, -0.1});
+  m.add_cell(CellType::triangle, {0, 1, f0 + 1}, 2);
+  m.add_cell(CellType::triangle, {0, f0 + 1, f0}, 2);
+  m.add_cell(CellType::triangle, {1, 2, f0 + 2}, 2);
+  m.add_cell(CellType::triangle, {1, f0 + 2, f0 + 1}, 2);
+  const std::uint32_t r0 = m.num_points();
+  for (int k = 1; k <= 3; ++k) m.points.push_back({0.1 + 0.01 * k, 0.0, -0.1 - 0.05 * k});  // a slightly slanted rod
+  m.add_cell(CellType::segment, {f0 + 1, r0}, 3);
+  m.add_cell(CellType::segment, {r0, r0 + 1}, 3);
+  m.add_cell(CellType::segment, {r0 + 1, r0 + 2}, 3);
+  const auto tet0 = m.cell(0);
+  m.add_cell(CellType::triangle, {tet0[0], tet0[1], tet0[2]}, 4);
+  m.add_cell(CellType::segment, {tet0[0], tet0[1]}, 5);
+  return m;
+}
+
+Scene mixed_scene() {
+  Scene s;
+  s.file = "mixed.json";
+  s.model = "mixed";
+  s.damping = "none";
+  return s;
+}
+
+std::array<int, 5> count_models(const std::vector<CellModel>& m) {
+  std::array<int, 5> n{};
+  for (CellModel c : m) ++n[static_cast<std::size_t>(c)];
+  return n;
+}
+
+std::string reason_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const SceneError& e) {
+    return e.path() + ": " + e.reason();
+  }
+  return "accepted";
+}
+
+// The sewn binary's standard output for `args`, and its exit code.
+int sewn_stdout(const std::string& args, std::string& out) {
+  const auto log = std::filesystem::temp_directory_path() / ("sewn_mixed_" + std::to_string(::getpid()) + ".txt");
+  const int status = std::system((std::string(SEWN_BINARY) + " " + args + " > " + log.string() + " 2>&1").c_str());
+  std::ifstream in(log);
+  out.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  std::filesystem::remove(log);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace mixed_test
+
+using namespace mixed_test;
+
+TEST_CASE("cell models: faces and edges of higher cells are labels unless a group names them") {
+  const IndexedMesh m = block_flap_rod();
+  const auto embedded = io::embedded_cells(m);
+  Scene s = mixed_scene();
+  // label, mass-spring, solid, shell, rod
+  CHECK(count_models(cell_models(m, embedded, s, "meshes[0]")) == std::array<int, 5>{2, 0, 12, 4, 3});
+  s.model_groups = {{4, "shell", {}}, {5, "rod", {}}};
+  CHECK(count_models(cell_models(m, embedded, s, "meshes[0]")) == std::array<int, 5>{0, 0, 12, 5, 4});
+  s.model_groups = {{2, "label", {}}};
+  CHECK(count_models(cell_models(m, embedded, s, "meshes[0]")) == std::array<int, 5>{6, 0, 12, 0, 3});
+  Scene ms;  // mass-spring: the same labels, every other cell springs
+  CHECK(count_models(cell_models(m, embedded, ms, "meshes[0]")) == std::array<int, 5>{2, 19, 0, 0, 0});
+
+  s.model_groups = {{1, "shell", {}}};
+  const std::string wrong = reason_of([&] { (void)cell_models(m, embedded, s, "meshes[0]"); });
+  CHECK(wrong.find("model.groups[0].as: \"shell\" takes triangles only, but meshes[0] cell 0 (tag 1) is a tetrahedron") == 0);
+  s.model = "solid";
+  s.model_groups = {};
+  CHECK(reason_of([&] { (void)cell_models(m, embedded, s, "meshes[0]"); }).find("model.type: \"solid\" needs tetrahedra only") == 0);
+  s.model_groups = {{2, "label", {}}, {3, "rod", {}}};  // the other kinds named: accepted
+  CHECK(count_models(cell_models(m, embedded, s, "meshes[0]")) == std::array<int, 5>{6, 0, 12, 0, 3});
+  s.model_groups.push_back({9, "rod", {}});
+  CHECK(reason_of([&] { check_groups_used(s, m.tags); }) == "model.groups[2].tag: no cell of any mesh carries tag 9");
+}
+
+TEST_CASE("simulated complex: components are the pieces that share a node") {
+  const IndexedMesh m = block_flap_rod();
+  Scene s = mixed_scene();
+  const auto models = cell_models(m, io::embedded_cells(m), s, "m");
+  const SimulatedComplex all = simulated_complex(m, models);
+  CHECK(all.cells == std::array<std::uint32_t, 4>{0, 3, 4, 12});
+  CHECK(all.components == 1);
+  CHECK(all.points == m.num_points());
+  REQUIRE(all.labels.size() == 2);
+  CHECK(all.labels[0].tag == 4);
+  CHECK(all.labels[0].dimension == 2);
+  CHECK(all.labels[1].tag == 5);
+  // without the flap, the rod hangs from nothing: two components; its points no longer count
+  s.model_groups = {{2, "label", {}}};
+  const SimulatedComplex split = simulated_complex(m, cell_models(m, io::embedded_cells(m), s, "m"));
+  CHECK(split.components == 2);
+  CHECK(split.points == m.num_points() - 2);
+}
+
+TEST_CASE("continuum on a mixed map: one node set, forces are the energy's gradient, rigid motions cost nothing") {
+  const IndexedMesh m = block_flap_rod();
+  const Scene s = mixed_scene();
+  const auto models = cell_models(m, io::embedded_cells(m), s, "m");
+  IndexedMesh sim;
+  sim.points = m.points;
+  std::vector<CellModel> sim_models;
+  for (std::uint32_t c = 0; c < m.num_cells(); ++c)
+    if (models[c] != CellModel::label) {
+      sim.add_cell(m.types[c], m.cell(c), m.tags[c]);
+      sim_models.push_back(models[c]);
+    }
+  std::vector<physics::MaterialParams> materials{{1e6, 0.3, 1000, 0.002, 1e-5, physics::ElongatedPolicy::refuse}};
+  std::vector<std::uint32_t> material_of_cell(sim.num_cells(), 0);
+  physics::MssOptions mo;
+  mo.gravity.setZero();
+  mo.damping = physics::DampingModel::none;
+  physics::MssModel<3> model(sim, materials, material_of_cell, mo);
+  const ContinuumParts parts = build_continuum(s, materials, sim, sim_models, model);
+  physics::System& sys = model.system();
+  CHECK(model.springs().num_alive() == 0);
+  CHECK(model.nodes().size() == m.num_points());  // the flap and the rod share the block's and the flap's nodes
+  REQUIRE(parts.rods != nullptr);
+  CHECK(parts.rods->num_rods() == 1);
+  CHECK(parts.rods->rod(0).num_edges() == 3);
+  int tets = 0, membranes = 0, hinges = 0;
+  for (const auto& t : sys.terms()) {
+    if (auto* p = dynamic_cast<physics::solids::Tets*>(t.get())) tets += static_cast<int>(p->size());
+    if (auto* p = dynamic_cast<physics::shells::Membranes*>(t.get())) membranes += static_cast<int>(p->size());
+    if (auto* p = dynamic_cast<physics::shells::Hinges*>(t.get())) hinges += static_cast<int>(p->size());
+  }
+  CHECK(tets == 12);
+  CHECK(membranes == 4);
+  CHECK(hinges == 3);  // the flap's interior edges; its top edge on the block carries none
+
+  // a rigid rotation and translation of the whole: no energy, no force
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  for (physics::Index i = 0; i < model.nodes().size(); ++i)
+    model.nodes().set_position(i, R * model.rest_position(i) + Eigen::Vector3d(0.3, -0.2, 1.0));
+  sys.compute_forces();
+  CHECK(std::abs(sys.potential_energy()) < 1e-9 * sys.energy_scale());
+  double fmax = 0;
+  for (physics::Index i = 0; i < model.nodes().size(); ++i) fmax = std::max(fmax, model.nodes().force(i).norm());
+  CHECK(fmax < 1e-6);
+
+  // a deformed state: every force is −∂E/∂x by central differences, on shared nodes too
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.01, 0.01);
+  for (physics::Index i = 0; i < model.nodes().size(); ++i)
+    model.nodes().set_position(i, model.rest_position(i) + Eigen::Vector3d(u(rng), u(rng), u(rng)));
+  sys.compute_forces();
+  std::vector<Eigen::Vector3d> f(model.nodes().size());
+  for (physics::Index i = 0; i < model.nodes().size(); ++i) f[i] = model.nodes().force(i);
+  const double h = 1e-6;
+  double worst = 0, scale = 0;
+  for (physics::Index i = 0; i < model.nodes().size(); ++i) {
+    for (int a = 0; a < 3; ++a) {
+      const Eigen::Vector3d x = model.nodes().position(i);
+      Eigen::Vector3d xp = x, xm = x;
+      xp[a] += h;
+      xm[a] -= h;
+      model.nodes().set_position(i, xp);
+      const double ep = sys.potential_energy();
+      model.nodes().set_position(i, xm);
+      const double em = sys.potential_energy();
+      model.nodes().set_position(i, x);
+      worst = std::max(worst, std::abs(-(ep - em) / (2 * h) - f[i][a]));
+      scale = std::max(scale, std::abs(f[i][a]));
+    }
+  }
+  CAPTURE(worst);
+  CAPTURE(scale);
+  CHECK(scale > 1.0);
+  CHECK(worst < 1e-5 * scale);
+}
+
+TEST_CASE("rods: segments chain through nodes of two, split at junctions, close into loops") {
+  IndexedMesh m;
+  // a star of three arms from point 0, and a separate triangle loop
+  m.points = {{0, 0, 0}, {1, 0, 0}, {2, 0.1, 0}, {0, 1, 0}, {0, 2, 0.1}, {0, 0, 1}, {5, 0, 0}, {6, 0, 0}, {5.5, 1, 0}};
+  for (auto [a, b] : std::vector<std::pair<std::uint32_t, std::uint32_t>>{{0, 1}, {1, 2}, {0, 3}, {3, 4}, {0, 5}, {6, 7}, {7, 8}, {8, 6}})
+    m.add_cell(CellType::segment, {a, b}, 3);
+  const Scene s = mixed_scene();
+  const auto models = cell_models(m, io::embedded_cells(m), s, "m");
+  std::vector<physics::MaterialParams> materials{{1e9, 0.3, 1000, 1, 1e-6, physics::ElongatedPolicy::refuse}};
+  physics::MssOptions mo;
+  mo.damping = physics::DampingModel::none;
+  physics::MssModel<3> model(m, materials, {}, mo);
+  const ContinuumParts parts = build_continuum(s, materials, m, models, model);
+  REQUIRE(parts.rods != nullptr);
+  REQUIRE(parts.rods->num_rods() == 4);
+  int closed = 0, edges = 0;
+  for (physics::Index r = 0; r < 4; ++r) {
+    closed += parts.rods->rod(r).closed();
+    edges += parts.rods->rod(r).num_edges();
+  }
+  CHECK(closed == 1);
+  CHECK(edges == 8);
+  // the material frame written to .vtu: unit, perpendicular to its segment
+  std::vector<physics::Index> elements(model.elements().size());
+  for (physics::Index e = 0; e < elements.size(); ++e) elements[e] = e;
+  model.system().compute_forces();
+  const auto d = rod_directors(parts, model, elements);
+  for (physics::Index e = 0; e < elements.size(); ++e) {
+    const auto nodes = model.element_nodes(e);
+    const Eigen::Vector3d t = (model.nodes().position(nodes[1]) - model.nodes().position(nodes[0])).normalized();
+    const Eigen::Vector3d m1(d[e][0], d[e][1], d[e][2]);
+    CHECK(std::abs(m1.norm() - 1) < 1e-12);
+    CHECK(std::abs(m1.dot(t)) < 1e-12);
+  }
+}
+
+TEST_CASE("scene keys of model groups: sections for rods only, labels only with mass-spring") {
+  auto scene = [](const std::string& model) {
+    return nlohmann::json::parse(R"({"materials": {"m": {"young": 1e6, "density": 1000}},
+      "meshes": [{"type": "polyline", "material": "m", "points": [[0,0,0],[1,0,0],[2,0,0]]}],
+      "damping": {"model": "none"}, "model": )" + model + "}");
+  };
+  auto error = [](const nlohmann::json& j) { return reason_of([&] { (void)parse_scene(j, "g.json"); }); };
+  CHECK(error(scene(R"({"type": "mixed", "groups": [{"tag": 0, "as": "rod", "semi_axes": [0.01, 0.005]}]})")) == "accepted");
+  CHECK(error(scene(R"({"type": "mixed", "groups": [{"tag": 0, "as": "shell", "radius": 0.01}]})")) ==
+        "model.groups[0].radius: a section applies to rods only, not to \"shell\"");
+  CHECK(error(scene(R"({"type": "mixed", "groups": [{"tag": 0, "as": "rod", "radius": 0.01, "semi_axes": [1, 1]}]})")) ==
+        "model.groups[0].semi_axes: give either radius or semi_axes, not both");
+  CHECK(error(scene(R"({"groups": [{"tag": 0, "as": "rod"}]})")).find("model.groups[0].as: \"rod\" cannot be combined with model.type \"mass-spring\"") == 0);
+  CHECK(error(scene(R"({"type": "mixed", "groups": [{"tag": 0, "as": "cable"}]})")).find("model.groups[0].as") == 0);
+  const Scene s = parse_scene(scene(R"({"type": "mixed", "groups": [{"tag": 0, "as": "rod", "radius": 0.01}]})"), "g.json");
+  REQUIRE(s.model_groups.size() == 1);
+  CHECK(s.model_groups[0].semi_axes == std::array<double, 2>{0.01, 0.01});
+}
+
+TEST_CASE("sewn check reports the simulated complex of a mesh with a face list, and its labels") {
+  std::string out;
+  const std::string data = std::string(SEWN_SOURCE_DIR) + "/tests/apps/data/box_faces.mesh";
+  REQUIRE(sewn_stdout("check " + data, out) == 0);
+  CAPTURE(out);
+  CHECK(out.find("292 cells (144 volumes, 116 surface cells, 32 segments)") != std::string::npos);
+  CHECK(out.find("simulated: 144 volumes, 0 surface cells, 0 segments on 62 points; 1 component") != std::string::npos);
+  CHECK(out.find("1 component; 116 boundary faces") != std::string::npos);  // the map of the tetrahedra alone
+  CHECK(out.find("  tag 3: 22 surface cells") != std::string::npos);
+  CHECK(out.find("1 component, χ = 1") != std::string::npos);
+
+  const std::string fin = std::string(SEWN_SOURCE_DIR) + "/scenes/meshes/fin.msh";
+  REQUIRE(sewn_stdout("check " + fin, out) == 0);
+  CAPTURE(out);
+  CHECK(out.find("simulated: 411 volumes, 34 surface cells, 4 segments") != std::string::npos);
+  CHECK(out.find("; 1 component (cells sharing a point)") != std::string::npos);
+  CHECK(out.find("  tag 4 \"top\": ") != std::string::npos);
+}
