@@ -1,11 +1,11 @@
 #include "sewn/apps/continuum.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
 
 #include "sewn/physics/shells/shell_terms.hpp"
-#include "sewn/physics/solids/tets.hpp"
 
 namespace sewn::app {
 
@@ -22,17 +22,32 @@ int group_of(const Scene& scene, std::int32_t tag) {
   return g;
 }
 
+// Cuts are followed on tetrahedra only: a shell's hinge across a cut edge, or a rod's stencil
+// across a cut vertex, would have to leave its term, which has no removal yet.
+void check_cuts(const Scene& scene, const std::vector<CellModel>& models) {
+  if (scene.cuts.empty()) return;
+  const auto shells = std::count(models.begin(), models.end(), CellModel::shell);
+  const auto rods = std::count(models.begin(), models.end(), CellModel::rod);
+  if (shells + rods > 0)
+    throw SceneError(scene.file, "cuts",
+                     "cutting is supported on solid tetrahedra only, and this scene has " + std::to_string(shells) +
+                         " shell triangles and " + std::to_string(rods) + " rod segments (their hinges and rod stencils cannot follow a cut yet)");
+  for (std::size_t k = 0; k < scene.cuts.size(); ++k)
+    if (scene.cuts[k].type == "pierce")
+      throw SceneError(scene.file, "cuts[" + std::to_string(k) + "].type",
+                       "\"pierce\" is not supported with model \"" + scene.model + "\": it removes elements, which the tetrahedra cannot follow yet; use a plane, faces or particles cut");
+}
+
 // Checks what a continuum model cannot take and removes the springs it replaces.
 void drop_springs(const Scene& scene, physics::MssModel<3>& model) {
   const std::string m = "model \"" + scene.model + "\"";
-  if (!scene.cuts.empty()) throw SceneError(scene.file, "cuts", "cutting is not supported with " + m + " yet");
   if (scene.damping == "viscous")
     throw SceneError(scene.file, "damping.model", "\"viscous\" is per-spring damping, which " + m + " has none of: use \"rayleigh\" (alpha) or \"none\"");
   if (scene.damping == "rayleigh" && scene.rayleigh_beta != 0.0)
     throw SceneError(scene.file, "damping.beta", "stiffness-proportional damping acts on springs, which " + m + " has none of: use alpha");
   physics::Springs& springs = model.springs();
   for (Index s = 0; s < springs.size(); ++s)
-    if (springs.is_alive(s)) springs.remove(s);
+    if (springs.is_alive(s)) springs.remove(s);  // for good: the model's edits keep removed springs removed
 }
 
 template <int N>
@@ -171,17 +186,18 @@ void add_shells(const std::vector<physics::MaterialParams>& materials, const Ind
 }
 
 void add_solids(const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh, const std::vector<CellModel>& models,
-                physics::MssModel<3>& model, const Scene& scene) {
-  physics::solids::Tets* tets = nullptr;
-  for (const auto& el : model.elements()) {
+                physics::MssModel<3>& model, const Scene& scene, ContinuumParts& parts) {
+  for (Index e = 0; e < model.elements().size(); ++e) {
+    const auto& el = model.elements()[e];
     if (!el.alive || models[el.mesh_cell] != CellModel::solid) continue;
-    if (!tets)
-      tets = &model.system().add<physics::solids::Tets>(scene.law == "stvk" ? physics::solids::TetLaw::stvk
-                                                                            : physics::solids::TetLaw::stable_neo_hookean);
+    if (!parts.tets)
+      parts.tets = &model.system().add<physics::solids::Tets>(scene.law == "stvk" ? physics::solids::TetLaw::stvk
+                                                                                  : physics::solids::TetLaw::stable_neo_hookean);
     physics::solids::TetPositions X;
     const auto nodes = corner_nodes<4>(model, mesh.cell(el.mesh_cell), X);
     const auto& mat = materials[el.material];
-    tets->add(nodes, X, mat.young, mat.poisson);
+    parts.tets->add(nodes, X, mat.young, mat.poisson);
+    parts.element_of_tet.push_back(e);
   }
 }
 
@@ -207,12 +223,20 @@ void apply_rod_sections(const Scene& scene, const IndexedMesh& mesh, const std::
 
 ContinuumParts build_continuum(const Scene& scene, const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh,
                                const std::vector<CellModel>& models, physics::MssModel<3>& model) {
+  check_cuts(scene, models);
   drop_springs(scene, model);
   ContinuumParts parts;
-  add_solids(materials, mesh, models, model, scene);
+  add_solids(materials, mesh, models, model, scene, parts);
   add_shells(materials, mesh, models, model, scene);
   add_rods(scene, materials, mesh, models, model, parts);
   return parts;
+}
+
+void follow_cut(const ContinuumParts& parts, const physics::MssModel<3>& model) {
+  for (Index k = 0; k < parts.element_of_tet.size(); ++k) {
+    const std::vector<Index> nodes = model.element_nodes(parts.element_of_tet[k]);
+    parts.tets->set_element_nodes(k, {nodes[0], nodes[1], nodes[2], nodes[3]});
+  }
 }
 
 std::vector<Point3> rod_directors(const ContinuumParts& parts, const physics::MssModel<3>& model,

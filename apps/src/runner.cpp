@@ -549,6 +549,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
         if (elements.empty()) throw SceneError(scene.file, path + ".where", "selects no element (at its time)");
         rep = refine::pierce(*model, elements, c.remove);
       }
+      if (scene.model != "mass-spring") follow_cut(continuum, *model);
       sum.faces_cut += rep.facets;
       ++sum.cuts;
       ledger.rebase(model->system());

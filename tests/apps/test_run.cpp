@@ -427,9 +427,27 @@ TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped b
   SUBCASE("per-spring damping") {
     expect_run_error<SceneError>(scene("tet_grid", R"({"model": "viscous"})", ""), "per-spring damping");
   }
-  SUBCASE("cuts") {
-    expect_run_error<SceneError>(
-        scene("tet_grid", rayleigh, R"(, "cuts": [{"type": "plane", "time": 0.05, "point": [0.2, 0, 0], "normal": [1, 0, 0]}])"),
-        "cutting is not supported");
+  SUBCASE("cuts: the tetrahedra follow a plane cut; piercing and cut shells are refused") {
+    const fs::path file = scratch("solid_cut.json");
+    write(file, scene("tet_grid", rayleigh, R"(, "cuts": [{"type": "plane", "time": 0.05, "point": [0.2, 0, 0], "normal": [1, 0, 0]}])"));
+    RunOptions opt;
+    opt.quiet = true;
+    opt.out = scratch("solid_cut_out");
+    const RunSummary sum = run(load_scene(file.string()), opt);
+    CHECK(sum.cuts == 1);
+    std::vector<std::string> header;
+    const auto rows = read_csv(sum.csv, header);
+    const auto col = [&](const std::string& name) {
+      return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+    };
+    CHECK(rows.back()[col("springs")] == 0.0);
+    CHECK(rows.back()[col("particles")] == 24.0);  // the 2 × 2 section points at x = 0.2 duplicated
+    CHECK(rows.back()[col("elements")] == 24.0);
+    expect_run_error<SceneError>(scene("tet_grid", rayleigh, R"(, "cuts": [{"type": "pierce", "time": 0.05, "where": {"type": "all"}}])"),
+                                 "\"pierce\" is not supported with model \"solid\"");
+    std::string shell = scene("tri_grid", rayleigh, R"(, "cuts": [{"type": "plane", "time": 0.05, "point": [0.2, 0, 0], "normal": [1, 0, 0]}])");
+    shell.replace(shell.find(R"("solid", "law": "stvk")"), 22, R"("shell")");
+    shell.replace(shell.find(R"("cells": [4, 1, 1], "size": [0.4, 0.1, 0.1])"), 43, R"("cells": [4, 1], "size": [0.4, 0.1])");
+    expect_run_error<SceneError>(shell, "cutting is supported on solid tetrahedra only, and this scene has 8 shell triangles");
   }
 }

@@ -19,14 +19,27 @@ std::string StencilTerm<N>::element_name(Index e) const {
 }
 
 template <int N>
-Index StencilTerm<N>::push_element(const Nodes& nodes) {
+void StencilTerm<N>::check_distinct(Index e, const Nodes& nodes) const {
   for (int a = 0; a < N; ++a)
     for (int b = a + 1; b < N; ++b)
-      if (nodes[a] == nodes[b])
-        throw InputError(element_name(size()) + ": node " + std::to_string(nodes[a]) + " appears twice");
+      if (nodes[a] == nodes[b]) throw InputError(element_name(e) + ": node " + std::to_string(nodes[a]) + " appears twice");
+}
+
+template <int N>
+Index StencilTerm<N>::push_element(const Nodes& nodes) {
+  check_distinct(size(), nodes);
   nodes_.push_back(nodes);
   touch_topology();
   return size() - 1;
+}
+
+template <int N>
+void StencilTerm<N>::set_element_nodes(Index e, const Nodes& nodes) {
+  if (e >= size()) throw InputError(element_name(e) + ": no such element (" + std::to_string(size()) + " elements)");
+  check_distinct(e, nodes);
+  if (nodes_[e] == nodes) return;
+  nodes_[e] = nodes;
+  touch_topology();
 }
 
 template <int N>

@@ -34,18 +34,26 @@ void MssModel<D>::install_hooks() {
     const Index n = map_.value(gone).node;
     if (unlink_vertex(n, gone.index())) system_.nodes().remove(n);
   });
+  // Springs the caller removed (a continuum model standing in for them) stay removed: their
+  // edges' copies get none, and resync leaves them alone.
   map_.template on_split<1>([this](AttrId<1> a, AttrId<1> b) {
     // a duplicated edge: a new spring (ends, stiffness and rest length follow in resync)
     const Index s = map_.value(a).spring;
+    if (!springs_->is_alive(s)) {
+      map_.value(b).spring = invalid_index;
+      return;
+    }
     map_.value(b).spring = springs_->add(springs_->node_i(s), springs_->node_j(s), springs_->stiffness(s),
                                          springs_->rest_length(s), springs_->kind(s), springs_->viscosity(s));
     dirty_edges_.insert(dirty_edges_.end(), {a.index(), b.index()});
   });
   map_.template on_merge<1>([this](AttrId<1> kept, AttrId<1> gone) {
-    springs_->remove(map_.value(gone).spring);
+    if (springs_->is_alive(map_.value(gone).spring)) springs_->remove(map_.value(gone).spring);
     dirty_edges_.push_back(kept.index());
   });
-  map_.template on_erase<1>([this](AttrId<1> gone) { springs_->remove(map_.value(gone).spring); });
+  map_.template on_erase<1>([this](AttrId<1> gone) {
+    if (springs_->is_alive(map_.value(gone).spring)) springs_->remove(map_.value(gone).spring);
+  });
   auto element_erased = [this](Index e) {
     Element& el = elements_[e];
     el.alive = false;
@@ -118,6 +126,7 @@ void MssModel<D>::resync() {
     if (!eattr.is_alive(e) || !mss_detail::first_visit(seen_edge_, e, generation_)) continue;
     const Dart d = map_.dart_of(AttrId<1>(e));
     const Index s = map_.value(AttrId<1>(e)).spring, i = node_of(d), j = end_node(d);
+    if (!springs_->is_alive(s)) continue;
     if (springs_->node_i(s) != i || springs_->node_j(s) != j) springs_->set_endpoints(s, i, j);
     springs_->set_stiffness(s, edge_stiffness(d));
     springs_->set_rest_length(s, (rest_[j] - rest_[i]).norm());
@@ -149,7 +158,8 @@ void MssModel<D>::compact() {
   const std::vector<Index> node_map = system_.compact_nodes();
   const std::vector<Index> spring_map = springs_->compact();
   for (AttrId<0> a : map_.template attributes<0>()) map_.value(a).node = node_map[map_.value(a).node];
-  for (AttrId<1> a : map_.template attributes<1>()) map_.value(a).spring = spring_map[map_.value(a).spring];
+  for (AttrId<1> a : map_.template attributes<1>())
+    if (map_.value(a).spring != invalid_index) map_.value(a).spring = spring_map[map_.value(a).spring];
   for (Element& el : elements_)
     for (Index& s : el.diagonal)
       if (s != invalid_index) s = spring_map[s];

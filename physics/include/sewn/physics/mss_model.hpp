@@ -14,7 +14,8 @@
 // particles and springs, and the model then recomputes, from the elements that remain incident,
 // the masses of the touched particles, the stiffness and end particles of the touched springs,
 // the particles each diagonal spring is attached to (the paper's Fig. 6) and the per-spring
-// viscosities. Total mass is conserved up to the rounding of these sums.
+// viscosities. Total mass is conserved up to the rounding of these sums. Springs the caller
+// removed (a continuum model standing in for them) stay removed through later edits.
 
 #include <array>
 #include <cstdint>

@@ -37,6 +37,10 @@ class StencilTerm : public ForceTerm {
   [[nodiscard]] const Nodes& element_nodes(Index e) const { return nodes_[e]; }
   /// Positions of element e's nodes in state s.
   [[nodiscard]] Positions gather(const StateView& s, Index e) const;
+  /// Moves element e onto other nodes with the same rest data: a cut that duplicated a corner
+  /// particle hands the element its copy. Throws InputError (naming the element, unchanged) if
+  /// e is out of range or a node repeats. O(1); the Jacobian pattern is rebuilt when next needed.
+  void set_element_nodes(Index e, const Nodes& nodes);
 
   void add_forces(const StateView& s, std::span<double> f) const override;
   [[nodiscard]] double potential_energy(const StateView& s) const override;
@@ -59,6 +63,8 @@ class StencilTerm : public ForceTerm {
   [[nodiscard]] std::string element_name(Index e) const;
 
  private:
+  void check_distinct(Index e, const Nodes& nodes) const;
+
   std::vector<Nodes> nodes_;
   std::vector<Index> slots_;  // N² per element, row-major (a, b)
   std::uint64_t bound_pattern_ = ~std::uint64_t{0};

@@ -1,0 +1,134 @@
+// Cuts on finite-element tetrahedra: after refine::cut the Tets term follows the particles the
+// cut duplicated. A cut changes no energy or mass at the state it is made in, keeps the map
+// valid, and leaves the pieces free of each other; random sequences of cuts keep all of it.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+#include <set>
+
+#include <Eigen/Geometry>
+
+#include "sewn/apps/cell_models.hpp"
+#include "sewn/apps/continuum.hpp"
+#include "sewn/io/cleanup.hpp"
+#include "sewn/refine/cut.hpp"
+
+using namespace sewn;
+using namespace sewn::app;
+
+namespace solid_cuts_test {
+
+struct SolidBody {
+  IndexedMesh mesh;
+  std::vector<physics::MaterialParams> materials{{1e6, 0.3, 1000, 1, 1e-4, physics::ElongatedPolicy::refuse}};
+  std::unique_ptr<physics::MssModel<3>> model;
+  ContinuumParts parts;
+
+  SolidBody(std::uint32_t nx, std::uint32_t ny, std::uint32_t nz) {
+    GridSpec g;
+    g.spacing = {0.1, 0.1, 0.1};
+    mesh = tet_grid(nx, ny, nz, TetSplit::kuhn6, g);
+    Scene s;
+    s.file = "cuts.json";
+    s.model = "solid";
+    s.law = "stvk";
+    s.damping = "none";
+    s.cuts.push_back({});  // cuts are scheduled: the builder must accept them
+    s.cuts.back().type = "plane";
+    physics::MssOptions mo;
+    mo.gravity.setZero();
+    mo.damping = physics::DampingModel::none;
+    model = std::make_unique<physics::MssModel<3>>(mesh, materials, std::vector<std::uint32_t>{}, mo);
+    parts = build_continuum(s, materials, mesh, cell_models(mesh, io::embedded_cells(mesh), s, "m"), *model);
+  }
+  void deform(std::mt19937& rng, double amount) {
+    std::uniform_real_distribution<double> u(-amount, amount);
+    for (physics::Index i = 0; i < model->nodes().size(); ++i)
+      model->nodes().set_position(i, model->nodes().position(i) + Eigen::Vector3d(u(rng), u(rng), u(rng)));
+  }
+  // Every tetrahedron of the term sits on its model element's current corners.
+  [[nodiscard]] bool tets_on_elements() const {
+    for (physics::Index k = 0; k < parts.element_of_tet.size(); ++k) {
+      const auto nodes = model->element_nodes(parts.element_of_tet[k]);
+      const auto& held = parts.tets->element_nodes(k);
+      if (!std::equal(held.begin(), held.end(), nodes.begin())) return false;
+    }
+    return true;
+  }
+};
+
+}  // namespace solid_cuts_test
+
+using namespace solid_cuts_test;
+
+TEST_CASE("solid cut: energy and mass unchanged at the cut, the map valid, the two halves free") {
+  SolidBody b(4, 1, 1);
+  std::mt19937 rng(3);
+  b.deform(rng, 0.01);
+  physics::System& sys = b.model->system();
+  const double e0 = sys.potential_energy(), m0 = b.model->node_mass();
+  REQUIRE(e0 > 0);
+  const auto facets = refine::facets_across_plane(*b.model, Eigen::Vector3d(0.2, 0, 0), Eigen::Vector3d(1, 0, 0));
+  REQUIRE(facets.size() == 2);  // the two triangles of the 0.1 m square section
+  const physics::Index nodes_before = b.model->nodes().size();
+  (void)refine::cut(*b.model, facets);
+  follow_cut(b.parts, *b.model);
+  CHECK(b.model->map().validate().ok());
+  CHECK(b.model->nodes().size() == nodes_before + 4);
+  CHECK(b.model->springs().num_alive() == 0);
+  CHECK(b.tets_on_elements());
+  CHECK(std::abs(sys.potential_energy() - e0) <= 1e-12 * e0);
+  CHECK(std::abs(b.model->node_mass() - m0) <= 1e-12 * m0);
+  CHECK(std::abs(b.model->node_mass() - b.model->element_mass()) <= 1e-12 * m0);
+  // the right half moved away rigidly costs nothing: no tetrahedron joins the halves any more
+  std::set<physics::Index> left, right;
+  for (physics::Index e = 0; e < b.model->elements().size(); ++e)
+    for (physics::Index n : b.model->element_nodes(e)) (b.model->element_centroid(e).x() < 0.2 ? left : right).insert(n);
+  for (physics::Index n : right) CHECK(left.count(n) == 0);
+  for (physics::Index n : right) b.model->nodes().set_position(n, b.model->nodes().position(n) + Eigen::Vector3d(0.05, -0.02, 0.03));
+  CHECK(std::abs(sys.potential_energy() - e0) <= 1e-9 * e0);
+}
+
+TEST_CASE("solid cut: random sequences of plane cuts keep the map valid, energy, mass and forces") {
+  for (std::uint32_t seed = 1; seed <= 6; ++seed) {
+    CAPTURE(seed);
+    SolidBody b(3, 3, 3);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    physics::System& sys = b.model->system();
+    std::size_t facets_cut = 0;
+    for (int k = 0; k < 4; ++k) {
+      b.deform(rng, 0.005);
+      const double e0 = sys.potential_energy(), m0 = b.model->node_mass();
+      const Eigen::Vector3d normal = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
+      const Eigen::Vector3d point(0.15 + 0.1 * u(rng), 0.15 + 0.1 * u(rng), 0.15 + 0.1 * u(rng));
+      const auto facets = refine::facets_across_plane(*b.model, point, normal);
+      facets_cut += refine::cut(*b.model, facets).facets;
+      follow_cut(b.parts, *b.model);
+      CHECK(b.model->map().validate().ok());
+      CHECK(b.tets_on_elements());
+      CHECK(b.model->springs().num_alive() == 0);
+      CHECK(std::abs(sys.potential_energy() - e0) <= 1e-12 * e0);
+      CHECK(std::abs(b.model->node_mass() - m0) <= 1e-12 * m0);
+      // the forces are still the energy's gradient on the new particle numbering
+      sys.compute_forces();
+      const physics::Index n = b.model->nodes().size() - 1;  // a particle the cuts may have made
+      const Eigen::Vector3d f = b.model->nodes().force(n), x = b.model->nodes().position(n);
+      for (int a = 0; a < 3; ++a) {
+        const double h = 1e-7;
+        Eigen::Vector3d xp = x, xm = x;
+        xp[a] += h;
+        xm[a] -= h;
+        b.model->nodes().set_position(n, xp);
+        const double ep = sys.potential_energy();
+        b.model->nodes().set_position(n, xm);
+        const double em = sys.potential_energy();
+        b.model->nodes().set_position(n, x);
+        CHECK(std::abs(-(ep - em) / (2 * h) - f[a]) <= 1e-6 * (1 + f.norm()));
+      }
+    }
+    CHECK(facets_cut > 0);
+    CHECK(b.model->nodes().size() > 64);  // particles were duplicated
+  }
+}
