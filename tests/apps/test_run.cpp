@@ -380,24 +380,35 @@ TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped b
            extra + "}";
   };
   const std::string rayleigh = R"({"model": "rayleigh", "alpha": 1.0})";
-  SUBCASE("runs, with no spring left and elastic energy from the tetrahedra") {
-    const fs::path file = scratch("solid.json");
-    write(file, scene("tet_grid", rayleigh, ""));
+  // Runs scene text; the last row of its frames.csv, by column name.
+  struct LastFrame {
+    RunSummary sum;
+    std::vector<std::string> header;
+    std::vector<std::vector<double>> rows;
+    [[nodiscard]] double operator[](const std::string& name) const {
+      const auto c = static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+      REQUIRE(c < header.size());
+      return rows.back()[c];
+    }
+  };
+  auto run_text = [](const std::string& text, const std::string& name) {
+    const fs::path file = scratch(name + ".json");
+    write(file, text);
     RunOptions opt;
     opt.quiet = true;
-    opt.out = scratch("solid_out");
-    const RunSummary sum = run(load_scene(file.string()), opt);
-    CHECK(sum.steps == 20);
-    std::vector<std::string> header;
-    const auto rows = read_csv(sum.csv, header);
-    const auto col = [&](const std::string& name) {
-      return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
-    };
-    REQUIRE(col("elastic_energy") < header.size());
-    CHECK(rows.back()[col("springs")] == 0.0);
-    CHECK(rows.back()[col("elements")] == 24.0);
-    CHECK(rows.back()[col("elastic_energy")] > 0.0);
-    CHECK(std::isfinite(rows.back()[col("kinetic_energy")]));
+    opt.out = scratch(name + "_out");
+    LastFrame f;
+    f.sum = run(load_scene(file.string()), opt);
+    f.rows = read_csv(f.sum.csv, f.header);
+    return f;
+  };
+  SUBCASE("runs, with no spring left and elastic energy from the tetrahedra") {
+    const LastFrame f = run_text(scene("tet_grid", rayleigh, ""), "solid");
+    CHECK(f.sum.steps == 20);
+    CHECK(f["springs"] == 0.0);
+    CHECK(f["elements"] == 24.0);
+    CHECK(f["elastic_energy"] > 0.0);
+    CHECK(std::isfinite(f["kinetic_energy"]));
   }
   SUBCASE("hexahedra") {
     expect_run_error<SceneError>(scene("hex_grid", rayleigh, ""), "needs tetrahedra only");
@@ -406,20 +417,10 @@ TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped b
     std::string text = scene("tri_grid", rayleigh, "");
     text.replace(text.find(R"("solid", "law": "stvk")"), 22, R"("shell")");
     text.replace(text.find(R"("cells": [4, 1, 1], "size": [0.4, 0.1, 0.1])"), 43, R"("cells": [4, 1], "size": [0.4, 0.1])");
-    const fs::path file = scratch("shell.json");
-    write(file, text);
-    RunOptions opt;
-    opt.quiet = true;
-    opt.out = scratch("shell_out");
-    const RunSummary sum = run(load_scene(file.string()), opt);
-    std::vector<std::string> header;
-    const auto rows = read_csv(sum.csv, header);
-    const auto col = [&](const std::string& name) {
-      return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
-    };
-    CHECK(rows.back()[col("springs")] == 0.0);
-    CHECK(rows.back()[col("elements")] == 8.0);
-    CHECK(rows.back()[col("elastic_energy")] > 0.0);
+    const LastFrame f = run_text(text, "shell");
+    CHECK(f["springs"] == 0.0);
+    CHECK(f["elements"] == 8.0);
+    CHECK(f["elastic_energy"] > 0.0);
     std::string hex = scene("tet_grid", rayleigh, "");
     hex.replace(hex.find(R"("solid", "law": "stvk")"), 22, R"("shell")");
     expect_run_error<SceneError>(hex, "needs triangles only");
@@ -428,21 +429,12 @@ TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped b
     expect_run_error<SceneError>(scene("tet_grid", R"({"model": "viscous"})", ""), "per-spring damping");
   }
   SUBCASE("cuts: the tetrahedra follow a plane cut; piercing and cut shells are refused") {
-    const fs::path file = scratch("solid_cut.json");
-    write(file, scene("tet_grid", rayleigh, R"(, "cuts": [{"type": "plane", "time": 0.05, "point": [0.2, 0, 0], "normal": [1, 0, 0]}])"));
-    RunOptions opt;
-    opt.quiet = true;
-    opt.out = scratch("solid_cut_out");
-    const RunSummary sum = run(load_scene(file.string()), opt);
-    CHECK(sum.cuts == 1);
-    std::vector<std::string> header;
-    const auto rows = read_csv(sum.csv, header);
-    const auto col = [&](const std::string& name) {
-      return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
-    };
-    CHECK(rows.back()[col("springs")] == 0.0);
-    CHECK(rows.back()[col("particles")] == 24.0);  // the 2 × 2 section points at x = 0.2 duplicated
-    CHECK(rows.back()[col("elements")] == 24.0);
+    const LastFrame f = run_text(scene("tet_grid", rayleigh, R"(, "cuts": [{"type": "plane", "time": 0.05, "point": [0.2, 0, 0], "normal": [1, 0, 0]}])"),
+                                 "solid_cut");
+    CHECK(f.sum.cuts == 1);
+    CHECK(f["springs"] == 0.0);
+    CHECK(f["particles"] == 24.0);  // the 2 × 2 section points at x = 0.2 duplicated
+    CHECK(f["elements"] == 24.0);
     expect_run_error<SceneError>(scene("tet_grid", rayleigh, R"(, "cuts": [{"type": "pierce", "time": 0.05, "where": {"type": "all"}}])"),
                                  "\"pierce\" is not supported with model \"solid\"");
     std::string shell = scene("tri_grid", rayleigh, R"(, "cuts": [{"type": "plane", "time": 0.05, "point": [0.2, 0, 0], "normal": [1, 0, 0]}])");
