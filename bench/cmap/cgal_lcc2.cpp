@@ -4,11 +4,11 @@
 namespace sewn::bench::cmap::cgal {
 namespace {
 
-void register_all() {
+void register_lcc2() {
   for (std::uint32_t n : quad_sizes(scale())) register_grid<2>(n);
 }
 
-const Registration registration(&register_all);
+const Registration lcc2_registration(&register_lcc2);
 
 }  // namespace
 }  // namespace sewn::bench::cmap::cgal

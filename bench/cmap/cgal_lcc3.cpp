@@ -4,11 +4,11 @@
 namespace sewn::bench::cmap::cgal {
 namespace {
 
-void register_all() {
+void register_lcc3() {
   for (std::uint32_t n : hex_sizes(scale())) register_grid<3>(n);
 }
 
-const Registration registration(&register_all);
+const Registration lcc3_registration(&register_lcc3);
 
 }  // namespace
 }  // namespace sewn::bench::cmap::cgal

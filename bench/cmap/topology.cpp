@@ -51,7 +51,7 @@ void bench_topology(benchmark::State& state, const Mesh& make, const std::string
     state.SkipWithError("the grid's invariants are not those of a ball");
 }
 
-void register_all() {
+void register_topology() {
   for (std::uint32_t n : topo_hex_sizes(scale())) {
     const std::string c = "hex" + std::to_string(n) + "/betti_orientability";
     ours(suite, c, [n, key = c](benchmark::State& s) { bench_topology(s, [n] { return hex_grid(n, n, n); }, key); });
@@ -64,7 +64,7 @@ void register_all() {
   }
 }
 
-const Registration registration(&register_all);
+const Registration topology_registration(&register_topology);
 
 }  // namespace
 }  // namespace sewn::bench::cmap

@@ -98,7 +98,7 @@ void register_watchdog() {
   peer("mss", name, "no energy checks", [](benchmark::State& st) { run(st, false); })->Unit(benchmark::kMicrosecond);
 }
 
-const Registration registration(&register_watchdog);
+const Registration watchdog_registration(&register_watchdog);
 
 }  // namespace
 

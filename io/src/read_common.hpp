@@ -1,14 +1,24 @@
 #pragma once
 // Internal helpers shared by the readers.
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include "cursor.hpp"
 #include "sewn/cmap/mesh.hpp"
 
 namespace sewn::io::detail {
+
+/// ASCII lower case: keywords and extensions are matched without regard to case.
+inline std::string lower(std::string_view s) {
+  std::string r(s);
+  std::transform(r.begin(), r.end(), r.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return r;
+}
 
 /// Reads `dim` coordinates (missing ones are 0) and rejects non-finite values, naming the node.
 inline Point3 read_point(Cursor& in, int dim, const std::string& node_name) {

@@ -16,11 +16,7 @@ namespace {
 
 using detail::Cursor;
 
-std::string lower(std::string_view s) {
-  std::string r(s);
-  std::transform(r.begin(), r.end(), r.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return r;
-}
+using detail::lower;
 
 struct CellKeyword {
   const char* name;

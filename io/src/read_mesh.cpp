@@ -2,6 +2,7 @@
 #include <cctype>
 
 #include "cursor.hpp"
+#include "read_common.hpp"
 #include "sewn/io/read.hpp"
 
 namespace sewn::io {
@@ -17,11 +18,7 @@ const char* to_string(MeshFormat f) {
 
 namespace {
 
-std::string lower(std::string_view s) {
-  std::string r(s);
-  std::transform(r.begin(), r.end(), r.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return r;
-}
+using detail::lower;
 
 // The first word of the file, skipping blank space and MEDIT '#' comment lines.
 std::string first_word(std::string_view bytes) {

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <string>
 
+#include "minimal_scene.hpp"
 #include "sewn/apps/scene.hpp"
 #include "sewn/physics/integrators.hpp"
 
@@ -14,12 +15,7 @@ using nlohmann::json;
 
 namespace {
 
-json minimal() {
-  return json::parse(R"({
-    "materials": {"steel": {"young": 2e11, "density": 7800}},
-    "meshes": [{"type": "hex_grid", "material": "steel", "cells": [4, 1, 1], "size": [1, 0.25, 0.25]}]
-  })");
-}
+using sewn::app::test::minimal;
 
 // Expects parse_scene to throw a SceneError whose key path is `path` and whose reason contains
 // `reason`.

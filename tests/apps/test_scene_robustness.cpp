@@ -9,6 +9,7 @@
 #include <string>
 
 #include "sewn/apps/runner.hpp"
+#include "minimal_scene.hpp"
 #include "sewn/apps/scene.hpp"
 #include "sewn/physics/errors.hpp"
 
@@ -20,12 +21,7 @@ namespace {
 
 constexpr std::size_t max_json_depth_for_test = 64;
 
-json minimal() {
-  return json::parse(R"({
-    "materials": {"steel": {"young": 2e11, "density": 7800}},
-    "meshes": [{"type": "hex_grid", "material": "steel", "cells": [4, 1, 1], "size": [1, 0.25, 0.25]}]
-  })");
-}
+using sewn::app::test::minimal;
 
 void expect_refused(const json& j, const std::string& path, const std::string& reason) {
   try {

@@ -16,14 +16,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
+fs::path tool_scratch(const std::string& name) {
   const fs::path p = fs::temp_directory_path() / ("sewn_test_tool_" + std::to_string(::getpid())) / name;
   fs::create_directories(p.parent_path());
   return p;
 }
 
-fs::path write(const std::string& name, const std::string& text) {
-  const fs::path p = scratch(name);
+fs::path tool_write(const std::string& name, const std::string& text) {
+  const fs::path p = tool_scratch(name);
   std::ofstream(p) << text;
   return p;
 }
@@ -35,8 +35,8 @@ std::string read(const fs::path& p) {
 
 // Runs `sewn <args>` through bash (for ulimit), with `prefix` run first; returns the exit code
 // and fills `err` with what it printed (standard output and error).
-int sewn(const std::string& args, std::string& err, const std::string& prefix = "") {
-  const fs::path log = scratch("stderr.txt");
+int run_sewn(const std::string& args, std::string& err, const std::string& prefix = "") {
+  const fs::path log = tool_scratch("stderr.txt");
   const std::string inner = prefix + std::string(SEWN_BINARY) + " " + args + " > " + log.string() + " 2>&1";
   const std::string cmd = "bash -c '" + inner + "'";
   const int status = std::system(cmd.c_str());
@@ -61,38 +61,38 @@ std::string cube_msh(const std::vector<std::string>& elements) {
 }  // namespace
 
 TEST_CASE("paths that cannot be used: exit 2 with the path and the reason, before any work") {
-  const fs::path scene = write("tiny.json", tiny_scene);
+  const fs::path scene = tool_write("tiny.json", tiny_scene);
   std::string err;
-  const fs::path file = write("a_file", "x");
-  CHECK(sewn("run --quiet --out " + file.string() + " " + scene.string(), err) == 2);
+  const fs::path file = tool_write("a_file", "x");
+  CHECK(run_sewn("run --quiet --out " + file.string() + " " + scene.string(), err) == 2);
   CHECK(err.find(file.string() + ": exists and is not a folder") != std::string::npos);
-  CHECK(sewn("run --quiet --out " + (file / "sub").string() + " " + scene.string(), err) == 2);
+  CHECK(run_sewn("run --quiet --out " + (file / "sub").string() + " " + scene.string(), err) == 2);
   CHECK(err.find(file.string() + "/sub: cannot be created") != std::string::npos);
-  const fs::path long_out = scratch(std::string(300, 'o'));
-  CHECK(sewn("run --quiet --out " + long_out.string() + " " + scene.string(), err) == 2);
+  const fs::path long_out = tool_scratch(std::string(300, 'o'));
+  CHECK(run_sewn("run --quiet --out " + long_out.string() + " " + scene.string(), err) == 2);
   CHECK(err.find("300 bytes") != std::string::npos);
-  CHECK(sewn("run --quiet --out " + scratch("o1").string() + " " + scene.parent_path().string(), err) == 2);
+  CHECK(run_sewn("run --quiet --out " + tool_scratch("o1").string() + " " + scene.parent_path().string(), err) == 2);
   CHECK(err.find(scene.parent_path().string() + ": (top level): is a folder, not a scene file") != std::string::npos);
   const fs::path long_scene = scene.parent_path() / (std::string(300, 's') + ".json");
-  CHECK(sewn("run --quiet " + long_scene.string(), err) == 2);
+  CHECK(run_sewn("run --quiet " + long_scene.string(), err) == 2);
   CHECK(err.find("File name too long") != std::string::npos);
   // a name that would leave the output folder: refused, and nothing written beside it
   std::string escaping = tiny_scene;
   escaping.insert(1, R"("name": "../escaped", )");
-  const fs::path inside = scratch("inside");
-  CHECK(sewn("run --quiet --out " + inside.string() + " " + write("escape.json", escaping).string(), err) == 2);
+  const fs::path inside = tool_scratch("inside");
+  CHECK(run_sewn("run --quiet --out " + inside.string() + " " + tool_write("escape.json", escaping).string(), err) == 2);
   CHECK(err.find("name: must be a plain file name") != std::string::npos);
   CHECK_FALSE(fs::exists(inside.parent_path() / "escaped.pvd"));
   CHECK_FALSE(fs::exists(inside.parent_path() / "escaped.png"));
 }
 
 TEST_CASE("past a file size limit the run is exit 1 naming the file, and what it wrote stays valid") {
-  const fs::path scene = write("tiny.json", tiny_scene);
+  const fs::path scene = tool_write("tiny.json", tiny_scene);
   std::string err;
   // 12 kB: each frame (~2.3 kB) fits, frames.csv (~150 bytes a row) outgrows it first
-  const fs::path out = scratch("limited");
+  const fs::path out = tool_scratch("limited");
   fs::remove_all(out);
-  CHECK(sewn("run --quiet --out " + out.string() + " " + scene.string(), err, "ulimit -f 12; ") == 1);
+  CHECK(run_sewn("run --quiet --out " + out.string() + " " + scene.string(), err, "ulimit -f 12; ") == 1);
   CHECK(err.find("cannot write the output: " + (out / "frames.csv").string()) != std::string::npos);
   CHECK(err.find("File too large") != std::string::npos);
   for (const auto& e : fs::directory_iterator(out)) CHECK_MESSAGE(e.path().extension() != ".part", e.path());
@@ -124,9 +124,9 @@ TEST_CASE("past a file size limit the run is exit 1 naming the file, and what it
   // the picture past the limit (frames and csv fit): exit 1 naming it, no picture left
   std::string one_frame = tiny_scene;
   one_frame.replace(one_frame.find("\"frames\": 200"), 13, "\"frames\": 1");
-  const fs::path out2 = scratch("limited_png");
+  const fs::path out2 = tool_scratch("limited_png");
   fs::remove_all(out2);
-  CHECK(sewn("run --quiet --out " + out2.string() + " " + write("pic.json", one_frame).string(), err, "ulimit -f 12; ") == 1);
+  CHECK(run_sewn("run --quiet --out " + out2.string() + " " + tool_write("pic.json", one_frame).string(), err, "ulimit -f 12; ") == 1);
   CHECK(err.find((out2 / "pic.png").string()) != std::string::npos);
   CHECK_FALSE(fs::exists(out2 / "pic.png"));
   CHECK_FALSE(fs::exists(out2 / "pic.png.part"));
@@ -149,12 +149,12 @@ TEST_CASE("sewn check and sewn run agree on duplicate cells and meshes without c
   };
   for (const auto& c : cases) {
     CAPTURE(c.name);
-    const fs::path mesh = write(std::string(c.name) + ".msh", cube_msh(c.elements));
-    const fs::path scene = write(std::string(c.name) + ".json", R"({"materials": {"m": {"young": 1e6, "density": 1000}},
+    const fs::path mesh = tool_write(std::string(c.name) + ".msh", cube_msh(c.elements));
+    const fs::path scene = tool_write(std::string(c.name) + ".json", R"({"materials": {"m": {"young": 1e6, "density": 1000}},
         "meshes": [{"type": "file", "path": ")" + mesh.string() + R"(", "material": "m"}], "duration": 0.01})");
     std::string check_err, run_err;
-    const int check = sewn("check " + mesh.string(), check_err);
-    const int run = sewn("run --quiet --out " + scratch("agree").string() + " " + scene.string(), run_err);
+    const int check = run_sewn("check " + mesh.string(), check_err);
+    const int run = run_sewn("run --quiet --out " + tool_scratch("agree").string() + " " + scene.string(), run_err);
     CHECK(check == 2);
     CHECK(run == 2);
     CHECK_MESSAGE(check_err.find(c.reason) != std::string::npos, check_err);
@@ -164,10 +164,10 @@ TEST_CASE("sewn check and sewn run agree on duplicate cells and meshes without c
 
 TEST_CASE("the stable-step refusal names the scene keys, not the library option") {
   std::string err;
-  const fs::path scene = write("unstable.json", R"({"materials": {"m": {"young": 1e8, "density": 1000}},
+  const fs::path scene = tool_write("unstable.json", R"({"materials": {"m": {"young": 1e8, "density": 1000}},
       "meshes": [{"type": "hex_grid", "material": "m", "cells": [2, 1, 1], "size": [0.2, 0.1, 0.1]}],
       "integrator": {"type": "semi-implicit", "step": 0.001}, "duration": 0.01})");
-  CHECK(sewn("run --quiet --out " + scratch("unstable").string() + " " + scene.string(), err) == 2);
+  CHECK(run_sewn("run --quiet --out " + tool_scratch("unstable").string() + " " + scene.string(), err) == 2);
   CHECK(err.find("unstable.json: integrator.step") != std::string::npos);
   CHECK(err.find("integrator.allow_unstable = true") != std::string::npos);
   CHECK(err.find("enforce_stable_step") == std::string::npos);
@@ -175,8 +175,8 @@ TEST_CASE("the stable-step refusal names the scene keys, not the library option"
 
 TEST_CASE("a number too large for a double: exit 2 with file and key path, not a failed run") {
   std::string err;
-  const fs::path scene = write("inf.json", R"({"materials": {"m": {"young": 1e999, "density": 1000}},
+  const fs::path scene = tool_write("inf.json", R"({"materials": {"m": {"young": 1e999, "density": 1000}},
       "meshes": [{"type": "hex_grid", "material": "m", "cells": [1, 1, 1], "size": [0.1, 0.1, 0.1]}]})");
-  CHECK(sewn("run --quiet --out " + scratch("inf").string() + " " + scene.string(), err) == 2);
+  CHECK(run_sewn("run --quiet --out " + tool_scratch("inf").string() + " " + scene.string(), err) == 2);
   CHECK(err.find(scene.string() + ": materials.m.young: the number 1e999 is out of range") != std::string::npos);
 }

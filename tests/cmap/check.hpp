@@ -14,6 +14,11 @@
 
 namespace sewn::test {
 
+// Four numbers (Betti numbers or cell counts by dimension) as one line, for failure messages.
+inline std::string str(const std::array<std::int64_t, 4>& b) {
+  return std::to_string(b[0]) + " " + std::to_string(b[1]) + " " + std::to_string(b[2]) + " " + std::to_string(b[3]);
+}
+
 // Gives every cell of every dimension with attributes its own attribute, numbered 0, 1, 2, ...
 template <class M>
 void label_all_cells(M& m) {

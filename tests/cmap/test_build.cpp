@@ -11,10 +11,10 @@ using namespace sewn;
 using sewn::test::check_map;
 using sewn::test::counts;
 
-using Map1 = CMap<1, std::uint32_t>;
-using Map2 = CMap<2, std::uint32_t>;
-using Map3 = CMap<3, std::uint32_t>;
-using Map4 = CMap<4, std::uint32_t>;
+using UMap1 = CMap<1, std::uint32_t>;
+using UMap2 = CMap<2, std::uint32_t>;
+using UMap3 = CMap<3, std::uint32_t>;
+using UMap4 = CMap<4, std::uint32_t>;
 
 namespace {
 
@@ -40,7 +40,7 @@ TEST_CASE("hexahedral grids of any size and spacing") {
     CAPTURE(x);
     CAPTURE(y);
     CAPTURE(z);
-    Map3 m;
+    UMap3 m;
     const auto mesh = hex_grid(x, y, z, GridSpec{{0.5, 2.0, 0.1}, {1, 2, 3}});
     CHECK(mesh.points[mesh.num_points() - 1] == Point3{1 + 0.5 * x, 2 + 2.0 * y, 3 + 0.1 * z});
     const auto r = build_with_points(m, mesh);
@@ -60,7 +60,7 @@ TEST_CASE("hexahedral grids of any size and spacing") {
 }
 
 TEST_CASE("the paper's tetrahedral beam: 5x7x9 cells, 6 tetrahedra each") {
-  Map3 m;
+  UMap3 m;
   const auto mesh = tet_grid(5, 7, 9, TetSplit::kuhn6);
   CHECK(mesh.num_cells() == 1890);
   build_with_points(m, mesh);
@@ -72,10 +72,10 @@ TEST_CASE("the paper's tetrahedral beam: 5x7x9 cells, 6 tetrahedra each") {
 }
 
 TEST_CASE("a cube as five tetrahedra, and a conforming grid of them") {
-  Map3 m;
+  UMap3 m;
   build_with_points(m, tet_grid(1, 1, 1, TetSplit::five));
   CHECK(check_map(m) == counts<4>({8, 18, 16, 5}));  // 12 edges + 6 face diagonals: 18 springs
-  Map3 g;
+  UMap3 g;
   const auto r = build_with_points(g, tet_grid(3, 2, 2, TetSplit::five));
   check_map(g);
   CHECK(g.euler_characteristic() == 1);
@@ -84,27 +84,27 @@ TEST_CASE("a cube as five tetrahedra, and a conforming grid of them") {
 }
 
 TEST_CASE("quad and triangle grids in a 2-map and as surfaces in a 3-map") {
-  Map2 q2;
+  UMap2 q2;
   build_with_points(q2, quad_grid(4, 3));
   CHECK(check_map(q2) == counts<3>({20, 31, 12}));
-  Map2 t2;
+  UMap2 t2;
   build_with_points(t2, tri_grid(4, 3));
   CHECK(check_map(t2) == counts<3>({20, 43, 24}));
-  Map3 q3;
+  UMap3 q3;
   build_with_points(q3, quad_grid(4, 3));
   CHECK(check_map(q3) == counts<4>({20, 31, 12, 1}));  // one surface: a single 3-cell (open)
 }
 
 TEST_CASE("polylines in 1-, 2- and 3-maps") {
-  Map1 m1;
+  UMap1 m1;
   build_with_points(m1, polyline_x(5));
   auto n1 = check_map(m1);
   CHECK(n1[1] == 5);
   CHECK(m1.count_components() == 1);
-  Map2 m2;
+  UMap2 m2;
   build_with_points(m2, polyline_x(5));
   CHECK(check_map(m2) == counts<3>({6, 5, 2}));  // the forward and backward chains are two open 2-cells
-  Map3 m3;
+  UMap3 m3;
   build_with_points(m3, polyline_x(5));
   CHECK(check_map(m3) == counts<4>({6, 5, 2, 1}));
 }
@@ -124,7 +124,7 @@ TEST_CASE("mixed cell types in one solid: hexahedron, prism, pyramid, tetrahedro
   mesh.add_cell(CellType::prism, {1, 2, 8, 5, 6, 9});
   mesh.add_cell(CellType::pyramid, {4, 5, 6, 7, 10});
   mesh.add_cell(CellType::tetrahedron, {6, 7, 10, 11});
-  Map3 m;
+  UMap3 m;
   const auto r = build_with_points(m, mesh);
   CHECK(r.sewn_facets == 3);
   const auto n = check_map(m);
@@ -141,7 +141,7 @@ TEST_CASE("mixed dimensions: a solid, a shell on it and a rod share points but n
   mesh.add_cell(CellType::segment, {6, 8});  // a rod standing on a corner
   mesh.points.push_back({0.5, 0.5, 3});
   mesh.add_cell(CellType::segment, {8, 9});
-  Map3 m;
+  UMap3 m;
   const auto r = build_with_points(m, mesh);
   check_map(m);
   CHECK(m.count_components() == 3);
@@ -153,7 +153,7 @@ TEST_CASE("surface cells with inconsistent orientation are reversed and glued") 
   IndexedMesh mesh = tri_grid(3, 3);
   // reverse every other triangle
   for (std::uint32_t c = 0; c < mesh.num_cells(); c += 2) std::swap(mesh.conn[mesh.offsets[c] + 1], mesh.conn[mesh.offsets[c] + 2]);
-  Map2 m;
+  UMap2 m;
   const auto r = build_with_points(m, mesh);
   CHECK(check_map(m) == counts<3>({16, 33, 18}));
   std::uint32_t flipped = 0;
@@ -162,14 +162,14 @@ TEST_CASE("surface cells with inconsistent orientation are reversed and glued") 
   CHECK(r.unorientable_edges == 0);
   BuildOptions no_orient;
   no_orient.orient_surfaces = false;
-  Map2 raw;
+  UMap2 raw;
   const auto r2 = build_with_points(raw, mesh, no_orient);
   check_map(raw);
   CHECK(r2.unorientable_edges > 0);  // left unsewn, reported
 }
 
 TEST_CASE("a map of dimension 4 holds hexahedra glued by faces") {
-  Map4 m;
+  UMap4 m;
   build_with_points(m, hex_grid(2, 1, 1));
   const auto n = check_map(m);
   CHECK(n[0] == 12);
@@ -178,7 +178,7 @@ TEST_CASE("a map of dimension 4 holds hexahedra glued by faces") {
 }
 
 TEST_CASE("building into a map that already has darts") {
-  Map3 m;
+  UMap3 m;
   m.make_hexahedron();
   const auto r = build(m, hex_grid(2, 1, 1));
   CHECK(r.vertex_of_dart[0] == Dart::null_index);
@@ -191,7 +191,7 @@ TEST_CASE("sew_coincident_faces glues free facets through the same points, and o
   auto point_of = [](auto& m) { return [&m](Dart d) { return m.value(m.template attribute<0>(d)); }; };
   SUBCASE("the cells of a hexahedral grid made apart, then glued: the same map as build() makes") {
     const IndexedMesh mesh = hex_grid(3, 2, 2);
-    Map3 apart, together;
+    UMap3 apart, together;
     build_with_points(apart, mesh, BuildOptions{.sew = false});
     build_with_points(together, mesh);
     CHECK(check_map(apart)[3] == 12);
@@ -204,7 +204,7 @@ TEST_CASE("sew_coincident_faces glues free facets through the same points, and o
     CHECK(sew_coincident_faces(apart, point_of(apart), mesh.num_points()).sewn == 0);  // nothing left to glue
   }
   SUBCASE("a grid cut through its middle plane is put back together") {
-    Map3 m;
+    UMap3 m;
     build_with_points(m, hex_grid(4, 2, 2));
     const auto before = check_map(m);
     auto on_plane = [&](Dart d) { return m.value(m.attribute<0>(d)) % 5 == 2; };  // x = 2: point i + 5(j + 3k), i = 2
@@ -222,12 +222,12 @@ TEST_CASE("sew_coincident_faces glues free facets through the same points, and o
     IndexedMesh mesh;
     for (std::uint32_t p = 0; p < 8; ++p) mesh.points.push_back({double(p & 1), double((p >> 1) & 1), double(p >> 2)});
     for (int c = 0; c < 3; ++c) mesh.add_cell(CellType::hexahedron, {0, 1, 3, 2, 4, 5, 7, 6});  // three times the same cube
-    Map3 m;
+    UMap3 m;
     build_with_points(m, mesh, BuildOptions{.sew = false});
     const auto rep = sew_coincident_faces(m, point_of(m), 8);
     CHECK(rep == SewCoincidentReport{0, 6, 0});
     CHECK(check_map(m)[3] == 3);
-    Map3 twice;
+    UMap3 twice;
     mesh.conn.resize(16);
     mesh.offsets.resize(3);
     mesh.types.resize(2);
@@ -238,7 +238,7 @@ TEST_CASE("sew_coincident_faces glues free facets through the same points, and o
   }
   SUBCASE("quads of a 2-map glued along their edges") {
     const IndexedMesh mesh = quad_grid(3, 2);
-    Map2 apart, together;
+    UMap2 apart, together;
     build_with_points(apart, mesh, BuildOptions{.sew = false});
     build_with_points(together, mesh);
     const auto rep = sew_coincident_faces(apart, point_of(apart), mesh.num_points());
@@ -246,7 +246,7 @@ TEST_CASE("sew_coincident_faces glues free facets through the same points, and o
     CHECK(check_map(apart) == check_map(together));
   }
   SUBCASE("a point out of range is refused, the map unchanged") {
-    Map3 m;
+    UMap3 m;
     build_with_points(m, hex_grid(2, 1, 1), BuildOptions{.sew = false});
     const auto before = check_map(m);
     CHECK_THROWS_WITH_AS(sew_coincident_faces(m, point_of(m), 5), doctest::Contains("outside [0, 5)"), TopologyError);
@@ -266,7 +266,7 @@ TEST_CASE("bad meshes are refused with the cell named") {
   IndexedMesh mesh = hex_grid(2, 1, 1);
   SUBCASE("index out of range") {
     mesh.conn[9] = 99;
-    Map3 m;
+    UMap3 m;
     const auto msg = message_of([&] { build(m, mesh); });
     CHECK(msg.find("cell 1") != std::string::npos);
     CHECK(msg.find("99") != std::string::npos);
@@ -274,11 +274,11 @@ TEST_CASE("bad meshes are refused with the cell named") {
   }
   SUBCASE("repeated point") {
     mesh.conn[1] = mesh.conn[0];
-    Map3 m;
+    UMap3 m;
     CHECK(message_of([&] { build(m, mesh); }).find("twice") != std::string::npos);
   }
   SUBCASE("a volume in a 2-map") {
-    Map2 m;
+    UMap2 m;
     CHECK(message_of([&] { build(m, mesh); }).find("dimension 2") != std::string::npos);
   }
   SUBCASE("an inverted hexahedron next to a correct one") {
@@ -286,7 +286,7 @@ TEST_CASE("bad meshes are refused with the cell named") {
     auto c1 = std::vector<std::uint32_t>(mesh.cell(1).begin(), mesh.cell(1).end());
     for (int k = 0; k < 4; ++k) mesh.conn[mesh.offsets[1] + k] = c1[static_cast<std::size_t>(k + 4)],
                                 mesh.conn[mesh.offsets[1] + k + 4] = c1[static_cast<std::size_t>(k)];
-    Map3 m;
+    UMap3 m;
     const auto msg = message_of([&] { build(m, mesh); });
     CHECK(msg.find("inverted") != std::string::npos);
     CHECK(msg.find("cell 0") != std::string::npos);
@@ -298,14 +298,14 @@ TEST_CASE("bad meshes are refused with the cell named") {
     t.add_cell(CellType::tetrahedron, {0, 1, 2, 3});
     t.add_cell(CellType::tetrahedron, {0, 2, 1, 4});
     t.add_cell(CellType::tetrahedron, {0, 1, 2, 5});
-    Map3 m;
+    UMap3 m;
     BuildOptions strict;
     strict.allow_nonmanifold = false;
     strict.source = "three.msh";
     const auto msg = message_of([&] { build(m, t, strict); });
     CHECK(msg.find("three.msh") != std::string::npos);
     CHECK(msg.find("non-manifold") != std::string::npos);
-    Map3 lax;
+    UMap3 lax;
     const auto r = build_with_points(lax, t);
     CHECK(r.nonmanifold_facets == 1);
     CHECK(r.sewn_facets == 0);
@@ -318,7 +318,7 @@ TEST_CASE("bad meshes are refused with the cell named") {
     book.add_cell(CellType::quad, {0, 4, 5, 1});
     book.add_cell(CellType::quad, {0, 6, 7, 1});
     book.add_cell(CellType::quad, {3, 9, 8, 2});  // runs 2 -> 3 as page 0 does: reversed to be glued
-    Map3 m;
+    UMap3 m;
     BuildOptions strict;
     strict.allow_nonmanifold = false;
     strict.source = "book.msh";
@@ -326,7 +326,7 @@ TEST_CASE("bad meshes are refused with the cell named") {
     CHECK(msg.find("book.msh") != std::string::npos);
     CHECK(msg.find("non-manifold edge") != std::string::npos);
     CHECK(msg.find("cell 0 (quad)") != std::string::npos);
-    Map3 lax;
+    UMap3 lax;
     const auto r = build_with_points(lax, book);
     CHECK(r.nonmanifold_facets == 1);
     CHECK(r.sewn_facets == 1);  // the fourth page to the first
@@ -340,7 +340,7 @@ TEST_CASE("discs, cylinders and polylines through points") {
   const IndexedMesh frisbee = disc(0.15, 8, 8);
   CHECK(frisbee.num_points() == 289);  // the 2019 paper's nylon frisbee
   CHECK(frisbee.num_cells() == 512);
-  Map2 d;
+  UMap2 d;
   build_with_points(d, frisbee);
   const auto n = check_map(d);
   CHECK(n == counts<3>({289, 289 + 512 - 1, 512}));  // a disc: V - E + F = 1
@@ -351,7 +351,7 @@ TEST_CASE("discs, cylinders and polylines through points") {
     CHECK((b[0] - a[0]) * (e[1] - a[1]) - (b[1] - a[1]) * (e[0] - a[0]) > 0);
   }
   const IndexedMesh cyl = cylinder(0.1, 0.5, 3, 6, 4);
-  Map3 c;
+  UMap3 c;
   const auto r = build_with_points(c, cyl);
   check_map(c);
   CHECK(cyl.num_cells() == 3 * 4 * disc(0.1, 3, 6).num_cells());
@@ -371,7 +371,7 @@ TEST_CASE("unions of lattice boxes: overlaps counted once, touching boxes glued"
   CHECK(mesh.num_cells() == 4 + 2 + 4);  // the overlap cell (1, 0, 0) once
   for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) CHECK(mesh.types[c] == CellType::hexahedron);
   CHECK(mesh.points[mesh.cell(0)[0]] == Point3{0, 0, 0});  // cell (-2, 0, 0) starts at origin - 2 spacings
-  Map3 m;
+  UMap3 m;
   const auto r = build_with_points(m, mesh);
   check_map(m);
   CHECK(r.nonmanifold_facets == 0);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "check.hpp"
 #include "sewn/cmap/build.hpp"
 #include "sewn/cmap/cmap.hpp"
 #include "sewn/cmap/topology.hpp"
@@ -74,9 +75,7 @@ struct Built {
   Topology by_points() const { return topology(map, {res.vertex_of_dart}); }
 };
 
-std::string str(const B& b) {
-  return std::to_string(b[0]) + " " + std::to_string(b[1]) + " " + std::to_string(b[2]) + " " + std::to_string(b[3]);
-}
+using test::str;
 
 // Not inlined: GCC 12.2 at -O2 with AVX-512 (-march=native here) builds the constant argument
 // {1, 1, 0, 0} of an inlined call as {1, 1, 1, 1} (SLP vectorizer; -fno-tree-slp-vectorize or

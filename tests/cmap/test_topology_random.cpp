@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "check.hpp"
 #include "sewn/cmap/build.hpp"
 #include "sewn/cmap/cmap.hpp"
 #include "sewn/cmap/topology.hpp"
@@ -28,9 +29,7 @@ namespace {
 
 using B = std::array<std::int64_t, 4>;
 
-std::string str(const B& b) {
-  return std::to_string(b[0]) + " " + std::to_string(b[1]) + " " + std::to_string(b[2]) + " " + std::to_string(b[3]);
-}
+using test::str;
 
 // Rank over GF(2) of a dense matrix given as columns of bits.
 std::int64_t dense_rank(std::vector<std::vector<std::uint64_t>> cols) {

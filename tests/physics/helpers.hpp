@@ -1,5 +1,5 @@
 #pragma once
-// Shared helpers of the physics tests: dense Jacobians from the assembled pattern and by
+// Shared helpers of the physics tests: the 2013 paper's material, dense Jacobians from the assembled pattern and by
 // central finite differences of the forces.
 
 #include <random>
@@ -7,9 +7,13 @@
 
 #include <Eigen/Dense>
 
+#include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/physics.hpp"
 
 namespace sewn::physics::test {
+
+/// The 2013 paper's material: E = 100 MPa, ν = 0.3, ρ = 1000 kg/m³.
+inline const MaterialParams paper_material{100e6, 0.3, 1000};
 
 inline Eigen::VectorXd forces(System& sys) {
   sys.refresh();

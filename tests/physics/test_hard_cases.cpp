@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include "helpers.hpp"
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
 
@@ -16,7 +17,7 @@ using Eigen::Vector3d;
 
 namespace {
 
-const MaterialParams paper_material{100e6, 0.3, 1000};
+using sewn::physics::test::paper_material;
 
 // Fixes every node whose rest x is at most x_max (a clamped end).
 template <int D>

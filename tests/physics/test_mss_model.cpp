@@ -8,6 +8,7 @@
 #include <set>
 #include <tuple>
 
+#include "helpers.hpp"
 #include "sewn/physics/lattice.hpp"
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/stiffness.hpp"
@@ -17,7 +18,7 @@ using namespace sewn::physics;
 
 namespace {
 
-const MaterialParams paper_material{100e6, 0.3, 1000};  // E = 100 MPa, ν = 0.3, ρ = 1000 (the 2013 paper)
+using sewn::physics::test::paper_material;
 
 MssOptions no_gravity() {
   MssOptions o;

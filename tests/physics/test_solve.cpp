@@ -12,6 +12,7 @@
 
 #include <Eigen/SparseCholesky>
 
+#include "helpers.hpp"
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
@@ -23,7 +24,7 @@ using Eigen::Vector3d;
 
 namespace {
 
-const MaterialParams paper_material{100e6, 0.3, 1000};
+using sewn::physics::test::paper_material;
 
 struct Problem {
   std::vector<double> b, x0, free_dof, mass;

@@ -18,6 +18,8 @@ using namespace sewn::refine;
 using namespace refine_test;
 using Eigen::Vector3d;
 
+namespace test_coarsen {  // one namespace per file: the unity build compiles several files as one
+
 namespace {
 
 const MaterialParams material{1e5, 0.3, 100, 0.5};
@@ -206,3 +208,5 @@ TEST_CASE("cut and refine: seeded random refine / coarsen / cut sequences") {
     CHECK(cuts > 0);
   }
 }
+
+}  // namespace test_coarsen

@@ -17,6 +17,8 @@ using namespace sewn::physics;
 using namespace sewn::refine;
 using Eigen::Vector3d;
 
+namespace test_cut {  // one namespace per file: the unity build compiles several files as one
+
 namespace {
 
 const MaterialParams paper_material{100e6, 0.3, 1000};
@@ -364,3 +366,5 @@ TEST_CASE("randomized sequences of cuts and piercings on hexahedral and tetrahed
     CHECK(piercings > 1);
   }
 }
+
+}  // namespace test_cut

@@ -21,6 +21,8 @@ using namespace sewn::refine;
 using namespace refine_test;
 using Eigen::Vector3d;
 
+namespace test_refine_hex {  // one namespace per file: the unity build compiles several files as one
+
 namespace {
 
 const MaterialParams material{1e5, 0.3, 100};
@@ -326,3 +328,5 @@ TEST_CASE("coarsen hexahedra: a family with a cut between siblings is refused, t
   CHECK(before == std::make_tuple(m.map().num_darts(), m.nodes().num_alive(), m.springs().size()));
   CHECK(r.children.size() == 8);
 }
+
+}  // namespace test_refine_hex

@@ -20,6 +20,8 @@ using namespace sewn::refine;
 using namespace refine_test;
 using Eigen::Vector3d;
 
+namespace test_refine_quad {  // one namespace per file: the unity build compiles several files as one
+
 namespace {
 
 const MaterialParams material{1e5, 0.3, 100, 0.5};
@@ -265,3 +267,5 @@ TEST_CASE("refine: bad requests are refused with the reason, the model unchanged
   CHECK_THROWS_WITH_AS(refine_element(tris, 0), doctest::Contains("triangle"), InputError);
   
 }
+
+}  // namespace test_refine_quad

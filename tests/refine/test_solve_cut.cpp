@@ -14,6 +14,8 @@ using namespace sewn::physics;
 using namespace sewn::refine;
 using Eigen::Vector3d;
 
+namespace test_solve_cut {  // one namespace per file: the unity build compiles several files as one
+
 namespace {
 
 // A 2x2x8 beam of 1.25 cm cubes clamped at z = 0, stepped at h = 1 ms; its section at mid
@@ -60,3 +62,5 @@ TEST_CASE("every solver backend notices a cut and follows a tight solve through 
     CHECK((x - ref).norm() <= 30 * 1e-6 * ref.norm());
   }
 }
+
+}  // namespace test_solve_cut

@@ -18,6 +18,8 @@ using namespace sewn::physics;
 using namespace sewn::refine;
 using Eigen::Vector3d;
 
+namespace test_t_junctions {  // one namespace per file: the unity build compiles several files as one
+
 namespace {
 
 MssOptions free_body() {
@@ -253,3 +255,5 @@ TEST_CASE("adaptive refinement: the docs/refinement.md example runs and refines 
   CHECK(check_hierarchy(beam).ok());
   CHECK(beam.map().validate().ok());
 }
+
+}  // namespace test_t_junctions

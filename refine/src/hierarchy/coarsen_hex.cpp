@@ -13,10 +13,7 @@ namespace sewn::refine::detail {
 namespace {
 
 using physics::Element;
-using Lat = std::array<int, 3>;
 using Vec3 = Eigen::Vector3d;
-constexpr std::array<Lat, 8> corner_lattice = {{{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}, {0, 0, 2}, {2, 0, 2}, {2, 2, 2}, {0, 2, 2}}};
-constexpr int at(const Lat& p) { return p[0] + 3 * p[1] + 9 * p[2]; }
 
 class HexCoarsener {
   using A = ModelAccess<3>;

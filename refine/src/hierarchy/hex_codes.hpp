@@ -11,8 +11,16 @@
 
 namespace sewn::refine::detail {
 
+/// The model's hexahedron edges, as pairs of VTK corners.
 inline constexpr std::array<std::array<std::uint8_t, 2>, 12> hex_edge_ends = {
     {{0, 1}, {3, 2}, {4, 5}, {7, 6}, {0, 3}, {1, 2}, {4, 7}, {5, 6}, {0, 4}, {1, 5}, {2, 6}, {3, 7}}};
+
+/// A point of a hexahedron's refinement lattice: each coordinate 0, 1 or 2 (halves of the parent).
+using Lat = std::array<int, 3>;
+/// VTK corner order in lattice coordinates of the parent.
+inline constexpr std::array<Lat, 8> corner_lattice = {{{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}, {0, 0, 2}, {2, 0, 2}, {2, 2, 2}, {0, 2, 2}}};
+/// The lattice point's index among the 27.
+constexpr int at(const Lat& p) { return p[0] + 3 * p[1] + 9 * p[2]; }
 
 /// Where the rest point r lies on the segment [a, b]: its parameter, or -1 if off the segment.
 inline double on_segment(const Eigen::Vector3d& r, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {

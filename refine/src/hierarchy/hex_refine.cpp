@@ -22,14 +22,6 @@ namespace {
 
 using physics::Element;
 using physics::ElementKind;
-using Lat = std::array<int, 3>;
-
-// VTK corner order, in lattice coordinates of the parent, and the model's hexahedron edges.
-constexpr std::array<Lat, 8> corner_lattice = {{{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}, {0, 0, 2}, {2, 0, 2}, {2, 2, 2}, {0, 2, 2}}};
-constexpr std::array<std::array<std::uint8_t, 2>, 12> hex_edges = {
-    {{0, 1}, {3, 2}, {4, 5}, {7, 6}, {0, 3}, {1, 2}, {4, 7}, {5, 6}, {0, 4}, {1, 5}, {2, 6}, {3, 7}}};
-
-constexpr int at(const Lat& p) { return p[0] + 3 * p[1] + 9 * p[2]; }
 
 int corner_of(const Lat& p) {
   for (int v = 0; v < 8; ++v)
@@ -198,7 +190,7 @@ class HexRefiner : RefinerBase<3> {
     el.parent = e;
     // the model's own rules for a hexahedron (MssModel's make_element), at the child's rest size
     std::array<double, 3> len{};
-    for (std::size_t k = 0; k < 12; ++k) len[k / 4] += (r(hex_edges[k][1]) - r(hex_edges[k][0])).norm() / 4;
+    for (std::size_t k = 0; k < 12; ++k) len[k / 4] += (r(hex_edge_ends[k][1]) - r(hex_edge_ends[k][0])).norm() / 4;
     physics::BoxStiffness s = physics::baudet_box(mat.young, mat.poisson, len[0], len[1], len[2]);
     if (!s.valid()) s = physics::clamp_edges(s, 0.0);  // only a parent built under the clamp policy gets here
     for (std::size_t k = 0; k < 12; ++k) el.edge_k[k] = s.edge[k / 4];
