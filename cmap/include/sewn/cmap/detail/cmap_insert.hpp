@@ -203,16 +203,29 @@ template <int D, class... A>
 bool CMap<D, A...>::is_insertable_face_in_hole(std::span<const Dart> path) const {
   if constexpr (D < 3) return false;
   if (path.empty()) return false;
-  for (Dart d : path) {
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    const Dart d = path[k];
     if (!is_alive(d) || b(d.index(), 2) != detail::null_index) return false;
     for (int j = 4; j <= D; ++j)
       if (b(d.index(), j) != detail::null_index) return false;
+    for (std::size_t l = 0; l < k; ++l)
+      if (path[l] == d) return false;
   }
+  // Usual case, without walking the volume: each next dart is the first 2-free dart met turning
+  // around the vertex where the previous one ends, inside its volume (β1 then β2∘β1 steps stay
+  // at that vertex and in that volume), so all share one volume and the chain closes.
+  const std::uint32_t cap = dart_capacity();
+  bool chained = true;
+  for (std::size_t k = 0; chained && k < path.size(); ++k) {
+    std::uint32_t y = b(path[k].index(), 1);
+    for (std::uint32_t steps = 0; y != detail::null_index && b(y, 2) != detail::null_index && steps <= cap; ++steps)
+      y = b(b(y, 2), 1);
+    chained = y == path[(k + 1) % path.size()].index();
+  }
+  if (chained) return true;
   const DartList vol = cell<3>(path[0]);
   for (std::size_t k = 0; k < path.size(); ++k) {
     if (std::find(vol.begin(), vol.end(), path[k]) == vol.end()) return false;
-    if (std::find(path.begin(), path.begin() + static_cast<std::ptrdiff_t>(k), path[k]) != path.begin() + static_cast<std::ptrdiff_t>(k))
-      return false;
     const std::uint32_t end = b(path[k].index(), 1);
     if (end == detail::null_index || !same_cell<0>(Dart(end), path[(k + 1) % path.size()])) return false;
   }
