@@ -101,6 +101,24 @@ void check_once(benchmark::State& state, const std::string& key, const Ours<D>& 
   if (std::string e = work.check(want); !e.empty()) state.SkipWithError(e.c_str());
 }
 
+// Times op(work) on a fresh copy of the prototype each repetition; making the copy and
+// prepare(work) are untimed. Returns the last copy, for the check.
+template <int D, class Prepare, class Op>
+std::unique_ptr<Ours<D>> on_fresh_copies(benchmark::State& state, const Proto<D>& p, Prepare prepare, Op op) {
+  std::unique_ptr<Ours<D>> work;
+  for (auto _ : state) {
+    {
+      const Untimed untimed(state);
+      work.reset();
+      work = std::make_unique<Ours<D>>(p.ours);
+      prepare(*work);
+    }
+    op(*work);
+  }
+  return work;
+}
+inline constexpr auto no_preparation = [](auto&) {};
+
 template <int D>
 void bench_build(benchmark::State& state, std::uint32_t n, const std::string& key) {
   const IndexedMesh& mesh = grid_mesh(D, n);
@@ -164,15 +182,9 @@ void bench_validate(benchmark::State& state, std::uint32_t n) {
 template <int D>
 void bench_split_edges(benchmark::State& state, std::uint32_t n, const std::string& key) {
   const Proto<D>& p = proto<D>(n);
-  std::unique_ptr<Ours<D>> work;
-  for (auto _ : state) {
-    {
-      const Untimed untimed(state);
-      work.reset();
-      work = std::make_unique<Ours<D>>(p.ours);
-    }
-    auto& map = work->map;
-    auto& pos = work->positions;
+  auto work = on_fresh_copies<D>(state, p, no_preparation, [&](Ours<D>& w) {
+    auto& map = w.map;
+    auto& pos = w.positions;
     for (Dart d : p.edges) {
       const Point3& a = pos[map.value(map.template attribute<0>(d))];
       const Point3& b = pos[map.value(map.template attribute<0>(map.template beta<1>(d)))];
@@ -180,22 +192,15 @@ void bench_split_edges(benchmark::State& state, std::uint32_t n, const std::stri
       map.insert_vertex_in_edge(d, static_cast<std::uint32_t>(pos.size()));
       pos.push_back(mid);
     }
-  }
+  });
   check_once(state, key, *work, after_vertex_in_every_edge(built_counts(D, n)));
 }
 
 void bench_split_faces(benchmark::State& state, std::uint32_t n, const std::string& key) {
   const Proto<2>& p = proto<2>(n);
-  std::unique_ptr<Ours<2>> work;
-  for (auto _ : state) {
-    {
-      const Untimed untimed(state);
-      work.reset();
-      work = std::make_unique<Ours<2>>(p.ours);
-    }
-    auto& map = work->map;
-    for (Dart d : p.faces) map.insert_edge_in_face(d, map.beta(d, 1, 1));
-  }
+  auto work = on_fresh_copies<2>(state, p, no_preparation, [&](Ours<2>& w) {
+    for (Dart d : p.faces) w.map.insert_edge_in_face(d, w.map.beta(d, 1, 1));
+  });
   check_once(state, key, *work, after_edge_in_every_face(quad_counts(n)));
 }
 
@@ -203,19 +208,15 @@ void bench_split_faces(benchmark::State& state, std::uint32_t n, const std::stri
 // CGAL's unsew copies the point into the new vertex attribute: this is what a cut must do.
 void bench_unsew_plane(benchmark::State& state, std::uint32_t n, const std::string& key) {
   const Proto<3>& p = proto<3>(n);
-  std::unique_ptr<Ours<3>> work;
-  for (auto _ : state) {
-    {
-      const Untimed untimed(state);
-      work.reset();
-      work = std::make_unique<Ours<3>>(p.ours);
-      work->map.on_split<0>([w = &*work](AttrId<0> orig, AttrId<0> copy) {
-        w->map.value(copy) = static_cast<std::uint32_t>(w->positions.size());
-        w->positions.push_back(w->positions[w->map.value(orig)]);
-      });
-    }
-    for (Dart d : p.plane_faces) work->map.unsew<3>(d);
-  }
+  auto copy_position = [](Ours<3>& w) {
+    w.map.on_split<0>([pw = &w](AttrId<0> orig, AttrId<0> copy) {
+      pw->map.value(copy) = static_cast<std::uint32_t>(pw->positions.size());
+      pw->positions.push_back(pw->positions[pw->map.value(orig)]);
+    });
+  };
+  auto work = on_fresh_copies<3>(state, p, copy_position, [&](Ours<3>& w) {
+    for (Dart d : p.plane_faces) w.map.unsew<3>(d);
+  });
   if (p.plane_faces.size() != std::uint64_t{n} * n)
     state.SkipWithError(("found " + std::to_string(p.plane_faces.size()) + " faces in the middle plane").c_str());
   else
@@ -226,15 +227,9 @@ void bench_unsew_plane(benchmark::State& state, std::uint32_t n, const std::stri
 // gives it a point.
 void bench_vertex_in_faces(benchmark::State& state, std::uint32_t n, const std::string& key) {
   const Proto<3>& p = proto<3>(n);
-  std::unique_ptr<Ours<3>> work;
-  for (auto _ : state) {
-    {
-      const Untimed untimed(state);
-      work.reset();
-      work = std::make_unique<Ours<3>>(p.ours);
-    }
-    auto& map = work->map;
-    auto& pos = work->positions;
+  auto work = on_fresh_copies<3>(state, p, no_preparation, [&](Ours<3>& w) {
+    auto& map = w.map;
+    auto& pos = w.positions;
     for (Dart d : p.faces) {
       Point3 c{0, 0, 0};
       double k = 0;
@@ -249,7 +244,7 @@ void bench_vertex_in_faces(benchmark::State& state, std::uint32_t n, const std::
       map.set_attribute<0>(w, static_cast<std::uint32_t>(pos.size()));
       pos.push_back({c[0] / k, c[1] / k, c[2] / k});
     }
-  }
+  });
   check_once(state, key, *work, after_vertex_in_every_face(hex_counts(n)));
 }
 
@@ -259,22 +254,16 @@ void bench_vertex_in_faces(benchmark::State& state, std::uint32_t n, const std::
 // its is_valid() then fails (ours handles both sides; see the CGAL twin check).
 void bench_dangling_in_faces(benchmark::State& state, std::uint32_t n, const std::string& key) {
   const Proto<3>& p = proto<3>(n);
-  std::unique_ptr<Ours<3>> work;
-  for (auto _ : state) {
-    {
-      const Untimed untimed(state);
-      work.reset();
-      work = std::make_unique<Ours<3>>(p.ours);
-    }
-    auto& map = work->map;
-    auto& pos = work->positions;
+  auto work = on_fresh_copies<3>(state, p, no_preparation, [&](Ours<3>& w) {
+    auto& map = w.map;
+    auto& pos = w.positions;
     for (Dart d : p.boundary_faces) {
       const Point3 at = pos[map.value(map.attribute<0>(d))];
       const Dart a = map.insert_dangling_edge_in_face(d);
       map.set_attribute<0>(map.beta<1>(a), static_cast<std::uint32_t>(pos.size()));
       pos.push_back(at);
     }
-  }
+  });
   check_once(state, key, *work, after_dangling_edge_in_every_boundary_face(n));
 }
 
@@ -282,27 +271,23 @@ void bench_dangling_in_faces(benchmark::State& state, std::uint32_t n, const std
 // the ring of 2-free darts it left: the grid is whole again.
 void bench_close_holes(benchmark::State& state, std::uint32_t n, const std::string& key) {
   const Proto<3>& p = proto<3>(n);
-  std::unique_ptr<Ours<3>> work;
   std::vector<std::vector<Dart>> rings;
-  for (auto _ : state) {
-    {
-      const Untimed untimed(state);
-      work.reset();
-      work = std::make_unique<Ours<3>>(p.ours);
-      rings.clear();
-      for (Dart f : p.top_faces) {
-        std::vector<Dart> ring;
-        Dart x = f;
-        do {  // the β2 partners, in reverse order: a path running the other way
-          ring.insert(ring.begin(), work->map.beta<2>(x));
-          x = work->map.beta<1>(x);
-        } while (x != f);
-        work->map.remove_cell<2>(f);
-        rings.push_back(std::move(ring));
-      }
+  auto open_holes = [&](Ours<3>& w) {
+    rings.clear();
+    for (Dart f : p.top_faces) {
+      std::vector<Dart> ring;
+      Dart x = f;
+      do {  // the β2 partners, in reverse order: a path running the other way
+        ring.insert(ring.begin(), w.map.beta<2>(x));
+        x = w.map.beta<1>(x);
+      } while (x != f);
+      w.map.remove_cell<2>(f);
+      rings.push_back(std::move(ring));
     }
-    for (const auto& ring : rings) work->map.insert_face_in_hole(ring);
-  }
+  };
+  auto work = on_fresh_copies<3>(state, p, open_holes, [&](Ours<3>& w) {
+    for (const auto& ring : rings) w.map.insert_face_in_hole(ring);
+  });
   if (p.top_faces.size() != std::uint64_t{n} * n)
     state.SkipWithError(("found " + std::to_string(p.top_faces.size()) + " faces in the top plane").c_str());
   else
