@@ -19,6 +19,13 @@
 //   unsew plane  unsew<3> on one dart per face of the middle plane; CGAL copies the point of
 //                every vertex the cut splits, as our split hook copies the position.
 //   validate     is_valid() (combinatorial checks plus "every dart has a vertex attribute").
+//   vertex in faces    insert_barycenter_in_cell<2> (insert_cell_0_in_cell_2 plus the point), as
+//                ours insert_vertex_in_face plus a node at the barycentre.
+//   dangling edges     insert_dangling_cell_1_in_cell_2(d, point of d) on every boundary face,
+//                as ours insert_dangling_edge_in_face plus a node at that point (on a 3-sewn
+//                face CGAL 5.5.1 gives the point to a wrong dart: is_valid() fails).
+//   close holes  insert_cell_2_in_cell_3 on the ring of 2-free darts each removed top face
+//                left (the removals untimed), as ours insert_face_in_hole.
 // Operations that change the map run on a copy of a prototype made before the clock restarts,
 // and the darts they apply to are collected on that copy, also untimed.
 
@@ -116,11 +123,13 @@ struct Peer {
   }
 
   // One dart per 3-sewn face whose vertices all lie in the middle plane (D = 3).
-  std::vector<DartHandle> middle_plane_faces(std::uint32_t n) {
-    const double z = middle_plane_z(n);
+  std::vector<DartHandle> middle_plane_faces(std::uint32_t n) { return faces_in_plane(middle_plane_z(n), false); }
+
+  // One dart per face, 3-sewn or 3-free as `free` says, whose vertices all lie in plane z.
+  std::vector<DartHandle> faces_in_plane(double z, bool free) {
     std::vector<DartHandle> out;
     for (DartHandle d : one_dart_per_cell<2>()) {
-      if (lcc.template is_free<3>(d)) continue;
+      if (lcc.template is_free<3>(d) != free) continue;
       bool in_plane = true;
       DartHandle x = d;
       do {
@@ -263,6 +272,67 @@ void bench_unsew_plane(benchmark::State& state, std::uint32_t n, const std::stri
 }
 
 template <int D>
+  requires(D == 3)
+void bench_vertex_in_faces(benchmark::State& state, std::uint32_t n, const std::string& key) {
+  auto work = on_fresh_copies<D>(
+      state, n, [](Peer<D>& w) { return w.template one_dart_per_cell<2>(); },
+      [](Lcc<D>& lcc, const auto& faces) {
+        for (auto d : faces) lcc.template insert_barycenter_in_cell<2>(d);
+      });
+  check_once(state, key, *work, after_vertex_in_every_face(hex_counts(n)));
+}
+
+template <int D>
+  requires(D == 3)
+void bench_dangling_in_faces(benchmark::State& state, std::uint32_t n, const std::string& key) {
+  auto work = on_fresh_copies<D>(
+      state, n,
+      [](Peer<D>& w) {
+        auto faces = w.template one_dart_per_cell<2>();
+        std::erase_if(faces, [&](auto d) { return !w.lcc.template is_free<3>(d); });
+        return faces;
+      },
+      [](Lcc<D>& lcc, const auto& faces) {
+        for (auto d : faces) lcc.insert_dangling_cell_1_in_cell_2(d, typename Lcc<D>::Point(lcc.point(d)));
+      });
+  check_once(state, key, *work, after_dangling_edge_in_every_boundary_face(n));
+}
+
+template <int D>
+  requires(D == 3)
+void bench_close_holes(benchmark::State& state, std::uint32_t n, const std::string& key) {
+  const Peer<D>& p = proto<D>(n);
+  std::unique_ptr<Peer<D>> work;
+  std::vector<std::vector<typename Peer<D>::DartHandle>> rings;
+  std::size_t found = 0;
+  for (auto _ : state) {
+    {
+      const Untimed untimed(state);
+      work.reset();
+      work = std::make_unique<Peer<D>>(p);
+      rings.clear();
+      const auto top = work->faces_in_plane(static_cast<double>(n), true);
+      found = top.size();
+      for (auto f : top) {
+        std::vector<typename Peer<D>::DartHandle> ring;
+        auto x = f;
+        do {  // the β2 partners, in reverse order, as ours
+          ring.insert(ring.begin(), work->lcc.template beta<2>(x));
+          x = work->lcc.next(x);
+        } while (x != f);
+        work->lcc.template remove_cell<2>(f);
+        rings.push_back(std::move(ring));
+      }
+    }
+    for (const auto& ring : rings) work->lcc.insert_cell_2_in_cell_3(ring.begin(), ring.end());
+  }
+  if (found != std::uint64_t{n} * n)
+    state.SkipWithError(("found " + std::to_string(found) + " faces in the top plane").c_str());
+  else
+    check_once(state, key, *work, hex_counts(n));
+}
+
+template <int D>
 void register_grid(std::uint32_t n) {
   const std::string g = grid_name(D, n);
   auto add = [&](const char* operation, auto body) {
@@ -279,8 +349,14 @@ void register_grid(std::uint32_t n) {
       [](benchmark::State& s, std::uint32_t m, const std::string& k) { bench_split_edges<D>(s, m, k); });
   if constexpr (D == 2)
     add(op::split_faces, [](benchmark::State& s, std::uint32_t m, const std::string& k) { bench_split_faces<D>(s, m, k); });
-  else
+  else {
     add(op::unsew_plane, [](benchmark::State& s, std::uint32_t m, const std::string& k) { bench_unsew_plane<D>(s, m, k); });
+    add(op::vertex_in_faces,
+        [](benchmark::State& s, std::uint32_t m, const std::string& k) { bench_vertex_in_faces<D>(s, m, k); });
+    add(op::dangling_in_faces,
+        [](benchmark::State& s, std::uint32_t m, const std::string& k) { bench_dangling_in_faces<D>(s, m, k); });
+    add(op::close_holes, [](benchmark::State& s, std::uint32_t m, const std::string& k) { bench_close_holes<D>(s, m, k); });
+  }
   add(op::validate, [](benchmark::State& s, std::uint32_t m, const std::string&) { bench_validate<D>(s, m); });
 }
 

@@ -65,6 +65,24 @@ Counts after_vertex_in_every_edge(const Counts& c) {
   return r;
 }
 
+Counts after_vertex_in_every_face(const Counts& c) {
+  Counts r = c;
+  r.cells[0] += c.cells[2];
+  r.cells[1] += 4 * c.cells[2];
+  r.cells[2] *= 4;
+  r.darts *= 3;
+  return r;
+}
+
+Counts after_dangling_edge_in_every_boundary_face(std::uint32_t n) {
+  Counts r = hex_counts(n);
+  const std::uint64_t faces = 6 * std::uint64_t{n} * n;
+  r.cells[0] += faces;
+  r.cells[1] += faces;
+  r.darts += 2 * faces;
+  return r;
+}
+
 Counts after_edge_in_every_face(const Counts& c) {
   Counts r = c;
   r.cells[1] += c.cells[2];

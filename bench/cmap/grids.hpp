@@ -41,11 +41,17 @@ Counts after_vertex_in_every_edge(const Counts& c);
 /// After inserting an edge in every (quad) face of a 2D map with counts c: each face becomes
 /// two, and gains one edge of two darts.
 Counts after_edge_in_every_face(const Counts& c);
+/// After inserting a vertex in every (quad) face, joined to its four corners: each face becomes
+/// four triangles, each side of a face's 4 darts 12.
+Counts after_vertex_in_every_face(const Counts& c);
+/// After inserting a dangling edge in every boundary face of an n³ grid: one more vertex, edge
+/// and two darts per face.
+Counts after_dangling_edge_in_every_boundary_face(std::uint32_t n);
 /// After 3-unsewing every face of the middle plane z = n/2 of an n³ grid: the plane's faces,
 /// edges and vertices are all doubled; no dart is created.
 Counts after_unsew_middle_plane(std::uint32_t n);
 
-/// The z coordinate of the middle plane of an n³ grid with unit spacing (n ≥ 2).
+/// The z coordinate of the middle plane of an n³ grid with unit spacing (n ≥ 2); its top is z = n.
 inline double middle_plane_z(std::uint32_t n) { return static_cast<double>(n / 2); }
 
 /// The operations, in report order; a case is "<grid>/<operation>", e.g. "hex16/build".
@@ -56,6 +62,9 @@ inline constexpr const char* count_all = "count_all";            // count i-cell
 inline constexpr const char* split_edges = "insert_vertex_in_every_edge";
 inline constexpr const char* split_faces = "insert_edge_in_every_face";  // 2D grids only
 inline constexpr const char* unsew_plane = "unsew3_middle_plane";       // 3D grids only
+inline constexpr const char* vertex_in_faces = "insert_vertex_in_every_face";    // 3D grids only
+inline constexpr const char* dangling_in_faces = "insert_dangling_edge_in_every_boundary_face";  // 3D
+inline constexpr const char* close_holes = "close_top_holes";  // 3D: insert_face_in_hole per top face
 inline constexpr const char* validate = "validate";
 }  // namespace op
 

@@ -59,22 +59,27 @@ struct Proto {
   std::vector<Dart> edges;        // one dart per edge
   std::vector<Dart> faces;        // one dart per face
   std::vector<Dart> plane_faces;  // D = 3: one dart per face of the middle plane
+  std::vector<Dart> top_faces;    // D = 3: one dart per boundary face of the top plane
+  std::vector<Dart> boundary_faces;  // D = 3: one dart per 3-free face
 
   explicit Proto(std::uint32_t n) : ours(grid_mesh(D, n)) {
     for (Dart d : ours.map.template cells<1>()) edges.push_back(d);
     for (Dart d : ours.map.template cells<2>()) faces.push_back(d);
     if constexpr (D == 3) {
-      const double z = middle_plane_z(n);
       auto z_of = [&](Dart d) { return ours.positions[ours.map.value(ours.map.template attribute<0>(d))][2]; };
-      for (Dart d : faces) {
-        if (ours.map.template beta<3>(d).is_null()) continue;
-        bool in_plane = true;
+      auto in_plane = [&](Dart d, double z) {
+        bool all = true;
         Dart x = d;
         do {
-          in_plane = in_plane && z_of(x) == z;
+          all = all && z_of(x) == z;
           x = ours.map.template beta<1>(x);
         } while (x != d);
-        if (in_plane) plane_faces.push_back(d);
+        return all;
+      };
+      for (Dart d : faces) {
+        if (ours.map.template beta<3>(d).is_null()) boundary_faces.push_back(d);
+        if (!ours.map.template beta<3>(d).is_null() && in_plane(d, middle_plane_z(n))) plane_faces.push_back(d);
+        if (ours.map.template beta<3>(d).is_null() && in_plane(d, static_cast<double>(n))) top_faces.push_back(d);
       }
     }
   }
@@ -95,6 +100,24 @@ void check_once(benchmark::State& state, const std::string& key, const Ours<D>& 
   if (!first_time(key)) return;
   if (std::string e = work.check(want); !e.empty()) state.SkipWithError(e.c_str());
 }
+
+// Times op(work) on a fresh copy of the prototype each repetition; making the copy and
+// prepare(work) are untimed. Returns the last copy, for the check.
+template <int D, class Prepare, class Op>
+std::unique_ptr<Ours<D>> on_fresh_copies(benchmark::State& state, const Proto<D>& p, Prepare prepare, Op op) {
+  std::unique_ptr<Ours<D>> work;
+  for (auto _ : state) {
+    {
+      const Untimed untimed(state);
+      work.reset();
+      work = std::make_unique<Ours<D>>(p.ours);
+      prepare(*work);
+    }
+    op(*work);
+  }
+  return work;
+}
+inline constexpr auto no_preparation = [](auto&) {};
 
 template <int D>
 void bench_build(benchmark::State& state, std::uint32_t n, const std::string& key) {
@@ -159,15 +182,9 @@ void bench_validate(benchmark::State& state, std::uint32_t n) {
 template <int D>
 void bench_split_edges(benchmark::State& state, std::uint32_t n, const std::string& key) {
   const Proto<D>& p = proto<D>(n);
-  std::unique_ptr<Ours<D>> work;
-  for (auto _ : state) {
-    {
-      const Untimed untimed(state);
-      work.reset();
-      work = std::make_unique<Ours<D>>(p.ours);
-    }
-    auto& map = work->map;
-    auto& pos = work->positions;
+  auto work = on_fresh_copies<D>(state, p, no_preparation, [&](Ours<D>& w) {
+    auto& map = w.map;
+    auto& pos = w.positions;
     for (Dart d : p.edges) {
       const Point3& a = pos[map.value(map.template attribute<0>(d))];
       const Point3& b = pos[map.value(map.template attribute<0>(map.template beta<1>(d)))];
@@ -175,22 +192,15 @@ void bench_split_edges(benchmark::State& state, std::uint32_t n, const std::stri
       map.insert_vertex_in_edge(d, static_cast<std::uint32_t>(pos.size()));
       pos.push_back(mid);
     }
-  }
+  });
   check_once(state, key, *work, after_vertex_in_every_edge(built_counts(D, n)));
 }
 
 void bench_split_faces(benchmark::State& state, std::uint32_t n, const std::string& key) {
   const Proto<2>& p = proto<2>(n);
-  std::unique_ptr<Ours<2>> work;
-  for (auto _ : state) {
-    {
-      const Untimed untimed(state);
-      work.reset();
-      work = std::make_unique<Ours<2>>(p.ours);
-    }
-    auto& map = work->map;
-    for (Dart d : p.faces) map.insert_edge_in_face(d, map.beta(d, 1, 1));
-  }
+  auto work = on_fresh_copies<2>(state, p, no_preparation, [&](Ours<2>& w) {
+    for (Dart d : p.faces) w.map.insert_edge_in_face(d, w.map.beta(d, 1, 1));
+  });
   check_once(state, key, *work, after_edge_in_every_face(quad_counts(n)));
 }
 
@@ -198,23 +208,90 @@ void bench_split_faces(benchmark::State& state, std::uint32_t n, const std::stri
 // CGAL's unsew copies the point into the new vertex attribute: this is what a cut must do.
 void bench_unsew_plane(benchmark::State& state, std::uint32_t n, const std::string& key) {
   const Proto<3>& p = proto<3>(n);
-  std::unique_ptr<Ours<3>> work;
-  for (auto _ : state) {
-    {
-      const Untimed untimed(state);
-      work.reset();
-      work = std::make_unique<Ours<3>>(p.ours);
-      work->map.on_split<0>([w = &*work](AttrId<0> orig, AttrId<0> copy) {
-        w->map.value(copy) = static_cast<std::uint32_t>(w->positions.size());
-        w->positions.push_back(w->positions[w->map.value(orig)]);
-      });
-    }
-    for (Dart d : p.plane_faces) work->map.unsew<3>(d);
-  }
+  auto copy_position = [](Ours<3>& w) {
+    w.map.on_split<0>([pw = &w](AttrId<0> orig, AttrId<0> copy) {
+      pw->map.value(copy) = static_cast<std::uint32_t>(pw->positions.size());
+      pw->positions.push_back(pw->positions[pw->map.value(orig)]);
+    });
+  };
+  auto work = on_fresh_copies<3>(state, p, copy_position, [&](Ours<3>& w) {
+    for (Dart d : p.plane_faces) w.map.unsew<3>(d);
+  });
   if (p.plane_faces.size() != std::uint64_t{n} * n)
     state.SkipWithError(("found " + std::to_string(p.plane_faces.size()) + " faces in the middle plane").c_str());
   else
     check_once(state, key, *work, after_unsew_middle_plane(n));
+}
+
+// The new vertex gets a node at the face's barycentre, as CGAL's insert_barycenter_in_cell<2>
+// gives it a point.
+void bench_vertex_in_faces(benchmark::State& state, std::uint32_t n, const std::string& key) {
+  const Proto<3>& p = proto<3>(n);
+  auto work = on_fresh_copies<3>(state, p, no_preparation, [&](Ours<3>& w) {
+    auto& map = w.map;
+    auto& pos = w.positions;
+    for (Dart d : p.faces) {
+      Point3 c{0, 0, 0};
+      double k = 0;
+      Dart x = d;
+      do {
+        const Point3& q = pos[map.value(map.attribute<0>(x))];
+        for (int i = 0; i < 3; ++i) c[static_cast<std::size_t>(i)] += q[static_cast<std::size_t>(i)];
+        k += 1;
+        x = map.beta<1>(x);
+      } while (x != d);
+      const Dart w = map.insert_vertex_in_face(d);
+      map.set_attribute<0>(w, static_cast<std::uint32_t>(pos.size()));
+      pos.push_back({c[0] / k, c[1] / k, c[2] / k});
+    }
+  });
+  check_once(state, key, *work, after_vertex_in_every_face(hex_counts(n)));
+}
+
+// The new vertex gets a node at the position of the vertex the edge hangs from, as CGAL's
+// insert_dangling_cell_1_in_cell_2 is given that point. Boundary faces only: on a 3-sewn face
+// CGAL 5.5.1 gives the new vertex's attribute to a dart of the old vertex on the far side, and
+// its is_valid() then fails (ours handles both sides; see the CGAL twin check).
+void bench_dangling_in_faces(benchmark::State& state, std::uint32_t n, const std::string& key) {
+  const Proto<3>& p = proto<3>(n);
+  auto work = on_fresh_copies<3>(state, p, no_preparation, [&](Ours<3>& w) {
+    auto& map = w.map;
+    auto& pos = w.positions;
+    for (Dart d : p.boundary_faces) {
+      const Point3 at = pos[map.value(map.attribute<0>(d))];
+      const Dart a = map.insert_dangling_edge_in_face(d);
+      map.set_attribute<0>(map.beta<1>(a), static_cast<std::uint32_t>(pos.size()));
+      pos.push_back(at);
+    }
+  });
+  check_once(state, key, *work, after_dangling_edge_in_every_boundary_face(n));
+}
+
+// Every top boundary face removed (untimed), then each hole closed by insert_face_in_hole on
+// the ring of 2-free darts it left: the grid is whole again.
+void bench_close_holes(benchmark::State& state, std::uint32_t n, const std::string& key) {
+  const Proto<3>& p = proto<3>(n);
+  std::vector<std::vector<Dart>> rings;
+  auto open_holes = [&](Ours<3>& w) {
+    rings.clear();
+    for (Dart f : p.top_faces) {
+      std::vector<Dart> ring;
+      Dart x = f;
+      do {  // the β2 partners, in reverse order: a path running the other way
+        ring.insert(ring.begin(), w.map.beta<2>(x));
+        x = w.map.beta<1>(x);
+      } while (x != f);
+      w.map.remove_cell<2>(f);
+      rings.push_back(std::move(ring));
+    }
+  };
+  auto work = on_fresh_copies<3>(state, p, open_holes, [&](Ours<3>& w) {
+    for (const auto& ring : rings) w.map.insert_face_in_hole(ring);
+  });
+  if (p.top_faces.size() != std::uint64_t{n} * n)
+    state.SkipWithError(("found " + std::to_string(p.top_faces.size()) + " faces in the top plane").c_str());
+  else
+    check_once(state, key, *work, hex_counts(n));
 }
 
 template <int D>
@@ -234,8 +311,14 @@ void register_grid(std::uint32_t n) {
       [](benchmark::State& s, std::uint32_t m, const std::string& k) { bench_split_edges<D>(s, m, k); });
   if constexpr (D == 2)
     add(op::split_faces, [](benchmark::State& s, std::uint32_t m, const std::string& k) { bench_split_faces(s, m, k); });
-  else
+  else {
     add(op::unsew_plane, [](benchmark::State& s, std::uint32_t m, const std::string& k) { bench_unsew_plane(s, m, k); });
+    add(op::vertex_in_faces,
+        [](benchmark::State& s, std::uint32_t m, const std::string& k) { bench_vertex_in_faces(s, m, k); });
+    add(op::dangling_in_faces,
+        [](benchmark::State& s, std::uint32_t m, const std::string& k) { bench_dangling_in_faces(s, m, k); });
+    add(op::close_holes, [](benchmark::State& s, std::uint32_t m, const std::string& k) { bench_close_holes(s, m, k); });
+  }
   add(op::validate, [](benchmark::State& s, std::uint32_t m, const std::string&) { bench_validate<D>(s, m); });
 }
 

@@ -6,8 +6,12 @@
 // elimination over GF(2)); b0 against count_components(), χ against euler_characteristic() and
 // Σ(-1)^i b_i; the orientation found against every sew; and what each operation must do:
 // insertions keep every Betti number, so do removals between two distinct cells and contractions
-// of an edge between two distinct vertices, and a new closed cell adds one component. The seed,
-// step and operation are printed on failure so the sequence replays.
+// of an edge between two distinct vertices, and a new closed cell adds one component. The map
+// carries a per-dart tag (DartInfo), unique to each dart, checked after every operation against
+// a model kept here: a surviving dart keeps its tag, an erased dart's tag is gone (a slot reused
+// later starts from 0), a built dart starts from 0, and each dart an insertion makes holds the
+// tag of the dart the header's rule names. The seed, step and operation are printed on failure
+// so the sequence replays.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -106,7 +110,7 @@ B oracle_betti(const Map& m) {
 
 template <int D>
 struct Driver {
-  CMap<D> m;
+  CMap<D, DartInfo<std::uint64_t>> m;
   std::mt19937 rng;
   std::uint32_t max_darts;
   std::int64_t ops_applied = 0;
@@ -151,6 +155,77 @@ struct Driver {
   Expect skipped = Expect::any;
   bool applied = false;
 
+  // Per-dart tags. tag_model[slot]: the tag the live dart in that slot must hold, 0 for a slot
+  // with no dart. An operation that makes darts says which tags they may hold (new_tags) and
+  // how many it makes (new_count, -1: any); a dart it makes that the rule does not allow fails.
+  std::vector<std::uint64_t> tag_model;
+  std::uint64_t next_tag = 1;
+  std::function<std::vector<std::uint64_t>(Dart)> new_tags;
+  std::int64_t new_count = -1;
+  std::int64_t tag_checks = 0;
+  std::uint64_t model_tag(Dart d) const { return d.index() < tag_model.size() ? tag_model[d.index()] : 0; }
+  // Builders and make_*: new darts start from the default value.
+  void expect_default_tags() {
+    new_tags = [](Dart) { return std::vector<std::uint64_t>{0}; };
+    new_count = -1;
+  }
+  // Insertions into the face of d: darts on d's side copy d, those on β3(d)'s side copy β3(d)
+  // (D = 3); `side` finds the side of a new dart.
+  void expect_face_copies(Dart d, std::int64_t count) {
+    const std::uint64_t td = model_tag(d);
+    const Dart d3 = D == 3 ? m.beta(d, D) : null_dart;
+    const std::uint64_t t3 = d3 ? model_tag(d3) : 0;
+    new_tags = [this, d, d3, td, t3](Dart x) {
+      if (!d3) return std::vector<std::uint64_t>{td};
+      const bool near = m.template same_cell<D>(x, d), far = m.template same_cell<D>(x, d3);
+      if (near && far) return std::vector<std::uint64_t>{td, t3};  // a volume sewn to itself
+      return std::vector<std::uint64_t>{near ? td : t3};
+    };
+    new_count = d3 ? 2 * count : count;
+  }
+  // Faces inserted along path: the new darts β2(path[i]) (and, for a face in a volume, its β3
+  // partner) copy path[i]. Called after the insertion, which is what makes β2(path[i]) new.
+  void expect_path_copies(const std::vector<Dart>& path, int per_dart) {
+    std::vector<std::pair<std::uint32_t, std::uint64_t>> want;
+    for (Dart d : path) {
+      const Dart p = m.beta(d, 2);
+      want.emplace_back(p.index(), model_tag(d));
+      if (per_dart == 2) want.emplace_back(m.beta(p, 3).index(), model_tag(d));
+    }
+    new_tags = [want](Dart x) {
+      for (const auto& w : want)
+        if (w.first == x.index()) return std::vector<std::uint64_t>{w.second};
+      return std::vector<std::uint64_t>{};  // not a dart the rule makes
+    };
+    new_count = static_cast<std::int64_t>(want.size());
+  }
+  // Checks every live dart against the model, then gives the new darts fresh tags and forgets
+  // the erased ones.
+  void check_tags() {
+    tag_model.resize(m.dart_capacity(), 0);
+    std::int64_t made = 0;
+    for (std::uint32_t x = 0; x < tag_model.size(); ++x)
+      if (!m.is_alive(Dart(x))) tag_model[x] = 0;
+    for (Dart x : m.darts()) {
+      const std::uint64_t have = m.info(x);
+      if (const std::uint64_t want = tag_model[x.index()]; want != 0) {
+        INFO("dart ", x.index());
+        CHECK(have == want);
+        continue;
+      }
+      ++made;
+      const std::vector<std::uint64_t> allowed = new_tags ? new_tags(x) : std::vector<std::uint64_t>{0};
+      INFO("new dart ", x.index(), " holds tag ", have);
+      CHECK(std::find(allowed.begin(), allowed.end(), have) != allowed.end());
+    }
+    if (new_count >= 0) CHECK(made == new_count);
+    for (Dart x : m.darts())
+      if (tag_model[x.index()] == 0) m.info(x) = tag_model[x.index()] = next_tag++;
+    ++tag_checks;
+    new_tags = nullptr;
+    new_count = 0;  // an operation that makes darts says so
+  }
+
   void install() {
     auto done = [this](Expect e) {
       applied = true;
@@ -162,7 +237,12 @@ struct Driver {
     };
     ops.push_back({"insert_vertex_in_edge", [=, this] {
                      if (m.num_darts() > max_darts) return skip();
-                     m.insert_vertex_in_edge(random_dart());
+                     const Dart d = random_dart();
+                     const auto edge = m.template cell<1>(d);
+                     m.insert_vertex_in_edge(d);
+                     // each new dart follows the dart it was split from in its face
+                     new_tags = [this](Dart x) { return std::vector<std::uint64_t>{model_tag(m.beta(x, 0))}; };
+                     new_count = static_cast<std::int64_t>(edge.size());
                      return done(Expect::keep);
                    }});
     ops.push_back({"insert_edge_in_face", [=, this] {
@@ -170,6 +250,7 @@ struct Driver {
                      const Dart a = random_dart();
                      const auto cyc = face_cycle(a);
                      if (cyc.size() < 2) return skip();
+                     expect_face_copies(a, 2);
                      m.insert_edge_in_face(a, cyc[1 + uniform(static_cast<std::uint32_t>(cyc.size() - 1))]);
                      return done(Expect::keep);
                    }});
@@ -177,6 +258,7 @@ struct Driver {
                      if (m.num_darts() > max_darts) return skip();
                      const Dart d = random_dart();
                      if (!m.is_insertable_vertex_in_face(d)) return skip();
+                     expect_face_copies(d, 2 * static_cast<std::int64_t>(face_cycle(d).size()));
                      m.insert_vertex_in_face(d);
                      return done(Expect::keep);
                    }});
@@ -184,6 +266,7 @@ struct Driver {
                      if (m.num_darts() > max_darts) return skip();
                      const Dart d = random_dart();
                      if (!m.is_insertable_dangling_edge_in_face(d)) return skip();
+                     expect_face_copies(d, 2);
                      m.insert_dangling_edge_in_face(d);
                      return done(Expect::keep);
                    }});
@@ -255,6 +338,7 @@ struct Driver {
                      if constexpr (D == 2) m.make_polygon(3 + uniform(3));
                      else if (uniform(2) == 0) m.make_tetrahedron();
                      else m.make_hexahedron();
+                     expect_default_tags();
                      return done(Expect::add_component);
                    }});
     if constexpr (D == 3)
@@ -283,12 +367,16 @@ struct Driver {
                            }
                            FAIL("the ring left by removing a boundary face cannot be closed:", why);
                          }
+                         check_tags();  // the removal's erased slots may be reused next
                          m.insert_face_in_hole(ring);
+                         expect_path_copies(ring, 1);
                          return done(Expect::keep);
                        }
                        // the face was all that held a vertex, an edge or the volume together
                        // (a pinch): the map split it, and the hole has several rings, each closed
                        // by a face of its own
+                       check_tags();
+                       std::vector<Dart> closed;
                        for (Dart r : ring) {
                          if (!m.is_free(r, 2)) continue;
                          std::vector<Dart> sub;
@@ -301,7 +389,9 @@ struct Driver {
                          } while (x != r && sub.size() <= ring.size());
                          if (!m.is_insertable_face_in_hole(sub)) FAIL("a ring of a pinched hole cannot be closed");
                          m.insert_face_in_hole(sub);
+                         closed.insert(closed.end(), sub.begin(), sub.end());
                        }
+                       expect_path_copies(closed, 1);
                        return done(Expect::any);
                      }});
     if constexpr (D == 3)
@@ -310,6 +400,7 @@ struct Driver {
                        const auto cyc = face_cycle(random_dart());
                        if (!m.is_insertable_face_in_volume(cyc)) return skip();
                        m.insert_face_in_volume(cyc);
+                       expect_path_copies(cyc, 2);
                        return done(Expect::keep);
                      }});
   }
@@ -322,6 +413,7 @@ struct Driver {
     INFO("seed ", seed, ", step ", step, ", after ", what);
     const auto report = m.validate();
     REQUIRE_MESSAGE(report.ok(), report.str());
+    check_tags();
     last = topology(m, {{}, false});
     const Topology& t = last;
     const B& b = t.total.betti;
@@ -366,11 +458,15 @@ struct Driver {
       if (m.num_darts() == 0) {
         if constexpr (D == 2) build(m, quad_grid(2 + uniform(2), 2));
         else build(m, hex_grid(2, 1 + uniform(2), 1));
+        expect_default_tags();
+        check_tags();
         last = topology(m, {{}, false});
       }
       const B before = last.total.betti;
       cells_before = last.total.cells;
       Op& op = ops[uniform(static_cast<std::uint32_t>(ops.size()))];
+      new_tags = nullptr;
+      new_count = 0;
       const Expect e = op.run();
       if (!applied) continue;
       ++ops_applied;
@@ -382,31 +478,35 @@ struct Driver {
 }  // namespace
 
 TEST_CASE("random operation sequences keep the invariants they must (2-maps)") {
-  std::int64_t total = 0, kept = 0, pinched = 0;
+  std::int64_t total = 0, kept = 0, pinched = 0, tag_checks = 0;
   for (unsigned seed : {11u, 12u, 13u, 14u, 15u}) {
     Driver<2> d(seed, 200);
     d.run(seed, 18500);
     total += d.ops_applied;
+    tag_checks += d.tag_checks;
     kept += d.kept;
     pinched += d.pinched;
   }
   MESSAGE("2-map operations applied: ", total, ", of which ", kept, " had to keep every Betti number; ", pinched,
           " removals or contractions pinched");
   CHECK(total >= 50000);
+  CHECK(tag_checks >= total);  // the per-dart tags were checked after every operation
   CHECK(kept >= total / 4);
 }
 
 TEST_CASE("random operation sequences keep the invariants they must (3-maps)") {
-  std::int64_t total = 0, kept = 0, pinched = 0;
+  std::int64_t total = 0, kept = 0, pinched = 0, tag_checks = 0;
   for (unsigned seed : {21u, 22u, 23u, 24u, 25u}) {
     Driver<3> d(seed, 300);
     d.run(seed, 23000);
     total += d.ops_applied;
+    tag_checks += d.tag_checks;
     kept += d.kept;
     pinched += d.pinched;
   }
   MESSAGE("3-map operations applied: ", total, ", of which ", kept, " had to keep every Betti number; ", pinched,
           " removals or contractions pinched");
   CHECK(total >= 50000);
+  CHECK(tag_checks >= total);  // the per-dart tags were checked after every operation
   CHECK(kept >= total / 4);
 }

@@ -8,7 +8,7 @@
 // the orbit of its darts under every β except βi (for i = 0: the compositions βj∘βk, j≠k).
 //
 // Storage: darts are 32-bit indices; β0..βD are stored packed per dart; removed darts go on a
-// free list. For each dimension I whose attribute type A_I is not void, every dart also stores
+// free list. With DartInfo<T> as first type parameter, every dart also holds a T (see info()). For each dimension I whose attribute type A_I is not void, every dart also stores
 // the index of its I-cell's attribute (null if the cell has none), and the values live in one
 // AttributeContainer<A_I> (contiguous, iterable without darts). A void attribute costs nothing.
 //
@@ -57,6 +57,16 @@ namespace sewn {
 /// Darts of an orbit or cell, in breadth-first order from the dart asked for (which comes first).
 using DartList = boost::container::small_vector<Dart, 32>;
 
+/// CMap<D, DartInfo<T>, A0, A1, ...> gives every dart a value of type T (CGAL's Dart_info), read
+/// and written with info(d). Without it a map stores nothing per dart beyond its links and
+/// attribute indices. T must be default-constructible and copyable.
+template <class T>
+struct DartInfo {
+  static_assert(!std::is_void_v<T> && std::is_default_constructible_v<T> && std::is_copy_assignable_v<T>,
+                "DartInfo<T>: T must be a default-constructible, copyable type");
+  using type = T;
+};
+
 namespace detail {
 
 template <int I, class... A>
@@ -90,6 +100,34 @@ struct StoreTuple<std::integer_sequence<int, I...>, A...> {
   using type = std::tuple<AttrStore<I, typename nth_or_void<I, A...>::type>...>;
 };
 
+// CMap's type parameters: an optional DartInfo<T> first, then the cell attribute types.
+template <class T>
+struct is_dart_info : std::false_type {};
+template <class T>
+struct is_dart_info<DartInfo<T>> : std::true_type {};
+template <class... A>
+struct MapParams {
+  using info = void;
+  template <int I>
+  using attr = typename nth_or_void<I, A...>::type;
+  template <class Seq>
+  using stores = typename StoreTuple<Seq, A...>::type;
+  static constexpr std::size_t num_attrs = sizeof...(A);
+  static constexpr bool info_only_first = (!is_dart_info<A>::value && ...);
+};
+template <class T, class... A>
+struct MapParams<DartInfo<T>, A...> : MapParams<A...> {
+  using info = T;
+};
+
+// The per-dart values of a map with DartInfo<T>; nothing at all without.
+template <class T>
+struct InfoStore {
+  std::conditional_t<std::is_trivially_copyable_v<T>, PodArray<T>, std::vector<T>> of_dart;
+};
+template <>
+struct InfoStore<void> {};
+
 inline constexpr std::uint32_t null_index = Dart::null_index;
 inline constexpr std::uint32_t dead_marker = Dart::null_index - 1;  // β0 of a free-listed dart
 
@@ -116,14 +154,19 @@ struct CellTemplate {
 
 template <int D, class... Attrs>
 class CMap {
+  using Params = detail::MapParams<Attrs...>;
   static_assert(D >= 1 && D <= 8, "CMap dimension must be in 1..8");
-  static_assert(sizeof...(Attrs) <= D + 1, "at most D+1 attribute types (one per dimension 0..D)");
+  static_assert(Params::num_attrs <= D + 1, "at most D+1 attribute types (one per dimension 0..D)");
+  static_assert(Params::info_only_first, "DartInfo<T> may only be CMap's first type after D");
 
  public:
   static constexpr int dimension = D;
   /// The attribute type of I-cells (void when disabled).
   template <int I>
-  using attribute_type = typename detail::nth_or_void<I, Attrs...>::type;
+  using attribute_type = typename Params::template attr<I>;
+  /// The per-dart value type (void without DartInfo<T>).
+  using dart_info_type = typename Params::info;
+  static constexpr bool has_dart_info = !std::is_void_v<dart_info_type>;
   template <int I>
   static constexpr bool has_attribute = (I >= 0 && I <= D) && !std::is_void_v<attribute_type<I>>;
 
@@ -274,6 +317,41 @@ class CMap {
   void set_hooks_enabled(bool on) { hooks_on_ = on; }
   [[nodiscard]] bool hooks_enabled() const { return hooks_on_; }
 
+  // ---------------------------------------------------------------- per-dart data
+  /// The info of dart d (maps declared with DartInfo<T> only). Throws TopologyError if d is not
+  /// a live dart. O(1).
+  ///
+  /// Every operation keeps it, so no table indexed by dart needs clearing by hand:
+  ///   - sew, unsew, link, unlink and the attribute hooks leave each dart's info alone;
+  ///   - erasing a dart (erase_dart, remove_cell, contract_cell) drops its info: a dart made
+  ///     later in the same slot starts from T{}, never from the erased dart's value;
+  ///   - create_dart, make_polygon/polyline/cell and the other builders give new darts T{};
+  ///   - compact() moves each info with its dart; copying the map copies them;
+  ///   - an insertion gives each dart it makes a copy of the info of one argument dart:
+  ///       insert_vertex_in_edge(d): each new dart copies the dart it was split from (the one
+  ///         before it in its face);
+  ///       insert_edge_in_face(a, b): both new darts copy a (in a βj-sewn copy of the face,
+  ///         a's βj image);
+  ///       insert_vertex_in_face(d), insert_dangling_edge_in_face(d): every new dart copies d
+  ///         (on the other side of a 3-sewn face, β3(d));
+  ///       insert_face_in_volume(path), insert_face_in_hole(path): the new darts along the edge
+  ///         of path[i] copy path[i].
+  /// CGAL's insertions give their new darts a default-constructed info instead; the copy is what
+  /// a tag such as "which input face or material this dart came from" needs.
+  template <class T = dart_info_type>
+    requires(!std::is_void_v<T>)
+  T& info(Dart d) {
+    check_alive(d, "info");
+    return info_.of_dart[d.index()];
+  }
+  /// Read-only info of dart d; same checks. O(1).
+  template <class T = dart_info_type>
+    requires(!std::is_void_v<T>)
+  const T& info(Dart d) const {
+    check_alive(d, "info");
+    return info_.of_dart[d.index()];
+  }
+
   // ---------------------------------------------------------------- traversal
   /// Darts reachable from d through the listed β indices (1 also follows β0). O(orbit).
   template <int... B>
@@ -411,6 +489,10 @@ class CMap {
   Dart insert_edge_in_face(Dart a, Dart b);
   /// True if path is a closed chain of darts of one volume (end of each = start of the next),
   /// with distinct edges, along which a face may be inserted (D ≥ 3; 4..D-free darts).
+  /// Stricter than CGAL's is_insertable_cell_2_in_cell_3, which takes any closed path of one
+  /// volume and, when its darts are 2-free, closes the hole with a one-sided face instead of
+  /// inserting a two-sided one. Here one operation makes one shape: the two-sided face always
+  /// (distinct edges, so each edge gets one new pair), and insert_face_in_hole for the hole.
   [[nodiscard]] bool is_insertable_face_in_volume(std::span<const Dart> path) const;
   /// Inserts a face along the closed dart path inside a volume (two β3-linked polygons). Returns
   /// the new dart β2(path[0]). If the volume falls in two, the part holding path[0] keeps its
@@ -453,6 +535,9 @@ class CMap {
   /// True if the I-cell of d can be removed: I ≥ D-1, or it is incident to at most two
   /// (I+1)-cells (β_{I+1}∘β_{I+2} is an involution on its darts); and removing it does not fold
   /// a cell onto itself (a dart would become its own βi partner). O(cell).
+  /// Stricter than CGAL: CGAL's is_removable checks only the degree and then removes, e.g., the
+  /// only edge between a face and itself, leaving a βi with a fixed point that its own
+  /// is_valid() rejects. Refusing such a cell here keeps every operation's result valid().
   template <int I>
   [[nodiscard]] bool is_removable(Dart d) const;
   /// Removes the I-cell of d, merging the (I+1)-cells around it (on_merge keeps the attribute
@@ -461,6 +546,8 @@ class CMap {
   void remove_cell(Dart d);
   /// True if the I-cell of d can be contracted: I = 1, or (I ≥ 2) it has at most two (I-1)-cells;
   /// and contracting it does not fold a cell onto itself. O(cell).
+  /// Stricter than CGAL for the reason given at is_removable: CGAL's is_contractible checks only
+  /// the number of (I-1)-cells and can leave a βi fixed point; the fold check refuses that case.
   template <int I>
   [[nodiscard]] bool is_contractible(Dart d) const;
   /// Contracts the I-cell of d into an (I-1)-cell (I = 1: the edge's two vertices merge).
@@ -487,7 +574,7 @@ class CMap {
   }
 
  private:
-  using Stores = typename detail::StoreTuple<std::make_integer_sequence<int, D + 1>, Attrs...>::type;
+  using Stores = typename Params::template stores<std::make_integer_sequence<int, D + 1>>;
 
   template <int I>
   auto& store() {
@@ -661,6 +748,10 @@ class CMap {
 
   // Gives `to` the attributes of `from` for every dimension whose bit is set in dims.
   void inherit_attributes(std::uint32_t from, std::uint32_t to, unsigned dims);
+  // Gives the new dart `to` a copy of the info of `from` (the insertion rule above).
+  void copy_info(std::uint32_t from, std::uint32_t to) {
+    if constexpr (has_dart_info) info_.of_dart[to] = info_.of_dart[from];
+  }
 
   // Cell removal and contraction share one relinking engine (see ops header): βi(w) becomes
   // `target`, replacing the links of the erased dart `from`.
@@ -683,6 +774,7 @@ class CMap {
   std::uint32_t free_head_ = detail::null_index;  // free list threaded through β1 of dead darts
   std::uint32_t alive_ = 0;
   Stores stores_;
+  [[no_unique_address]] detail::InfoStore<dart_info_type> info_;
   mutable detail::MarkPlanes marks_;
   bool hooks_on_ = true;
   friend struct detail::LinkSoundness;

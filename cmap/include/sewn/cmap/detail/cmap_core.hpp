@@ -39,6 +39,7 @@ std::uint32_t CMap<D, A...>::new_dart() {
     for_each_dim([&](auto k) {
       if constexpr (has_attribute<k()>) store<k()>().of_dart.push_back(detail::null_index);
     });
+    if constexpr (has_dart_info) info_.of_dart.push_back(dart_info_type{});
     if ((x & 63u) == 0) marks_.resize(x + 64);
   }
   ++alive_;
@@ -59,6 +60,7 @@ void CMap<D, A...>::new_darts(std::uint32_t k, Out& out) {
   for_each_dim([&](auto kk) {
     if constexpr (has_attribute<kk()>) store<kk()>().of_dart.resize(x0 + k, detail::null_index);
   });
+  if constexpr (has_dart_info) info_.of_dart.resize(x0 + k, dart_info_type{});
   if ((x0 + 63) / 64 != (x0 + k + 63) / 64) marks_.resize(x0 + k);
   alive_ += k;
   for (std::uint32_t i = 0; i < k; ++i) out.push_back(x0 + i);
@@ -92,6 +94,9 @@ void CMap<D, A...>::erase_dart_raw(std::uint32_t x) {
     bits &= bits - 1;
     marks_.clear(x, Mark(m));
   }
+  // Dropped now, so a dart made later in this slot starts from a default value (and a value
+  // holding memory frees it).
+  if constexpr (has_dart_info) info_.of_dart[x] = dart_info_type{};
   beta_[x].fill(detail::null_index);
   beta_[x][0] = detail::dead_marker;
   beta_[x][1] = free_head_;
@@ -191,6 +196,7 @@ void CMap<D, A...>::reserve(std::uint32_t n) {
   for_each_dim([&](auto k) {
     if constexpr (has_attribute<k()>) store<k()>().of_dart.reserve(n);
   });
+  if constexpr (has_dart_info) info_.of_dart.reserve(n);
 }
 
 template <int D, class... A>
@@ -205,6 +211,7 @@ void CMap<D, A...>::clear() {
       store<k()>().values.clear();
     }
   });
+  if constexpr (has_dart_info) info_.of_dart.clear();
   marks_.clear_storage();
   pending_erase_.clear();
   links_sound_ = true;  // no links left
@@ -229,9 +236,15 @@ std::vector<Dart> CMap<D, A...>::compact() {
     for_each_dim([&](auto k) {
       if constexpr (has_attribute<k()>) store<k()>().of_dart[nx] = store<k()>().of_dart[x];
     });
+    if constexpr (has_dart_info)
+      if (nx != x) info_.of_dart[nx] = std::move(info_.of_dart[x]);
   }
   beta_.resize(next);
   beta_.shrink_to_fit();
+  if constexpr (has_dart_info) {
+    info_.of_dart.resize(next);
+    info_.of_dart.shrink_to_fit();
+  }
   for_each_dim([&](auto k) {
     constexpr int K = k();
     if constexpr (has_attribute<K>) {
@@ -256,6 +269,7 @@ std::size_t CMap<D, A...>::memory_bytes() const {
     if constexpr (has_attribute<k()>)
       bytes += store<k()>().of_dart.capacity() * sizeof(std::uint32_t) + store<k()>().values.bytes();
   });
+  if constexpr (has_dart_info) bytes += info_.of_dart.capacity() * sizeof(dart_info_type);
   return bytes;
 }
 

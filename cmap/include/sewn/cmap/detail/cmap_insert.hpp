@@ -16,6 +16,7 @@ Dart CMap<D, A...>::split_edge(Dart d, detail::DartBuffer<32>& made) {
   for (std::size_t i = 0; i < edge.size(); ++i) {
     const std::uint32_t x = edge[i], nx = made[i], next = b(x, 1);
     inherit_attributes(x, nx, ~1u);  // same edge (for now), face, volume...; a new vertex
+    copy_info(x, nx);
     raw_link(nx, 1, next);
     raw_link(x, 1, nx);
   }
@@ -107,6 +108,8 @@ Dart CMap<D, A...>::insert_edge_in_face(Dart a, Dart b2) {
     inherit_attributes(c.c1, c.n1, ~2u);  // n1 starts at c1's vertex; the new edge has no attribute
     inherit_attributes(c.c1, c.n2, ~3u);
     inherit_attributes(c.c2, c.n2, 1u);
+    copy_info(c.a, c.n1);
+    copy_info(c.a, c.n2);
     raw_link(p1, 1, c.n1);
     raw_link(c.n1, 1, c.c2);
     raw_link(p2, 1, c.n2);
@@ -179,6 +182,8 @@ Dart CMap<D, A...>::insert_face_in_volume(std::span<const Dart> path) {
     inherit_attributes(path[i].index(), q[i], ~5u);
     inherit_attributes(path[i].index(), q[i], 1u);
     inherit_attributes(path[(i + 1) % k].index(), p[i], 1u);
+    copy_info(path[i].index(), p[i]);
+    copy_info(path[i].index(), q[i]);
   }
   for (std::size_t i = 0; i < k; ++i) {
     raw_link(p[i], 1, p[(i + k - 1) % k]);
@@ -198,16 +203,29 @@ template <int D, class... A>
 bool CMap<D, A...>::is_insertable_face_in_hole(std::span<const Dart> path) const {
   if constexpr (D < 3) return false;
   if (path.empty()) return false;
-  for (Dart d : path) {
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    const Dart d = path[k];
     if (!is_alive(d) || b(d.index(), 2) != detail::null_index) return false;
     for (int j = 4; j <= D; ++j)
       if (b(d.index(), j) != detail::null_index) return false;
+    for (std::size_t l = 0; l < k; ++l)
+      if (path[l] == d) return false;
   }
+  // Usual case, without walking the volume: each next dart is the first 2-free dart met turning
+  // around the vertex where the previous one ends, inside its volume (β1 then β2∘β1 steps stay
+  // at that vertex and in that volume), so all share one volume and the chain closes.
+  const std::uint32_t cap = dart_capacity();
+  bool chained = true;
+  for (std::size_t k = 0; chained && k < path.size(); ++k) {
+    std::uint32_t y = b(path[k].index(), 1);
+    for (std::uint32_t steps = 0; y != detail::null_index && b(y, 2) != detail::null_index && steps <= cap; ++steps)
+      y = b(b(y, 2), 1);
+    chained = y == path[(k + 1) % path.size()].index();
+  }
+  if (chained) return true;
   const DartList vol = cell<3>(path[0]);
   for (std::size_t k = 0; k < path.size(); ++k) {
     if (std::find(vol.begin(), vol.end(), path[k]) == vol.end()) return false;
-    if (std::find(path.begin(), path.begin() + static_cast<std::ptrdiff_t>(k), path[k]) != path.begin() + static_cast<std::ptrdiff_t>(k))
-      return false;
     const std::uint32_t end = b(path[k].index(), 1);
     if (end == detail::null_index || !same_cell<0>(Dart(end), path[(k + 1) % path.size()])) return false;
   }
@@ -229,6 +247,7 @@ Dart CMap<D, A...>::insert_face_in_hole(std::span<const Dart> path) {
     p[i] = new_dart();
     inherit_attributes(path[i].index(), p[i], ~5u);
     inherit_attributes(path[(i + 1) % k].index(), p[i], 1u);
+    copy_info(path[i].index(), p[i]);
   }
   for (std::size_t i = 0; i < k; ++i) {
     raw_link(p[i], 1, p[(i + k - 1) % k]);
@@ -260,6 +279,8 @@ Dart CMap<D, A...>::insert_vertex_in_face(Dart d) {
   // 2) an edge from c0's start to c1's start (beside c0), split by the new vertex v
   const Dart h = insert_edge_in_face(c[0], c[1]);  // c0's start -> c1's start, in c1's face
   const Dart w = insert_vertex_in_edge(h);         // v -> c1's start
+  //    (per-dart info: each insertion copies its first argument's, which is d's or, for the
+  //    darts the split made, h's, itself a copy of d's; so every new dart copies d, as stated)
   // 3) an edge from v to each remaining vertex; each returned dart starts at v and lies in the
   //    face that holds the next vertex
   Dart a = w;
@@ -288,6 +309,8 @@ Dart CMap<D, A...>::insert_dangling_edge_in_face(Dart d) {
   inherit_attributes(x, a, ~3u);
   inherit_attributes(x, a, 1u);
   inherit_attributes(x, bb, ~3u);
+  copy_info(x, a);
+  copy_info(x, bb);
   raw_link(p, 1, a);
   raw_link(a, 1, bb);
   raw_link(bb, 1, x);
@@ -299,6 +322,8 @@ Dart CMap<D, A...>::insert_dangling_edge_in_face(Dart d) {
       inherit_attributes(x3, a3, ~3u);
       inherit_attributes(x, a3, 1u);
       inherit_attributes(x3, b3, ~3u);
+      copy_info(x3, a3);
+      copy_info(x3, b3);
       raw_link(x3, 1, a3);
       raw_link(a3, 1, b3);
       raw_link(b3, 1, n3);
