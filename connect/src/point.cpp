@@ -1,5 +1,6 @@
 #include "sewn/connect/point.hpp"
 
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -22,9 +23,18 @@ using AD2 = Eigen::AutoDiffScalar<Eigen::Matrix<AD, max_dofs, 1>>;  // second or
 template <class T>
 using V3 = Eigen::Matrix<T, 3, 1>;
 
+// The chained Hessian's scalars: a side's frame in ≤ 9 directions, the core in 12.
+constexpr int side_dofs_max = 9;
+using S1 = Eigen::AutoDiffScalar<Eigen::Matrix<double, side_dofs_max, 1>>;
+using S2 = Eigen::AutoDiffScalar<Eigen::Matrix<S1, side_dofs_max, 1>>;
+using C1 = Eigen::AutoDiffScalar<Eigen::Matrix<double, 12, 1>>;
+using C2 = Eigen::AutoDiffScalar<Eigen::Matrix<C1, 12, 1>>;
+
 double value_of(double v) { return v; }
-double value_of(const AD& v) { return v.value(); }
-double value_of(const AD2& v) { return v.value().value(); }
+template <class D>
+double value_of(const Eigen::AutoDiffScalar<D>& v) {
+  return value_of(v.value());
+}
 
 [[noreturn]] void fail(const std::string& name, const std::string& why) {
   throw InputError("point connection '" + name + "': " + why);
@@ -103,6 +113,32 @@ Frame<T> build_frame(const Side& side, const Q& q, double sign, const std::array
   }
   f.m2 = f.m3.cross(f.m1);
   return f;
+}
+
+// A side's frame (m1, m3) as 6 values with their Jacobian and second derivatives over the
+// side's DOFs (the first 7 or 9 columns are used).
+struct SideJet {
+  Eigen::Matrix<double, 6, 1> value;
+  Eigen::Matrix<double, 6, side_dofs_max> jacobian;
+  std::array<Eigen::Matrix<double, side_dofs_max, side_dofs_max>, 6> hessian;
+};
+
+SideJet side_jet(const Side& side, const Eigen::VectorXd& qs, double sign, const std::array<double, 2>& coef) {
+  Eigen::Matrix<S2, side_dofs_max, 1> qa;
+  for (int i = 0; i < side_dofs_max; ++i) {
+    qa[i].value() = S1(i < qs.size() ? qs[i] : 0.0, side_dofs_max, i);
+    qa[i].derivatives() = Eigen::Matrix<S1, side_dofs_max, 1>::Constant(S1(0.0));
+    qa[i].derivatives()[i] = S1(1.0);
+  }
+  const Frame<S2> f = build_frame<S2>(side, qa, sign, coef);
+  SideJet jet;
+  for (int k = 0; k < 6; ++k) {
+    const S2& v = k < 3 ? f.m1[k] : f.m3[k - 3];
+    jet.value[k] = v.value().value();
+    jet.jacobian.row(k) = v.value().derivatives().transpose();
+    for (int j = 0; j < side_dofs_max; ++j) jet.hessian[static_cast<std::size_t>(k)].row(j) = v.derivatives()[j].derivatives().transpose();
+  }
+  return jet;
 }
 
 template <class T>
@@ -207,20 +243,19 @@ PointConnection::PointConnection(std::string name, Side m, Side n, PointStiffnes
   accepted_twist_ = rest_twist_;
 }
 
-PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update, bool want_gradient,
-                                    Eigen::MatrixXd* hessian) const {
+PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update, bool want_gradient, Eigen::MatrixXd* hessian,
+                                    HessianMethod method) const {
   if (q.size() != num_dofs())
     fail(name_, "configuration has " + std::to_string(q.size()) + " entries, the stencil " + std::to_string(num_dofs()));
   if (!q.allFinite()) fail(name_, "configuration is not finite");
   PointEval out;
-  auto run = [&](const auto& qt) {
-    using T = typename std::decay_t<decltype(qt)>::Scalar;
+  // Frames → energy and angles (everything after the frame constructions).
+  auto core = [&](const auto& fm, const auto& fn) {
+    using T = std::decay_t<decltype(fm.m1[0])>;
     using std::atan2;
     using std::cos;
     using std::sin;
     using std::sqrt;
-    const auto fm = build_frame<T>(m_, qt.head(dofs_m_), sign_m_, coef_m_);
-    const auto fn = build_frame<T>(n_, qt.segment(dofs_m_, dofs_n_), sign_n_, coef_n_);
     Core<T> c;
     c.one_plus_c = 1 + value_of(fm.m3.dot(fn.m3));
     const T raw = signed_angle_t<T>(transport_exact<T>(fm.m3, fn.m3, fm.m1), fn.m1, fn.m3);
@@ -241,7 +276,7 @@ PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update
       // ω < 1e-8: |d − d̄|² = 2 − 2cos ω = ω² + O(ω⁴), and smooth where sqrt(s2) is not.
       const V3<T> dd = d - db;
       eb = T(0.5 * k_.bend) * dd.dot(dd);
-      c.bend = value_of(sqrt(T(value_of(s2))));
+      c.bend = std::sqrt(value_of(s2));
     } else {
       const T w = atan2(sqrt(s2), d.dot(db));
       eb = T(0.5 * k_.bend) * w * w;
@@ -253,8 +288,47 @@ PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update
     c.twist_raw = value_of(raw);
     return c;
   };
+  auto run = [&](const auto& qt) {
+    using T = typename std::decay_t<decltype(qt)>::Scalar;
+    return core(build_frame<T>(m_, qt.head(dofs_m_), sign_m_, coef_m_),
+                build_frame<T>(n_, qt.segment(dofs_m_, dofs_n_), sign_n_, coef_n_));
+  };
   Core<double> c;
-  if (hessian) {
+  if (hessian && method == HessianMethod::chained) {
+    // E(q) = C(F_m(q_m), F_n(q_n)) with F = (m1, m3) per side: ∇²E = Jᵀ C_FF J + Σ_k C_F[k] ∇²F_k,
+    // J block-diagonal. Second-order AD of each side's frame (≤ 9 directions) and of the core
+    // (12 directions) instead of the whole stencil at once (18).
+    const SideJet jm = side_jet(m_, q.head(dofs_m_), sign_m_, coef_m_);
+    const SideJet jn = side_jet(n_, q.tail(dofs_n_), sign_n_, coef_n_);
+    Eigen::Matrix<C2, 12, 1> F;
+    for (int i = 0; i < 12; ++i) {
+      F[i].value() = C1((i < 6 ? jm : jn).value[i % 6], 12, i);
+      F[i].derivatives() = Eigen::Matrix<C1, 12, 1>::Constant(C1(0.0));
+      F[i].derivatives()[i] = C1(1.0);
+    }
+    Frame<C2> fm, fn;
+    fm.m1 = F.segment<3>(0);
+    fm.m3 = F.segment<3>(3);
+    fm.m2 = fm.m3.cross(fm.m1);
+    fn.m1 = F.segment<3>(6);
+    fn.m3 = F.segment<3>(9);
+    fn.m2 = fn.m3.cross(fn.m1);
+    const auto cc = core(fm, fn);
+    c = {value_of(cc.energy), cc.twist, cc.twist_raw, cc.bend, cc.one_plus_c};
+    const Eigen::Matrix<double, 12, 1> eF = cc.energy.value().derivatives();
+    Eigen::Matrix<double, 12, 12> eFF;
+    for (int j = 0; j < 12; ++j) eFF.row(j) = cc.energy.derivatives()[j].derivatives().transpose();
+    const Eigen::Index n = q.size(), dm = dofs_m_, dn = dofs_n_;
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(12, n);
+    J.topLeftCorner(6, dm) = jm.jacobian.leftCols(dm);
+    J.bottomRightCorner(6, dn) = jn.jacobian.leftCols(dn);
+    out.gradient = J.transpose() * eF;
+    *hessian = J.transpose() * eFF * J;
+    for (int k = 0; k < 6; ++k) {
+      hessian->topLeftCorner(dm, dm) += eF[k] * jm.hessian[static_cast<std::size_t>(k)].topLeftCorner(dm, dm);
+      hessian->bottomRightCorner(dn, dn) += eF[6 + k] * jn.hessian[static_cast<std::size_t>(k)].topLeftCorner(dn, dn);
+    }
+  } else if (hessian) {
     const Eigen::Index n = q.size();
     Eigen::Matrix<AD2, Eigen::Dynamic, 1> qa(n);
     for (Eigen::Index i = 0; i < n; ++i) {

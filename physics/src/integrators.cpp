@@ -77,6 +77,7 @@ void SymplecticEuler::reset() {
 
 StepReport SymplecticEuler::step(System& sys, double h) {
   check_step(h, "SymplecticEuler::step");
+  sys.require_no_angles("SymplecticEuler::step");
   StepReport rep;
   rep.pattern_rebuilt = sys.refresh();
   if (opt_.enforce_stable_step) {
@@ -150,6 +151,7 @@ void LinearlyImplicitEuler::reset() {
 
 StepReport LinearlyImplicitEuler::step(System& sys, double h) {
   check_step(h, "LinearlyImplicitEuler::step");
+  sys.require_no_angles("LinearlyImplicitEuler::step");
   if (!(opt_.cg_tolerance > 0 && std::isfinite(opt_.cg_tolerance)))
     throw InputError("LinearlyImplicitEuler::step: cg_tolerance must be finite and > 0, got " + detail::format_number(opt_.cg_tolerance));
   if (opt_.cg_max_iterations < 1)

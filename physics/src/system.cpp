@@ -66,9 +66,22 @@ ForceTerm& System::add_term(std::unique_ptr<ForceTerm> term) {
   return *terms_.back();
 }
 
+StateView System::state() const {
+  StateView s = nodes_.state();
+  s.angles = angles_.values();
+  s.angle_rates = angles_.rates();
+  return s;
+}
+
+void System::require_no_angles(const char* integrator) const {
+  if (!angles_.empty())
+    throw InputError(std::string(integrator) + ": the system has " + std::to_string(angles_.size()) +
+                     " angle DOFs (rods with integrated twist), which only the Newton integrator integrates");
+}
+
 bool System::refresh() {
   // Counters only increase, so their sum (plus the term count) changes iff one of them does.
-  std::uint64_t key = nodes_.topology_version() + terms_.size();
+  std::uint64_t key = nodes_.topology_version() + angles_.topology_version() + terms_.size();
   for (const auto& t : terms_) key += t->topology_version();
   if (key == seen_topology_) return false;
   for (const auto& t : terms_) t->check_nodes(nodes_);
@@ -78,10 +91,15 @@ bool System::refresh() {
 
 BlockMatrix& System::matrix() {
   refresh();
-  if (pattern_topology_ != seen_topology_ || matrix_.size() != nodes_.size()) {
+  const AngleLayout layout{nodes_.size()};
+  const Index blocks = nodes_.size() + AngleLayout::blocks_for(angles_.size());
+  if (pattern_topology_ != seen_topology_ || matrix_.size() != blocks) {
     std::vector<NodePair> pairs;
-    for (const auto& t : terms_) t->collect_pairs(pairs);
-    matrix_.build_pattern(nodes_.size(), pairs);
+    for (const auto& t : terms_) {
+      t->set_angle_layout(layout);
+      t->collect_pairs(pairs);
+    }
+    matrix_.build_pattern(blocks, pairs);
     for (const auto& t : terms_) t->bind_pattern(matrix_);
     pattern_topology_ = seen_topology_;
   }
@@ -95,7 +113,7 @@ void System::compute_forces() {
     std::fill(f.begin(), f.end(), 0.0);
     return;
   }
-  const StateView s = nodes_.state();
+  const StateView s = state();
   terms_.front()->set_forces(s, f);
   for (std::size_t t = 1; t < terms_.size(); ++t) terms_[t]->add_forces(s, f);
 }
@@ -106,7 +124,8 @@ void System::add_forces(const StateView& s, std::span<double> f) const {
 
 void System::add_jacobians(const JacobianRequest& req) {
   (void)matrix();  // the pattern the terms assemble into
-  for (const auto& t : terms_) t->add_jacobians(nodes_.state(), req);
+  const StateView s = state();
+  for (const auto& t : terms_) t->add_jacobians(s, req);
 }
 
 double System::kinetic_energy() const {
@@ -114,19 +133,24 @@ double System::kinetic_energy() const {
   const auto m = nodes_.masses();
   double e = 0;
   for (std::size_t i = 0; i < m.size(); ++i) e += 0.5 * m[i] * (v[3 * i] * v[3 * i] + v[3 * i + 1] * v[3 * i + 1] + v[3 * i + 2] * v[3 * i + 2]);
+  const auto w = angles_.rates();
+  const auto J = angles_.inertias();
+  for (std::size_t a = 0; a < w.size(); ++a) e += 0.5 * J[a] * w[a] * w[a];
   return e;
 }
 
 double System::potential_energy() const {
   double e = 0;
-  for (const auto& t : terms_) e += t->potential_energy(nodes_.state());
+  const StateView s = state();
+  for (const auto& t : terms_) e += t->potential_energy(s);
   return e;
 }
 
 double System::potential_energy(EnergyKind kind) const {
   double e = 0;
+  const StateView s = state();
   for (const auto& t : terms_)
-    if (t->energy_kind() == kind) e += t->potential_energy(nodes_.state());
+    if (t->energy_kind() == kind) e += t->potential_energy(s);
   return e;
 }
 
@@ -139,7 +163,8 @@ double System::energy_scale() const {
 StableStep System::stable_step() {
   refresh();
   StabilityRows rows(nodes_.masses(), nodes_.fixed_masks());
-  for (const auto& t : terms_) t->add_stability_rows(nodes_.state(), rows);
+  const StateView s = state();
+  for (const auto& t : terms_) t->add_stability_rows(s, rows);
   const auto k = rows.bound(StabilityRows::stiffness);
   const auto c = rows.bound(StabilityRows::damping);
   StableStep out;
@@ -165,13 +190,13 @@ std::vector<Index> System::compact_nodes() {
 }
 
 std::uint64_t System::version() const {
-  std::uint64_t key = nodes_.topology_version() + nodes_.parameter_version() + terms_.size();
+  std::uint64_t key = nodes_.topology_version() + nodes_.parameter_version() + angles_.topology_version() + terms_.size();
   for (const auto& t : terms_) key += t->topology_version() + t->parameter_version();
   return key;
 }
 
 void System::step_accepted() {
-  const StateView s = nodes_.state();
+  const StateView s = state();
   for (const auto& t : terms_) t->step_accepted(s);
 }
 

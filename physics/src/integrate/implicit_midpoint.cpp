@@ -70,6 +70,7 @@ StepReport ImplicitMidpoint::step(System& sys, double h) {
   if (!(opt_.newton_tolerance > 0 && opt_.cg_tolerance > 0 && opt_.max_newton_iterations >= 1 && opt_.cg_max_iterations >= 1))
     throw InputError("ImplicitMidpoint::step: tolerances must be > 0 and iteration limits >= 1");
   detail::require_symmetric_jacobians(sys, opt_.jacobian, "ImplicitMidpoint::step");
+  sys.require_no_angles("ImplicitMidpoint::step");
   StepReport rep;
   rep.pattern_rebuilt = sys.refresh();
   NodeTable& nodes = sys.nodes();

@@ -21,17 +21,21 @@ NewtonEuler& NewtonEuler::operator=(NewtonEuler&&) noexcept = default;
 
 void NewtonEuler::prepare(System& sys, double h) {
   const NodeTable& nodes = sys.nodes();
-  const std::size_t n3 = 3 * std::size_t{nodes.size()};
+  const AngleTable& angles = sys.angles();
+  n3_ = 3 * std::size_t{nodes.size()};
+  const std::size_t na = angles.size();
+  // Angles follow the positions, padded to whole 3×3 blocks (AngleLayout); the padding is fixed.
+  const std::size_t total = n3_ + 3 * std::size_t{AngleLayout::blocks_for(angles.size())};
   for (auto* a : {&xn_, &vn_, &qhat_, &q_, &trial_, &inertia_, &free_, &g_, &f_, &f0_, &vel_, &p_, &rhs_})
-    a->resize(n3);
-  zeros_.assign(n3, 0.0);
-  precond_.resize(3 * n3);
-  ws_.resize(n3);
+    a->assign(total, 0.0);
+  zeros_.assign(total, 0.0);
+  precond_.resize(3 * total);
+  ws_.resize(total);
   h_ = h;
   const auto x = nodes.x(), v = nodes.v();
   const auto m = nodes.masses();
   const auto fixed = nodes.fixed_masks();
-  for (std::size_t k = 0; k < n3; ++k) {
+  for (std::size_t k = 0; k < n3_; ++k) {
     if (!std::isfinite(x[k]) || !std::isfinite(v[k])) {
       std::ostringstream s;
       s << "newton euler: the state is not finite at node " << k / 3 << " (" << (std::isfinite(x[k]) ? "velocity" : "position")
@@ -40,26 +44,43 @@ void NewtonEuler::prepare(System& sys, double h) {
     }
     xn_[k] = x[k];
     vn_[k] = v[k];
-    qhat_[k] = x[k] + h * v[k];
     inertia_[k] = m[k / 3];
     free_[k] = ((fixed[k / 3] >> (k % 3)) & 1) ? 0.0 : 1.0;
   }
+  for (std::size_t a = 0; a < na; ++a) {
+    const std::size_t k = n3_ + a;
+    xn_[k] = angles.values()[a];
+    vn_[k] = angles.rates()[a];
+    if (!std::isfinite(xn_[k]) || !std::isfinite(vn_[k]))
+      throw NewtonError("newton euler: angle " + std::to_string(a) + " or its rate is not finite before the step",
+                        NewtonError::non_finite, {});
+    inertia_[k] = angles.inertias()[a];
+    free_[k] = angles.fixed(static_cast<Index>(a)) ? 0.0 : 1.0;
+  }
+  for (std::size_t k = n3_ + na; k < total; ++k) inertia_[k] = 1.0;
+  for (std::size_t k = 0; k < total; ++k) qhat_[k] = xn_[k] + h * vn_[k];
   // Probe: do any forces depend on velocity? Compare F(x_n, 1) with F(x_n, 0).
   std::fill(vel_.begin(), vel_.end(), 0.0);
-  std::fill(f0_.begin(), f0_.end(), 0.0);
-  sys.add_forces({x, vel_, m}, f0_);
+  sys.add_forces(view(sys, xn_, vel_), f0_);
   std::fill(vel_.begin(), vel_.end(), 1.0);
-  std::fill(f_.begin(), f_.end(), 0.0);
-  sys.add_forces({x, vel_, m}, f_);
+  sys.add_forces(view(sys, xn_, vel_), f_);
   damped_ = false;
-  for (std::size_t k = 0; k < n3 && !damped_; ++k) damped_ = f_[k] != f0_[k];
+  for (std::size_t k = 0; k < total && !damped_; ++k) damped_ = f_[k] != f0_[k];
+}
+
+StateView NewtonEuler::view(const System& sys, std::span<const double> q, std::span<const double> vel) const {
+  const std::size_t na = sys.angles().size();
+  return {q.first(n3_), vel.first(n3_), sys.nodes().masses(), q.subspan(n3_, na), vel.subspan(n3_, na)};
+}
+
+std::string NewtonEuler::describe_dof(std::size_t k) const {
+  return k < n3_ ? "node " + std::to_string(k / 3) : "angle " + std::to_string(k - n3_);
 }
 
 double NewtonEuler::evaluate(const System& sys, std::span<const double> q, bool want_gradient) {
   const std::size_t n = dof_count();
-  const auto m = sys.nodes().masses();
   for (std::size_t k = 0; k < n; ++k) vel_[k] = free_[k] != 0.0 ? (q[k] - xn_[k]) / h_ : vn_[k];
-  const StateView s{q, vel_, m};
+  const StateView s = view(sys, q, vel_);
   double phi = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
     const double d = q[k] - qhat_[k];
@@ -73,7 +94,7 @@ double NewtonEuler::evaluate(const System& sys, std::span<const double> q, bool 
   if (damped_) {
     // D = -½ Δq·F_d with F_d = F(q, v) - F(q, 0).
     std::fill(f0_.begin(), f0_.end(), 0.0);
-    sys.add_forces({q, zeros_, m}, f0_);
+    sys.add_forces(view(sys, q, zeros_), f0_);
     double d = 0.0;
     for (std::size_t k = 0; k < n; ++k) d -= free_[k] * (q[k] - xn_[k]) * (f_[k] - f0_[k]);
     phi += 0.5 * d;
@@ -93,10 +114,10 @@ void NewtonEuler::assemble(System& sys) {
   req.options.project_element_hessians = true;
   req.options.clamp_compression = true;
   req.options.drop_viscous_position_terms = true;
-  const StateView s{q_, vel_, sys.nodes().masses()};
+  const StateView s = view(sys, q_, vel_);
   for (const auto& t : sys.terms()) t->add_jacobians(s, req);
   for (Index i = 0; i < A.size(); ++i)
-    A.block(A.diagonal(i)).diagonal().array() += inertia_[3 * std::size_t{i}] / (h_ * h_);
+    for (int c = 0; c < 3; ++c) A.block(A.diagonal(i))(c, c) += inertia_[3 * std::size_t{i} + static_cast<std::size_t>(c)] / (h_ * h_);
 }
 
 int NewtonEuler::solve_linear(const BlockMatrix& A) {
@@ -154,7 +175,7 @@ NewtonReport NewtonEuler::step(System& sys, double h) {
   };
   if (!std::isfinite(phi)) fail(NewtonError::non_finite, "the incremental potential is not finite at the predicted state");
   if (const auto k = first_non_finite(g_); k >= 0)
-    fail(NewtonError::non_finite, "the gradient is not finite at node " + std::to_string(k / 3));
+    fail(NewtonError::non_finite, "the gradient is not finite at " + describe_dof(static_cast<std::size_t>(k)));
 
   bool converged = false;
   while (!converged) {
@@ -205,19 +226,28 @@ NewtonReport NewtonEuler::step(System& sys, double h) {
     phi = evaluate(sys, q_, true);
     if (!std::isfinite(phi)) fail(NewtonError::non_finite, "the incremental potential became non-finite");
     if (const auto k = first_non_finite(g_); k >= 0)
-      fail(NewtonError::non_finite, "the gradient is not finite at node " + std::to_string(k / 3));
+      fail(NewtonError::non_finite, "the gradient is not finite at " + describe_dof(static_cast<std::size_t>(k)));
   }
   if (const auto k = first_non_finite(q_); k >= 0)
-    fail(NewtonError::non_finite, "the new position is not finite at node " + std::to_string(k / 3));
+    fail(NewtonError::non_finite, "the new state is not finite at " + describe_dof(static_cast<std::size_t>(k)));
   rep.phi_decrease = phi0 - phi;
   NodeTable& nodes = sys.nodes();
   auto x = nodes.x();
   auto v = nodes.v();
-  for (std::size_t k = 0; k < n; ++k) {
+  for (std::size_t k = 0; k < n3_; ++k) {
     x[k] = q_[k];
     if (free_[k] != 0.0) v[k] = (q_[k] - xn_[k]) / h;
   }
+  AngleTable& angles = sys.angles();
+  for (std::size_t a = 0; a < angles.size(); ++a) {
+    const std::size_t k = n3_ + a;
+    angles.values()[a] = q_[k];
+    if (free_[k] != 0.0) angles.rates()[a] = (q_[k] - xn_[k]) / h;
+  }
   nodes.mark_state_finite();
+  // History frozen within the step (rods' time-parallel frames, connections' accepted twist)
+  // moves on to the accepted state.
+  sys.step_accepted();
   return rep;
 }
 

@@ -1,6 +1,7 @@
 #include "sewn/physics/rods/rods_term.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include <Eigen/Eigenvalues>
@@ -24,6 +25,8 @@ Eigen::Matrix<double, N, N> project_psd(const Eigen::Matrix<double, N, N>& H) {
 Index Rods::add_rod(std::span<const Index> nodes, std::span<const double> x, bool closed, const Section& section,
                     std::span<const Vec3> rest_directors) {
   const Index rid = num_rods();
+  if (angle_dofs_)
+    throw InputError("rods::Rods::add_rod: rod " + std::to_string(rid) + " added after use_angle_dofs (add every rod first)");
   std::vector<Index> sorted(nodes.begin(), nodes.end());
   std::sort(sorted.begin(), sorted.end());
   if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
@@ -65,6 +68,46 @@ Points Rods::gather(Index r, std::span<const double> x) const {
   return p;
 }
 
+void Rods::use_angle_dofs(AngleTable& angles, double inertia_per_length) {
+  if (angle_dofs_) throw InputError("rods::Rods::use_angle_dofs: called twice");
+  if (!(std::isfinite(inertia_per_length) && inertia_per_length >= 0))
+    throw InputError("rods::Rods::use_angle_dofs: the twist inertia per length must be finite and >= 0, got " +
+                     std::to_string(inertia_per_length));
+  for (Index r = 0; r < num_rods(); ++r) {
+    Entry& e = rods_[r];
+    const int m = e.rod.num_edges();
+    std::vector<double> value(static_cast<std::size_t>(m)), inertia(value.size());
+    std::vector<unsigned char> fixed(value.size());
+    for (int j = 0; j < m; ++j) {
+      const auto k = static_cast<std::size_t>(j);
+      value[k] = e.rod.theta()[k];
+      inertia[k] = inertia_per_length * e.rod.rest_length(j);
+      fixed[k] = e.rod.theta_fixed(j) ? 1 : 0;
+    }
+    e.first_angle = angles.add("rod " + std::to_string(r), value, inertia, fixed);
+  }
+  angle_dofs_ = true;
+  quasi_static_ = false;
+  touch_topology();
+}
+
+Index Rods::angle_of(Index r, int edge) const {
+  if (!angle_dofs_) throw InputError("rods::Rods::angle_of: the rods have no angle DOFs (use_angle_dofs)");
+  if (r >= num_rods() || edge < 0 || edge >= rods_[r].rod.num_edges())
+    throw InputError("rods::Rods::angle_of: rod " + std::to_string(r) + " edge " + std::to_string(edge) + " out of range");
+  return rods_[r].first_angle + static_cast<Index>(edge);
+}
+
+void Rods::read_angles(Index r, const StateView& s) const {
+  if (!angle_dofs_) return;
+  Entry& e = rods_[r];  // θ mirrors the state's angles
+  const int m = e.rod.num_edges();
+  if (s.angles.size() < std::size_t{e.first_angle} + static_cast<std::size_t>(m))
+    throw InputError("rods::Rods: rod " + std::to_string(r) + "'s twist angles are DOFs but the state has " +
+                     std::to_string(s.angles.size()) + " angles (only the Newton integrator integrates them)");
+  for (int j = 0; j < m; ++j) e.rod.set_theta(j, s.angles[e.first_angle + static_cast<std::size_t>(j)]);
+}
+
 void Rods::ensure_twist(Index r, const Points& x) const {
   if (!quasi_static_) return;
   Entry& e = rods_[r];  // θ is the term's own (mutable) state
@@ -79,9 +122,14 @@ void Rods::add_forces(const StateView& s, std::span<double> f) const {
     const Entry& e = rods_[r];
     const Points x = gather(r, s.x);
     ensure_twist(r, x);
+    read_angles(r, s);
     (void)e.rod.evaluate(x, g, nullptr);
     for (std::size_t k = 0; k < e.nodes.size(); ++k)
       for (int a = 0; a < 3; ++a) f[3 * e.nodes[k] + static_cast<std::size_t>(a)] -= g[3 * static_cast<Eigen::Index>(k) + a];
+    const std::size_t torques = 3 * std::size_t{s.size()} + e.first_angle;  // where θ's torques go
+    if (angle_dofs_ && f.size() >= torques + static_cast<std::size_t>(e.rod.num_edges()))
+      for (int j = 0; j < e.rod.num_edges(); ++j)
+        f[torques + static_cast<std::size_t>(j)] -= g[3 * static_cast<Eigen::Index>(e.nodes.size()) + j];
   }
 }
 
@@ -90,6 +138,7 @@ double Rods::potential_energy(const StateView& s) const {
   for (Index r = 0; r < num_rods(); ++r) {
     const Points x = gather(r, s.x);
     ensure_twist(r, x);
+    read_angles(r, s);
     E += rods_[r].rod.energy(x);
   }
   return E;
@@ -109,7 +158,29 @@ void Rods::collect_pairs(std::vector<NodePair>& out) const {
     for (int s = 0; s < e.rod.num_stencils(); ++s) {
       const auto v = e.rod.stencil_vertices(s);
       out.push_back({e.nodes[static_cast<std::size_t>(v[0])], e.nodes[static_cast<std::size_t>(v[2])]});
+      if (!angle_dofs_) continue;
+      std::array<Index, 5> block{};
+      std::array<int, 11> comp{};
+      stencil_blocks(e, s, block, comp);
+      for (int a = 0; a < 5; ++a)
+        for (int b = std::max(a + 1, 3); b < 5; ++b)
+          if (block[static_cast<std::size_t>(a)] != block[static_cast<std::size_t>(b)])
+            out.push_back({block[static_cast<std::size_t>(a)], block[static_cast<std::size_t>(b)]});
     }
+  }
+}
+
+void Rods::stencil_blocks(const Entry& e, int s, std::array<Index, 5>& block, std::array<int, 11>& comp) const {
+  const auto v = e.rod.stencil_vertices(s);
+  const auto ed = e.rod.stencil_edges(s);
+  for (int k = 0; k < 3; ++k) {
+    block[static_cast<std::size_t>(k)] = e.nodes[static_cast<std::size_t>(v[static_cast<std::size_t>(k)])];
+    for (int c = 0; c < 3; ++c) comp[static_cast<std::size_t>(3 * k + c)] = c;
+  }
+  for (int k = 0; k < 2; ++k) {
+    const Index a = e.first_angle + static_cast<Index>(ed[static_cast<std::size_t>(k)]);
+    block[static_cast<std::size_t>(3 + k)] = angle_layout().block(a);
+    comp[static_cast<std::size_t>(9 + k)] = angle_layout().component(a);
   }
 }
 
@@ -118,6 +189,14 @@ void Rods::bind_pattern(const BlockMatrix& pattern) {
     e.slots.clear();
     auto node = [&](int v) { return e.nodes[static_cast<std::size_t>(v)]; };
     for (int s = 0; s < e.rod.num_stencils(); ++s) {
+      if (angle_dofs_) {
+        std::array<Index, 5> block{};
+        std::array<int, 11> comp{};
+        stencil_blocks(e, s, block, comp);
+        for (Index a : block)
+          for (Index b : block) e.slots.push_back(pattern.find(a, b));
+        continue;
+      }
       const auto v = e.rod.stencil_vertices(s);
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) e.slots.push_back(pattern.find(node(v[static_cast<std::size_t>(a)]), node(v[static_cast<std::size_t>(b)])));
@@ -157,9 +236,66 @@ void Rods::for_each_block(const Entry& e, const Points& x, bool project, Visit&&
   }
 }
 
+namespace {
+
+// matrix += cx·(−H) and product_out += −H·product_in for a stencil Hessian H whose DOF i is
+// component comp[i] of group group[i], the groups sitting in block rows block[] with the
+// groups × groups slots from slot0 on (flat index of a component: 3·block + component).
+template <int N>
+void scatter_hessian(const Eigen::Matrix<double, N, N>& H, std::span<const Index> block, std::span<const int> comp,
+                     std::span<const int> group, std::span<const Index> slots, const JacobianRequest& req) {
+  const bool product = !req.product_in.empty();
+  for (std::size_t i = 0; i < std::size_t{N}; ++i)
+    for (std::size_t j = 0; j < std::size_t{N}; ++j) {
+      const auto gi = static_cast<std::size_t>(group[i]), gj = static_cast<std::size_t>(group[j]);
+      const double h = H(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
+      if (req.matrix) req.matrix->block(slots[gi * block.size() + gj])(comp[i], comp[j]) -= req.cx * h;
+      if (product)
+        req.product_out[3 * std::size_t{block[gi]} + static_cast<std::size_t>(comp[i])] -=
+            h * req.product_in[3 * std::size_t{block[gj]} + static_cast<std::size_t>(comp[j])];
+    }
+}
+
+}  // namespace
+
+void Rods::add_jacobians_with_angles(const StateView& s, const JacobianRequest& req) const {
+  static constexpr std::array<int, 11> stencil_group{0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 4};
+  static constexpr std::array<int, 6> edge_group{0, 0, 0, 1, 1, 1};
+  static constexpr std::array<int, 6> edge_comp{0, 1, 2, 0, 1, 2};
+  for (Index r = 0; r < num_rods(); ++r) {
+    const Entry& e = rods_[r];
+    const Points x = gather(r, s.x);
+    read_angles(r, s);
+    const std::span<const Index> slots(e.slots);
+    std::size_t slot = 0;
+    for (int st = 0; st < e.rod.num_stencils(); ++st, slot += 25) {
+      const auto v = e.rod.stencil_vertices(st);
+      const auto ed = e.rod.stencil_edges(st);
+      const BendTwistEval b = bend_twist(x.col(v[0]), x.col(v[1]), x.col(v[2]), e.rod.theta()[static_cast<std::size_t>(ed[0])],
+                                         e.rod.theta()[static_cast<std::size_t>(ed[1])], e.rod.stencil_rest(st),
+                                         e.rod.stencil_frames(st), Want::hessian);
+      std::array<Index, 5> block{};
+      std::array<int, 11> comp{};
+      stencil_blocks(e, st, block, comp);
+      scatter_hessian<11>(project_ ? project_psd<11>(b.hessian) : b.hessian, block, comp, stencil_group, slots.subspan(slot), req);
+    }
+    const int n = e.rod.num_vertices();
+    for (int j = 0; j < e.rod.num_edges(); ++j, slot += 4) {
+      const int v[2] = {j, (j + 1) % n};
+      const StretchEval st = stretch(x.col(v[0]), x.col(v[1]), e.rod.section().EA, e.rod.rest_length(j), true);
+      const std::array<Index, 2> block{e.nodes[static_cast<std::size_t>(v[0])], e.nodes[static_cast<std::size_t>(v[1])]};
+      scatter_hessian<6>(project_ ? project_psd<6>(st.hessian) : st.hessian, block, edge_comp, edge_group, slots.subspan(slot), req);
+    }
+  }
+}
+
 void Rods::add_jacobians(const StateView& s, const JacobianRequest& req) const {
   if (req.matrix && req.matrix->pattern_version() != bound_pattern_)
     throw InputError("rods::Rods::add_jacobians: the matrix does not carry the pattern this term was bound to");
+  if (angle_dofs_) {
+    add_jacobians_with_angles(s, req);
+    return;
+  }
   const bool product = !req.product_in.empty();
   for (Index r = 0; r < num_rods(); ++r) {
     const Entry& e = rods_[r];
@@ -183,6 +319,7 @@ void Rods::add_stability_rows(const StateView& s, StabilityRows& rows) const {
     const Entry& e = rods_[r];
     const Points x = gather(r, s.x);
     ensure_twist(r, x);
+    read_angles(r, s);
     for_each_block(e, x, true, [&](int a, int b, const Eigen::Matrix3d& B, std::size_t) {  // the bound needs PSD blocks
       const Index na = e.nodes[static_cast<std::size_t>(a)], nb = e.nodes[static_cast<std::size_t>(b)];
       if (na == nb)
@@ -197,6 +334,7 @@ void Rods::step_accepted(const StateView& s) {
   for (Index r = 0; r < num_rods(); ++r) {
     const Points x = gather(r, s.x);
     ensure_twist(r, x);
+    read_angles(r, s);
     rods_[r].rod.update_frames(x);
   }
 }

@@ -92,6 +92,12 @@ struct PointEval {
   [[nodiscard]] bool singular() const { return near_antiparallel || bend_near_pi; }
 };
 
+/// How evaluate() forms the Hessian. `chained`: second-order AD of each side's frame (m1, m3 over
+/// its ≤ 9 DOFs) and of the frames-to-energy core (12 directions), joined by the chain rule
+/// ∇²E = Jᵀ C_FF J + Σ_k C_F[k] ∇²F_k — exact, like `nested_ad`, which differentiates the
+/// whole stencil at once in 18 directions (kept as the reference the tests compare against).
+enum class HessianMethod { chained, nested_ad };
+
 inline constexpr double antiparallel_margin = 1e-3;
 inline constexpr double bend_margin = 1e-2;
 
@@ -124,11 +130,11 @@ class PointConnection {
   /// triangle of zero area *now* gives non-finite values (callers check, as for the rods).
   /// Throws physics::InputError naming the connection if q has the wrong size or is not finite. Cost O(1): measured ~0.7 µs for the
   /// energy, ~7–15 µs with the gradient (18-wide forward AD; AMD EPYC, shared machine).
-  /// With `hessian`, also d²E/dq² (and the gradient): second-order forward AD, exact to
-  /// round-off, symmetric, not projected (indefinite away from rest). Measured ~0.65 ms: 18×18
-  /// nested directions, ~60× a gradient; the closed form is left to do.
+  /// With `hessian`, also d²E/dq² (and the gradient), by `method` (see HessianMethod): exact
+  /// to round-off, symmetric, not projected (indefinite away from rest). Cost: see docs/connect.md
+  /// (nested_ad ~0.65 ms).
   [[nodiscard]] PointEval evaluate(const Eigen::VectorXd& q, TwistUpdate update, bool want_gradient,
-                                   Eigen::MatrixXd* hessian = nullptr) const;
+                                   Eigen::MatrixXd* hessian = nullptr, HessianMethod method = HessianMethod::chained) const;
 
   /// After an accepted step at q: the incremental δ becomes the accepted one (by `update`),
   /// and each rod side's frame history is transported to its current tangent (what

@@ -20,6 +20,7 @@
 
 #include <Eigen/Core>
 
+#include "sewn/physics/angles.hpp"
 #include "sewn/physics/block_matrix.hpp"
 #include "sewn/physics/types.hpp"
 
@@ -107,8 +108,11 @@ class ForceTerm {
   /// A characteristic energy (springs: Σ ½ k l²) that sets the watchdog's noise floor.
   [[nodiscard]] virtual double energy_scale() const { return 0.0; }
 
-  /// Appends the node pairs whose blocks this term writes (diagonal blocks always exist).
+  /// Appends the node pairs whose blocks this term writes (diagonal blocks always exist). A
+  /// term with angle DOFs names their blocks through angle_layout().
   virtual void collect_pairs(std::vector<NodePair>& /*out*/) const {}
+  /// Set by System before collect_pairs / bind_pattern: where the angle DOFs' blocks are.
+  void set_angle_layout(AngleLayout layout) { angle_layout_ = layout; }
   /// Called after the pattern is (re)built: cache block slots. Cost: O(elements · log).
   virtual void bind_pattern(const BlockMatrix& /*pattern*/) {}
   /// Performs the request (see JacobianRequest). The matrix must carry the bound pattern.
@@ -135,6 +139,7 @@ class ForceTerm {
   [[nodiscard]] std::uint64_t parameter_version() const { return parameter_version_; }
 
  protected:
+  [[nodiscard]] const AngleLayout& angle_layout() const { return angle_layout_; }
   void touch_topology() {
     ++topology_version_;
     ++parameter_version_;
@@ -142,6 +147,7 @@ class ForceTerm {
   void touch_parameters() { ++parameter_version_; }
 
  private:
+  AngleLayout angle_layout_;
   std::uint64_t topology_version_ = 0;
   std::uint64_t parameter_version_ = 0;
 };

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "sewn/physics/angles.hpp"
 #include "sewn/physics/block_matrix.hpp"
 #include "sewn/physics/constraints/slave_nodes.hpp"
 #include "sewn/physics/force_term.hpp"
@@ -47,6 +48,15 @@ class System {
 
   [[nodiscard]] NodeTable& nodes() { return nodes_; }
   [[nodiscard]] const NodeTable& nodes() const { return nodes_; }
+  /// Angle DOFs beyond positions (rods' twist angles when integrated); empty by default, and
+  /// then nothing of them costs anything.
+  [[nodiscard]] AngleTable& angles() { return angles_; }
+  [[nodiscard]] const AngleTable& angles() const { return angles_; }
+  /// The current state: the node table's view plus the angles. O(1).
+  [[nodiscard]] StateView state() const;
+  /// Throws InputError naming `integrator` if the system has angle DOFs (only NewtonEuler
+  /// integrates them). O(1).
+  void require_no_angles(const char* integrator) const;
 
   /// Constructs a term of type T in place and returns it (the reference stays valid for the
   /// System's lifetime). The pattern is rebuilt when next needed. O(1).
@@ -67,7 +77,8 @@ class System {
   /// stale. Returns true if the topology changed. O(terms) when nothing changed, else O(elements).
   bool refresh();
   /// The Jacobian pattern and value storage, (re)built first if the topology changed: only
-  /// integrators that assemble Jacobians pay for it. O(elements·log) after a change, else O(terms).
+  /// integrators that assemble Jacobians pay for it. Block rows: the nodes, then the angles'
+  /// (AngleLayout). O(elements·log) after a change, else O(terms).
   [[nodiscard]] BlockMatrix& matrix();
   [[nodiscard]] const BlockMatrix& matrix() const { return matrix_; }
 
@@ -84,7 +95,7 @@ class System {
   /// Integrators call it once per step. O(terms) plus what the terms with history do.
   void step_accepted();
 
-  /// ½ Σ m v². O(n).
+  /// ½ Σ m v² + ½ Σ J ω² over the angles. O(n).
   [[nodiscard]] double kinetic_energy() const;
   /// Σ of the terms' potentials. O(elements).
   [[nodiscard]] double potential_energy() const;
@@ -114,6 +125,7 @@ class System {
 
  private:
   NodeTable nodes_;
+  AngleTable angles_;
   std::vector<std::unique_ptr<ForceTerm>> terms_;
   BlockMatrix matrix_;
   SlaveNodes slaves_;

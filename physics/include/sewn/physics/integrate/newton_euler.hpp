@@ -22,10 +22,13 @@
 // energy, gradient or state) throws NewtonError naming what failed, with the node table
 // unchanged (positions and velocities as before the step).
 //
-// Extra DOFs: the step works on flat arrays of dof_count() entries with a per-DOF inertia and
-// a per-DOF free flag, all built in prepare(). Scalar DOFs such as a rod's twist angle per
-// edge are to be appended after the 3n position entries (inertia J, free unless clamped), with
-// their block in the matrix; a System without them has dof_count() = 3n and pays nothing.
+// Angle DOFs: the step works on flat arrays of dof_count() entries with a per-DOF inertia and
+// a per-DOF free flag, all built in prepare(): the 3n positions, then System::angles() (a
+// rod's twist angle per edge, inertia J ≥ 0, free unless fixed), padded to whole blocks
+// (AngleLayout); a System without angles has dof_count() = 3n and pays nothing.
+//
+// After an accepted step the integrator calls System::step_accepted(), so history frozen
+// within the step (rods' time-parallel frames, connections' accepted twist) moves on.
 //
 // Cost per Newton iteration: one Jacobian assembly (element Hessians + projections), one
 // linear solve (CG: iterations × one block-sparse product; LDLT: one numeric factorisation,
@@ -94,13 +97,16 @@ class NewtonEuler {
   /// failure. Allocation only when the DOF count or the pattern changed.
   NewtonReport step(System& sys, double h);
   [[nodiscard]] NewtonEulerOptions& options() { return opt_; }
-  /// Φ at positions q for the step being prepared (tests: monotone decrease). Valid after a
-  /// step; evaluates with that step's q_n, v_n and h.
+  /// Φ at q (positions, then angles as in dof_count()) for the step being prepared (tests:
+  /// monotone decrease). Valid after a step; evaluates with that step's q_n, v_n and h.
   [[nodiscard]] double incremental_potential(const System& sys, std::span<const double> q);
 
  private:
   struct LdltCache;
   void prepare(System& sys, double h);
+  // The state view of flat arrays q, vel (positions, then angles).
+  [[nodiscard]] StateView view(const System& sys, std::span<const double> q, std::span<const double> vel) const;
+  [[nodiscard]] std::string describe_dof(std::size_t k) const;
   // Φ and its gradient at q (velocities (q - q_n)/h); returns Φ, fills g_. O(elements).
   double evaluate(const System& sys, std::span<const double> q, bool want_gradient);
   void assemble(System& sys);
@@ -110,6 +116,7 @@ class NewtonEuler {
 
   NewtonEulerOptions opt_;
   double h_ = 0.0;
+  std::size_t n3_ = 0;  // position entries; angles follow
   bool damped_ = false;
   AlignedVector<double> xn_, vn_, qhat_, q_, trial_, inertia_, free_, g_, f_, f0_, vel_, p_, rhs_, precond_, zeros_;
   CgWorkspace ws_;

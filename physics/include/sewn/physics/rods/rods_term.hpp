@@ -14,14 +14,19 @@
 // couple bending and twist; for a straight rod H_xθ = 0 and nothing is dropped. The test
 // suite builds the Schur complement from Rod::evaluate and checks it against finite differences.
 //
-// Hook for θ as extra degrees of freedom (the Newton integrator, later): set_quasi_static(false)
-// stops the θ solve; the integrator then owns θ (Rod::set_theta), takes each rod's full
-// Hessian in rod DOF order from Rod::evaluate (positions of rod_nodes(r)[k] at 3k.., θ^j at
-// 3n + j), gives θ^j its inertia J = ρ(πr⁴/2)|ē^j| if wanted, and calls step_accepted().
+// θ as degrees of freedom (use_angle_dofs): every edge's θ becomes an angle of the System
+// (System::angles()), with inertia J = ρ·J_section·|ē| or none, integrated by the Newton
+// integrator beside the positions. The term then reads θ from the state, writes the torques
+// −∂E/∂θ after the position forces, and assembles each stencil's full 11×11 Hessian (positions
+// and angles, projected to PSD unless set_project_hessians(false)): the exact Jacobian, so
+// Newton converges quadratically where the quasi-static mode's −H_xx does not. Connections
+// (connect/) that hold a rod edge's frame need this mode: their θ gradient enters the same
+// Newton system. set_quasi_static(false) alone leaves θ to a caller (Rod::set_theta).
 //
 // Time-parallel frames are updated in step_accepted(), which integrators call once per accepted
 // step; within a step the frames are frozen (PHYSICS_NOTES §3.4's history state).
 
+#include <array>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -51,6 +56,17 @@ class Rods final : public ForceTerm {
 
   /// Quasi-static θ (default) or θ owned by the caller (see the header comment).
   void set_quasi_static(bool on) { quasi_static_ = on; }
+  /// Makes every rod's θ angle DOFs of `angles` (a System's angles()): per rod, edge by edge,
+  /// with the rod's current θ, inertia `inertia_per_length`·l̄ per edge (ρ times the section's
+  /// polar moment, kg·m: ρπr⁴/2 for a circle; 0: no inertia — θ is solved with the positions
+  /// in every Newton step) and each rod's fixed θ fixed. Ends the quasi-static solve. Rods
+  /// added later are refused. Throws InputError if called twice or with a negative or
+  /// non-finite inertia. O(edges).
+  void use_angle_dofs(AngleTable& angles, double inertia_per_length);
+  [[nodiscard]] bool has_angle_dofs() const { return angle_dofs_; }
+  /// The System angle that holds θ of rod r's edge j (use_angle_dofs). Throws InputError if out
+  /// of range or the rods have no angle DOFs.
+  [[nodiscard]] Index angle_of(Index r, int edge) const;
   /// Whether add_jacobians projects each stencil's position Hessian to PSD (default true).
   void set_project_hessians(bool on) { project_ = on; }
 
@@ -79,9 +95,16 @@ class Rods final : public ForceTerm {
     Rod rod;
     std::vector<Index> nodes;
     Points solved_at;             // positions of the last θ solve (0 columns: none yet)
-    std::vector<Index> slots;     // per stencil 9 block slots, then per edge 4
+    std::vector<Index> slots;     // per stencil 9 block slots (25 with angle DOFs), then per edge 4
+    Index first_angle = invalid_index;  // with angle DOFs: θ^j is System angle first_angle + j
   };
   void ensure_twist(Index r, const Points& x) const;
+  // With angle DOFs: θ of rod r from the state (InputError if the state has no angles).
+  void read_angles(Index r, const StateView& s) const;
+  // Block rows of stencil s's 5 DOF groups (3 vertices, 2 edge angles) and the component of
+  // each of its 11 DOFs.
+  void stencil_blocks(const Entry& e, int s, std::array<Index, 5>& block, std::array<int, 11>& comp) const;
+  void add_jacobians_with_angles(const StateView& s, const JacobianRequest& req) const;
   // Per-stencil and per-edge position Hessians of rod e at x (PSD-projected if `project`), calling
   // visit(vertex a, vertex b, 3×3 block, slot index into e.slots).
   template <class Visit>
@@ -89,6 +112,7 @@ class Rods final : public ForceTerm {
 
   mutable std::vector<Entry> rods_;
   bool quasi_static_ = true;
+  bool angle_dofs_ = false;
   bool project_ = true;
   std::uint64_t bound_pattern_ = ~std::uint64_t{0};
 };

@@ -1,0 +1,102 @@
+#pragma once
+// PointConnections: point connections (point.hpp) as a ForceTerm on a System, so that the
+// Newton integrator (physics/integrate/newton_euler.hpp) moves the joined bodies with them.
+// A rod side's θ is a System angle (the rods must hold their twist as angle DOFs,
+// rods::Rods::use_angle_dofs): the connection's torque on θ enters the same Newton system as
+// the rod's own twist, which a quasi-static twist solve inside the Rods term could not see.
+//
+// Per connection: forces −∂E/∂q on the stencil's nodes and angle (stencil order of point.hpp),
+// the energy, and the stencil Hessian (PSD-projected when the integrator asks,
+// JacobianOptions::project_element_hessians). Stiffnesses are per connection, in N·m/rad,
+// independent of the meshes' resolution; rigid_stiffness() gives the stiff option for a rigid
+// joint. History (the accepted twist, the rod sides' frames) moves on in step_accepted(), at
+// the same time as the rods' own frames.
+//
+// Guard against the singular configurations (PHYSICS_NOTES §3.5): a state where the two axes
+// are nearly antiparallel, the bend angle is near π, or the twist moved by more than
+// max_twist_increment since the last accepted step (an incremental angle would alias) has
+// infinite energy, so a line search shortens the step instead of crossing it; forces there
+// are still the formula's (finite).
+
+#include <array>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "sewn/connect/point.hpp"
+#include "sewn/physics/force_term.hpp"
+#include "sewn/physics/rods/rods_term.hpp"
+
+namespace sewn::connect {
+
+/// A rod edge as a side, by the Rods term's rod index and edge.
+struct RodEdgeRef {
+  Index rod = 0;
+  int edge = 0;
+};
+using SideRef = std::variant<RodEdgeRef, TriangleSide>;
+
+/// Largest change of the twist δ within one step before a state counts as singular (rad).
+inline constexpr double max_twist_increment = 2.8;
+
+/// The stiff option for a rigid joint: k_t = factor·GJ/l̄, k_b = factor·min(EI1, EI2)/l̄ of a rod
+/// section and edge — `factor` times the stiffness of the rod across one edge (1: the joint
+/// behaves as that much rod; 1e3: it bends and twists a thousand times less). Throws
+/// physics::InputError unless factor and rest_length are finite and > 0.
+[[nodiscard]] PointStiffness rigid_stiffness(const physics::rods::Section& section, double rest_length, double factor = 1e3);
+
+class PointConnections final : public physics::ForceTerm {
+ public:
+  /// `rods`: the term holding the rods that rod sides name (may be null if no side is a rod);
+  /// it must have angle DOFs by the time a rod side is added.
+  explicit PointConnections(const physics::rods::Rods* rods, TwistUpdate update = TwistUpdate::incremental_ii);
+
+  /// Joins sides m and n at their shared node, with the rest state s (positions and angles,
+  /// e.g. System::state() at build time). Throws physics::InputError naming the connection: a
+  /// rod side without rods or angle DOFs or out of range, and whatever PointConnection's
+  /// constructor refuses. Returns the connection's index. O(1).
+  Index add(const std::string& name, const SideRef& m, const SideRef& n, PointStiffness k, const physics::StateView& s);
+  [[nodiscard]] Index size() const { return static_cast<Index>(items_.size()); }
+  [[nodiscard]] const PointConnection& connection(Index c) const { return items_.at(c).connection; }
+  /// Values of connection c at state s (energy, angles, flags). O(1).
+  [[nodiscard]] PointEval evaluate(Index c, const physics::StateView& s) const;
+
+  [[nodiscard]] std::string_view name() const override { return "point connections"; }
+  void add_forces(const physics::StateView& s, std::span<double> f) const override;
+  [[nodiscard]] double potential_energy(const physics::StateView& s) const override;
+  void collect_pairs(std::vector<physics::NodePair>& out) const override;
+  void bind_pattern(const physics::BlockMatrix& pattern) override;
+  void add_jacobians(const physics::StateView& s, const physics::JacobianRequest& req) const override;
+  void step_accepted(const physics::StateView& s) override;
+  void check_nodes(const physics::NodeTable& nodes) const override;
+  void remap_nodes(std::span<const Index> old_to_new) override;
+
+ private:
+  // One stencil DOF: a node's axis or a System angle.
+  struct Dof {
+    bool angle = false;
+    Index id = 0;   // node or angle
+    int axis = 0;   // for a node
+  };
+  struct Item {
+    PointConnection connection;
+    std::vector<Dof> dofs;           // stencil order
+    std::vector<Index> blocks;       // distinct block rows of the stencil (set in collect_pairs)
+    std::vector<int> block_of;       // per DOF: its index in blocks
+    std::vector<Index> slots;        // blocks × blocks
+  };
+  [[nodiscard]] static Eigen::VectorXd gather(const std::vector<Dof>& dofs, const physics::StateView& s, const std::string& name);
+  // Block row and component of a DOF in the Jacobian (angles by the System's AngleLayout).
+  [[nodiscard]] Index block_row(const Dof& d) const;
+  [[nodiscard]] int component(const Dof& d) const;
+  // Energy, or +inf at a singular configuration (see the header comment).
+  [[nodiscard]] double guarded_energy(const Item& it, const PointEval& e) const;
+
+  const physics::rods::Rods* rods_;
+  TwistUpdate update_;
+  std::vector<Item> items_;
+  std::uint64_t bound_pattern_ = ~std::uint64_t{0};
+};
+
+}  // namespace sewn::connect

@@ -1,0 +1,36 @@
+#include "sewn/physics/angles.hpp"
+
+#include <cmath>
+
+#include "sewn/physics/errors.hpp"
+#include "format.hpp"
+
+namespace sewn::physics {
+
+Index AngleTable::add(const std::string& owner, std::span<const double> values, std::span<const double> inertias,
+                      std::span<const unsigned char> fixed) {
+  if (inertias.size() != values.size() || fixed.size() != values.size())
+    throw InputError("angles of " + owner + ": " + std::to_string(values.size()) + " values but " +
+                     std::to_string(inertias.size()) + " inertias and " + std::to_string(fixed.size()) + " fixed flags");
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    if (!std::isfinite(values[k]))
+      throw InputError("angles of " + owner + ": angle " + std::to_string(k) + " is not finite");
+    if (!(std::isfinite(inertias[k]) && inertias[k] >= 0))
+      throw InputError("angles of " + owner + ": inertia of angle " + std::to_string(k) + " must be finite and >= 0, got " +
+                       detail::format_number(inertias[k]));
+  }
+  const Index first = size();
+  value_.insert(value_.end(), values.begin(), values.end());
+  rate_.resize(value_.size(), 0.0);
+  inertia_.insert(inertia_.end(), inertias.begin(), inertias.end());
+  fixed_.insert(fixed_.end(), fixed.begin(), fixed.end());
+  ++topology_version_;
+  return first;
+}
+
+void AngleTable::set_fixed(Index a, bool on) {
+  if (a >= size()) throw InputError("AngleTable::set_fixed: angle " + std::to_string(a) + " of " + std::to_string(size()));
+  fixed_[a] = on ? 1 : 0;
+}
+
+}  // namespace sewn::physics
