@@ -30,6 +30,7 @@
 #include "sewn/physics/solids/tets.hpp"
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/solids/inversion.hpp"
+#include "sewn/physics/solids/volume_term.hpp"
 #include "sewn/refine/cut.hpp"
 
 namespace sewn::app {
@@ -374,6 +375,19 @@ void use_solid_model(const Scene& scene, const std::vector<physics::MaterialPara
   }
 }
 
+// The volume-preserving term of the materials that ask for it. Its stencils are read from the
+// model as built, so a scene that cuts is refused rather than given stale stencils.
+void add_volume_term(const Scene& scene, const std::vector<std::string>& material_names, physics::MssModel<3>& model) {
+  std::vector<double> kappa;
+  for (const auto& name : material_names) {
+    kappa.push_back(scene.materials.at(name).volume_stiffness);
+    if (kappa.back() > 0 && !scene.cuts.empty())
+      throw SceneError(scene.file, "materials." + name + ".volume_stiffness",
+                       "the volume term is not supported with cuts yet (its stencils would keep the nodes of before a cut)");
+  }
+  (void)physics::solids::add_volume_preservation(model, kappa);
+}
+
 }  // namespace
 
 RunSummary run(const Scene& scene, const RunOptions& options) {
@@ -416,6 +430,8 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   const IndexedMesh& mesh = assembly.mesh;
   if (scene.model == "solid") use_solid_model(scene, materials, mesh, *model);
   if (scene.model == "shell") use_shell_model(scene, materials, mesh, *model);
+
+  add_volume_term(scene, assembly.material_names, *model);
 
   // 2) fixed particles
   for (std::size_t k = 0; k < scene.fixed.size(); ++k) {

@@ -50,6 +50,8 @@ Field build_schema() {
           .doc("Mass density ρ (per unit area for 2D cells of unit thickness; the bound is four times osmium's)."),
       field("thickness", Kind::number).unit("m").fallback(1.0).above(0).doc("Thickness of 2D cells (membranes): scales their mass and stiffness."),
       field("area", Kind::number).unit("m²").fallback(1e-4).above(0).doc("Cross-section of 1D cells (polylines): axial spring k = E·area/length."),
+      field("volume_stiffness", Kind::number).unit("Pa").fallback(0.0).at_least(0).at_most(1e13)
+          .doc("Bulk stiffness κ of a volume-preserving term (Teschner et al. 2004): each tetrahedron, and each corner of a hexahedron with an eighth of its volume, stores ½ κ V̄ (V/V̄ - 1)². Springs see lengths, not orientation: a region much softer than its load (a 1 kPa region under a 1 GPa block) turns inside out, and κ well above the pressure it carries (e.g. 100× E for a soft, nearly incompressible solid) keeps it from inverting. 0: no term. Not available with `cuts`."),
       field("elongated", Kind::string).one_of({"refuse", "clamp"}).fallback("refuse")
           .doc("Baudet's edge stiffness turns negative for boxes longer than ~1.5× their width: refuse such an element (naming it), or clamp the negative edge stiffnesses to 0, the diagonals then carrying the load along the long axis. Clamping makes the body too stiff in bending (on a 1 m cantilever: 4.8× at 2.5:1, 66× at 5:1, 860× at 10:1); the run prints a warning with the number of clamped cells."),
   });
@@ -409,6 +411,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     ms.thickness = m.number("thickness");
     ms.area = m.number("area");
     ms.clamp_elongated = m.string("elongated") == "clamp";
+    ms.volume_stiffness = m.number("volume_stiffness");
     s.materials[it.key()] = ms;
   }
   auto check_material = [&](const std::string& name, const std::string& path) {

@@ -352,6 +352,32 @@ TEST_CASE("inverted elements: counted per frame with the first reported, or the 
   CHECK_THROWS_WITH(run(load_scene(scene.string()), opt), doctest::Contains("inverted at step"));
 }
 
+TEST_CASE("materials' volume_stiffness keeps the soft region of the column from inverting") {
+  // the column above, the soft material with a bulk stiffness 100 times its Young's modulus
+  const std::string volume_column = R"({"materials": {"soft": {"young": 1e3, "density": 1000, "volume_stiffness": 1e5},
+  "stiff": {"young": 1e9, "density": 1000}},
+  "meshes": [{"type": "hex_grid", "cells": [2, 2, 6], "size": [0.1, 0.1, 0.3], "material": "stiff",
+              "regions": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 0.15]}, "material": "soft"}]}],
+  "fixed": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 0.001]}}],
+  "integrator": {"type": "implicit", "step": 0.001, "max_iterations": 10000}, "duration": 0.5)";
+  const std::string rest = R"(, "output": {"frames": 10, "vtu": false, "picture": {"enabled": false}}})";
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  const RunSummary s = run_text(volume_column + rest, "column_volume", header, rows);
+  CHECK(s.inverted_max == 0);
+  for (const auto& r : rows) CHECK(column(header, r, "inverted") == 0.0);
+  // its energy is elastic energy: the columns still add up (total = kinetic + elastic + gravity)
+  const auto& last = rows.back();
+  CHECK(column(header, last, "total_energy") ==
+        doctest::Approx(column(header, last, "kinetic_energy") + column(header, last, "elastic_energy") +
+                        column(header, last, "gravity_energy")).epsilon(1e-12));
+  expect_run_error<SceneError>(volume_column + R"(, "cuts": [{"type": "plane", "time": 0.1, "point": [0, 0, 0.1], "normal": [0, 0, 1]}])" + rest,
+                               "materials.soft.volume_stiffness");
+  expect_run_error<SceneError>(R"({"materials": {"m": {"young": 1e6, "density": 1000, "volume_stiffness": -1}},
+                                   "meshes": [{"type": "hex_grid", "cells": [1, 1, 1], "size": [1, 1, 1], "material": "m"}]})",
+                               "materials.m.volume_stiffness");
+}
+
 TEST_CASE("the clamp policy for elongated cells is announced with the number of cells it altered") {
   const auto beam = [](const std::string& policy) {
     return R"({"materials": {"m": {"young": 100e6, "density": 1000)" + policy + R"(}},

@@ -34,6 +34,7 @@ struct MaterialSpec {
   double thickness = 1;  // 2D cells: membrane thickness (m)
   double area = 0;       // 1D cells: cross-section (m²)
   bool clamp_elongated = false;  // Baudet edge stiffness < 0: clamp instead of refusing
+  double volume_stiffness = 0;   // bulk stiffness κ of the volume term (Pa), 0 for none
 };
 
 struct LatticeBoxSpec {
