@@ -394,6 +394,12 @@ TEST_CASE("the clamp policy for elongated cells is announced with the number of 
   "duration": 0.002, "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})", "cubes", header, rows);
   CHECK(cubes.clamped_cells == 0);
   expect_run_error<sewn::physics::InputError>(beam(""), "too elongated");
+  // split: every 5:1 box cut into 5 near-cubes, no stiffness altered, the run goes on
+  const RunSummary split = run_text(beam(R"(, "elongated": "split")"), "split", header, rows);
+  CHECK(split.split_cells == 16);
+  CHECK(split.clamped_cells == 0);
+  CHECK(column(header, rows.back(), "elements") == 80.0);
+  CHECK(column(header, rows.back(), "particles") == 21.0 * 3 * 3);
 }
 
 TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped by Newton; misuse is named") {
