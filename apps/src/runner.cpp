@@ -657,9 +657,13 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
       ledger.rebase(model->system());
     }
     int cg = 0;
-    if (use_midpoint)
+    if (use_midpoint) {
       cg = midpoint.step(model->system(), h).cg_iterations;
-    else if (use_implicit)
+      if (midpoint.last_substeps() > 1) {
+        ++sum.substepped;
+        sum.most_substeps = std::max(sum.most_substeps, midpoint.last_substeps());
+      }
+    } else if (use_implicit)
       cg = implicit.step(model->system(), h).cg_iterations;
     else if (use_newton)
       cg = newton.step(model->system(), h).linear_iterations;

@@ -74,6 +74,8 @@ struct RunSummary {
   double ms_per_step = 0;
   double kinetic_start = 0, kinetic_end = 0, kinetic_max = 0;  ///< J
   std::uint64_t energy_rises = 0;   ///< implicit steps that created energy (see physics::EnergyLedger)
+  std::uint64_t substepped = 0;     ///< midpoint steps Newton could only take in sub-steps (the summary says so)
+  int most_substeps = 0;             ///< the most sub-steps one of them took
   std::string first_energy_rise;    ///< the warning printed for the first of them ("" if none)
   std::uint64_t clamped_cells = 0;   ///< cells whose stiffness the `clamp` policy altered (a warning says so)
   std::uint64_t split_cells = 0;     ///< source cells the `split` policy cut into near-cubes (a warning says so)
