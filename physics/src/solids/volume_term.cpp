@@ -24,15 +24,6 @@ Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
   return m;
 }
 
-// ∂det/∂(a-o, b-o, c-o): the columns b'×c', c'×a', a'×b'.
-Eigen::Matrix3d det_gradient(const Eigen::Matrix3d& e) {
-  Eigen::Matrix3d g;
-  g.col(0) = e.col(1).cross(e.col(2));
-  g.col(1) = e.col(2).cross(e.col(0));
-  g.col(2) = e.col(0).cross(e.col(1));
-  return g;
-}
-
 // The gradient of det over (o, a, b, c), o's being minus the sum of the others'.
 elements::Vec<12> stencil_gradient(const Eigen::Matrix3d& g) {
   elements::Vec<12> out;
@@ -51,13 +42,13 @@ double volume_energy(const CornerPositions& x, const VolumeStencil& r) {
 elements::Vec<12> volume_gradient(const CornerPositions& x, const VolumeStencil& r) {
   const Eigen::Matrix3d e = edges(x);
   const double strain = (e.determinant() - r.rest_det) / r.rest_det;
-  return (r.stiffness * strain / r.rest_det) * stencil_gradient(det_gradient(e));
+  return (r.stiffness * strain / r.rest_det) * stencil_gradient(elements::cofactor(e));
 }
 
 elements::Mat<12> volume_hessian(const CornerPositions& x, const VolumeStencil& r) {
   const Eigen::Matrix3d e = edges(x);
   const double strain = (e.determinant() - r.rest_det) / r.rest_det;
-  const elements::Vec<12> dJ = stencil_gradient(det_gradient(e)) / r.rest_det;
+  const elements::Vec<12> dJ = stencil_gradient(elements::cofactor(e)) / r.rest_det;
   // ∇²det over the edges a', b', c': block (p, q) = ∂(∂det/∂p)/∂q, zero on the diagonal. Over
   // (o, a, b, c), o enters every edge with a minus sign: its rows and columns are minus sums.
   std::array<std::array<Eigen::Matrix3d, 3>, 3> h;
