@@ -128,6 +128,9 @@ int cmd_run(const std::vector<std::string>& args) {
                 scene.name.c_str(), static_cast<unsigned long long>(s.steps), s.simulated, s.wall, s.ms_per_step, s.cuts,
                 s.cuts == 1 ? "" : "s", s.frames, s.out.string().c_str());
     if (!s.picture.empty()) std::printf(" (picture: %s)", s.picture.string().c_str());
+    if (s.substepped > 0)
+      std::printf("; midpoint: Newton missed at h in %llu steps, taken in up to %d sub-steps each",
+                  static_cast<unsigned long long>(s.substepped), s.most_substeps);
     std::printf("\n");
   }
   return ok;

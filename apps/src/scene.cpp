@@ -50,8 +50,10 @@ Field build_schema() {
           .doc("Mass density ρ (per unit area for 2D cells of unit thickness; the bound is four times osmium's)."),
       field("thickness", Kind::number).unit("m").fallback(1.0).above(0).doc("Thickness of 2D cells (membranes): scales their mass and stiffness."),
       field("area", Kind::number).unit("m²").fallback(1e-4).above(0).doc("Cross-section of 1D cells (polylines): axial spring k = E·area/length."),
-      field("elongated", Kind::string).one_of({"refuse", "clamp"}).fallback("refuse")
-          .doc("Baudet's edge stiffness turns negative for boxes longer than ~1.5× their width: refuse such an element (naming it), or clamp the negative edge stiffnesses to 0, the diagonals then carrying the load along the long axis. Clamping makes the body too stiff in bending (on a 1 m cantilever: 4.8× at 2.5:1, 66× at 5:1, 860× at 10:1); the run prints a warning with the number of clamped cells."),
+      field("volume_stiffness", Kind::number).unit("Pa").fallback(0.0).at_least(0).at_most(1e13)
+          .doc("Bulk stiffness κ of a volume-preserving term (Teschner et al. 2004): each tetrahedron, and each corner of a hexahedron with an eighth of its volume, stores ½ κ V̄ (V/V̄ - 1)². Springs see lengths, not orientation: a region much softer than its load (a 1 kPa region under a 1 GPa block) turns inside out, and κ well above the pressure it carries (e.g. 100× E for a soft, nearly incompressible solid) keeps it from inverting. 0: no term. Not available with `cuts`."),
+      field("elongated", Kind::string).one_of({"refuse", "clamp", "split"}).fallback("refuse")
+          .doc("Baudet's edge stiffness turns negative for boxes longer than ~1.5× their width. `refuse`: such an element is refused, naming it. `split`: each such hexahedron is cut into near-cubes (pieces of aspect at most √2) before the model is built, and so are the hexahedra sharing its split edges, so that the mesh stays conforming; on the 1 m cantilever at E = 100 MPa (4 cells through its thickness) the static tip is the cube-meshed beam's at 10:1 and 5:1 boxes (the pieces are its cubes) and 3.1 % softer at 2.5:1 (pieces of 0.83:1), at the cost of the cube mesh's particles. Cells of other types on a split edge are refused. Mesh cell numbers in later messages are those of the split mesh. `clamp`: the negative edge stiffnesses are set to 0 and the diagonals carry the load along the long axis, which makes the body far too stiff in bending (on that cantilever: 4.8× at 2.5:1, 66× at 5:1, 860× at 10:1). Both `split` and `clamp` print a warning with the number of cells they changed."),
   });
 
   Field mesh = field("mesh", Kind::object);
@@ -195,7 +197,7 @@ Field build_schema() {
   integrator.doc("Time integration.")
       .fallback(nlohmann::json::object())
       .members({field("type", Kind::string).one_of({"implicit", "semi-implicit", "midpoint", "newton"}).fallback("implicit")
-                    .doc("Linearly implicit Euler (Baraff–Witkin, CG: one solve per step, dissipative, loses angular momentum on fast rotations), semi-implicit (symplectic) Euler (explicit: below the stable step only), or the implicit midpoint rule with discrete-gradient springs solved by Newton and CG (keeps linear and angular momentum and the energy of free bodies to round-off at any step it converges at; several solves per step), or backward Euler by Newton on the incremental potential (PSD-projected Hessians, CG solves, Armijo line search; docs/elastic.md). See docs/integrators.md."),
+                    .doc("Linearly implicit Euler (Baraff–Witkin, CG: one solve per step, dissipative, loses angular momentum on fast rotations), semi-implicit (symplectic) Euler (explicit: below the stable step only), or the implicit midpoint rule with discrete-gradient springs solved by Newton and CG (keeps linear and angular momentum and the energy of free bodies to round-off at any step; a step where Newton misses, as at a radian of rotation per step, is taken as 2, 4, ... sub-steps and the summary says so; several solves per step), or backward Euler by Newton on the incremental potential (PSD-projected Hessians, CG solves, Armijo line search; docs/elastic.md). See docs/integrators.md."),
                 field("step", Kind::number).unit("s").fallback(1e-3).above(0).at_most(10).doc("Time step h."),
                 field("solver", Kind::string).one_of({"auto", "jacobi", "cholmod", "cholmod-pcg"}).fallback("auto")
                     .doc("Linear solver (implicit), docs/solvers.md: `jacobi` block-Jacobi CG, `cholmod` sparse Cholesky, `cholmod-pcg` CG preconditioned by a reused Cholesky factorization; `auto` picks by model size. The CHOLMOD ones need SuiteSparse at build time."),
@@ -419,7 +421,8 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     ms.density = m.number("density");
     ms.thickness = m.number("thickness");
     ms.area = m.number("area");
-    ms.clamp_elongated = m.string("elongated") == "clamp";
+    ms.elongated = m.string("elongated");
+    ms.volume_stiffness = m.number("volume_stiffness");
     s.materials[it.key()] = ms;
   }
   auto check_material = [&](const std::string& name, const std::string& path) {

@@ -322,6 +322,13 @@ TEST_CASE("a spinning cube: the linearly implicit step's energy rise is reported
   const std::string spin10 = R"([{"where": {"type": "all"}, "angular": [0, 0, 10]}])";
   const RunSummary calm = run_text(spin_scene("midpoint", 0.01, 0.2, spin10), "spin10", header, rows);
   CHECK(calm.energy_rises == 0);
+  CHECK(calm.substepped == 0);
+  // a radian per step: the midpoint rule's Newton needs sub-steps, the summary counts them, no energy is made
+  const RunSummary sub = run_text(spin_scene("midpoint", 0.01, 0.05, spin100), "spin100_midpoint", header, rows);
+  CHECK(sub.substepped > 0);
+  CHECK(sub.most_substeps > 1);
+  CHECK(sub.energy_rises == 0);
+  CHECK(std::abs(column(header, rows.back(), "dissipated")) <= 1e-9 * column(header, rows.front(), "total_energy"));
   const double e0 = column(header, rows.front(), "total_energy");
   CHECK(std::abs(column(header, rows.back(), "dissipated")) <= 1e-9 * e0);
 }
@@ -352,6 +359,32 @@ TEST_CASE("inverted elements: counted per frame with the first reported, or the 
   CHECK_THROWS_WITH(run(load_scene(scene.string()), opt), doctest::Contains("inverted at step"));
 }
 
+TEST_CASE("materials' volume_stiffness keeps the soft region of the column from inverting") {
+  // the column above, the soft material with a bulk stiffness 100 times its Young's modulus
+  const std::string volume_column = R"({"materials": {"soft": {"young": 1e3, "density": 1000, "volume_stiffness": 1e5},
+  "stiff": {"young": 1e9, "density": 1000}},
+  "meshes": [{"type": "hex_grid", "cells": [2, 2, 6], "size": [0.1, 0.1, 0.3], "material": "stiff",
+              "regions": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 0.15]}, "material": "soft"}]}],
+  "fixed": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 0.001]}}],
+  "integrator": {"type": "implicit", "step": 0.001, "max_iterations": 10000}, "duration": 0.5)";
+  const std::string rest = R"(, "output": {"frames": 10, "vtu": false, "picture": {"enabled": false}}})";
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  const RunSummary s = run_text(volume_column + rest, "column_volume", header, rows);
+  CHECK(s.inverted_max == 0);
+  for (const auto& r : rows) CHECK(column(header, r, "inverted") == 0.0);
+  // its energy is elastic energy: the columns still add up (total = kinetic + elastic + gravity)
+  const auto& last = rows.back();
+  CHECK(column(header, last, "total_energy") ==
+        doctest::Approx(column(header, last, "kinetic_energy") + column(header, last, "elastic_energy") +
+                        column(header, last, "gravity_energy")).epsilon(1e-12));
+  expect_run_error<SceneError>(volume_column + R"(, "cuts": [{"type": "plane", "time": 0.1, "point": [0, 0, 0.1], "normal": [0, 0, 1]}])" + rest,
+                               "materials.soft.volume_stiffness");
+  expect_run_error<SceneError>(R"({"materials": {"m": {"young": 1e6, "density": 1000, "volume_stiffness": -1}},
+                                   "meshes": [{"type": "hex_grid", "cells": [1, 1, 1], "size": [1, 1, 1], "material": "m"}]})",
+                               "materials.m.volume_stiffness");
+}
+
 TEST_CASE("the clamp policy for elongated cells is announced with the number of cells it altered") {
   const auto beam = [](const std::string& policy) {
     return R"({"materials": {"m": {"young": 100e6, "density": 1000)" + policy + R"(}},
@@ -368,6 +401,12 @@ TEST_CASE("the clamp policy for elongated cells is announced with the number of 
   "duration": 0.002, "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})", "cubes", header, rows);
   CHECK(cubes.clamped_cells == 0);
   expect_run_error<sewn::physics::InputError>(beam(""), "too elongated");
+  // split: every 5:1 box cut into 5 near-cubes, no stiffness altered, the run goes on
+  const RunSummary split = run_text(beam(R"(, "elongated": "split")"), "split", header, rows);
+  CHECK(split.split_cells == 16);
+  CHECK(split.clamped_cells == 0);
+  CHECK(column(header, rows.back(), "elements") == 80.0);
+  CHECK(column(header, rows.back(), "particles") == 21.0 * 3 * 3);
 }
 
 TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped by Newton; misuse is named") {

@@ -20,29 +20,6 @@ using Eigen::Vector3d;
 
 namespace {
 
-// Checks one element at x: gradient vs FD of the energy, Hessian vs FD of the gradient, net
-// force and torque zero; returns the FD errors for the caller's message.
-template <int N>
-void check_element(const std::function<double(const Eigen::Matrix<double, 3, N>&)>& E,
-                   const std::function<Eigen::Matrix<double, 3 * N, 1>(const Eigen::Matrix<double, 3, N>&)>& G,
-                   const std::function<Eigen::Matrix<double, 3 * N, 3 * N>(const Eigen::Matrix<double, 3, N>&)>& H,
-                   const Eigen::Matrix<double, 3, N>& x, double delta, double tol) {
-  using P = Eigen::Matrix<double, 3, N>;
-  const Eigen::VectorXd g = G(x);
-  const Eigen::VectorXd g_fd = fd_gradient<P>(E, x, delta);
-  const Eigen::MatrixXd h = H(x);
-  const Eigen::MatrixXd h_fd = fd_jacobian<P>([&](const P& y) { return Eigen::VectorXd(G(y)); }, x, delta);
-  CAPTURE(g.transpose());
-  CAPTURE(g_fd.transpose());
-  CHECK(rel_err(g, g_fd) < tol);
-  CHECK(rel_err(h, h_fd) < tol);
-  CHECK((h - h.transpose()).cwiseAbs().maxCoeff() <= 1e-12 * h.cwiseAbs().maxCoeff());
-  const auto [f, t] = net_force_torque<N>(x, G(x));
-  const double scale = g.cwiseAbs().maxCoeff() * (1.0 + x.cwiseAbs().maxCoeff());
-  CHECK(f.norm() <= 1e-12 * scale);
-  CHECK(t.norm() <= 1e-12 * scale);
-}
-
 const solids::Lame lame{0.7, 1.3};
 
 }  // namespace

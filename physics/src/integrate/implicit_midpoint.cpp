@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "sewn/physics/errors.hpp"
@@ -67,21 +68,54 @@ void ImplicitMidpoint::restore(NodeTable& nodes) const {
 
 StepReport ImplicitMidpoint::step(System& sys, double h) {
   if (!(std::isfinite(h) && h > 0)) throw InputError("ImplicitMidpoint::step: time step must be finite and > 0, got " + detail::format_number(h));
-  if (!(opt_.newton_tolerance > 0 && opt_.cg_tolerance > 0 && opt_.max_newton_iterations >= 1 && opt_.cg_max_iterations >= 1))
-    throw InputError("ImplicitMidpoint::step: tolerances must be > 0 and iteration limits >= 1");
+  if (!(opt_.newton_tolerance > 0 && opt_.cg_tolerance > 0 && opt_.max_newton_iterations >= 1 && opt_.cg_max_iterations >= 1 &&
+        opt_.max_step_halvings >= 0 && opt_.max_step_halvings <= 20))
+    throw InputError("ImplicitMidpoint::step: tolerances must be > 0, iteration limits >= 1 and max_step_halvings in [0, 20]");
   detail::require_symmetric_jacobians(sys, opt_.jacobian, "ImplicitMidpoint::step");
   sys.require_no_angles("ImplicitMidpoint::step");
   StepReport rep;
   rep.pattern_rebuilt = sys.refresh();
   NodeTable& nodes = sys.nodes();
+  const std::size_t n3 = 3 * std::size_t{nodes.size()};
+  if (dv_.size() != n3) {
+    for (auto* a : {&x0_, &v0_, &dv_, &r_, &delta_, &free_, &x_start_, &v_start_}) a->assign(n3, 0.0);
+    precond_.assign(9 * std::size_t{nodes.size()}, 0.0);
+  }
+  if (opt_.health.energy_check_interval > 0) watchdog_.baseline_if_needed(sys);
+  std::copy(nodes.x().begin(), nodes.x().end(), x_start_.begin());
+  std::copy(nodes.v().begin(), nodes.v().end(), v_start_.begin());
+  substeps_ = 0;
+  finest_ = 0;
+  newton_iterations_ = 0;
+  if (!advance(sys, h, 0, rep)) {
+    std::copy(x_start_.begin(), x_start_.end(), nodes.x().begin());
+    std::copy(v_start_.begin(), v_start_.end(), nodes.v().begin());
+    throw SolverError("ImplicitMidpoint::step: " + failure_ + ", even with the step split into " +
+                          std::to_string(1 << opt_.max_step_halvings) + " sub-steps of " +
+                          detail::format_number(h / (1 << opt_.max_step_halvings)) + " s (options max_step_halvings = " +
+                          std::to_string(opt_.max_step_halvings) + "); take a smaller step; the state is unchanged",
+                      newton_iterations_, failure_residual_);
+  }
+  return rep;
+}
+
+bool ImplicitMidpoint::advance(System& sys, double h, int depth, StepReport& rep) {
+  if (attempt(sys, h, rep)) {
+    ++substeps_;
+    finest_ = std::max(finest_, depth);
+    return true;
+  }
+  // Newton failed (the midpoint state left unchanged): two half steps compose to a step that
+  // keeps the same momenta and energy, and each turns the springs half as far
+  if (depth == opt_.max_step_halvings) return false;
+  return advance(sys, h / 2, depth + 1, rep) && advance(sys, h / 2, depth + 1, rep);
+}
+
+bool ImplicitMidpoint::attempt(System& sys, double h, StepReport& rep) {
+  NodeTable& nodes = sys.nodes();
   const Index n = nodes.size();
   const std::size_t n3 = 3 * std::size_t{n};
-  if (dv_.size() != n3) {
-    for (auto* a : {&x0_, &v0_, &dv_, &r_, &delta_, &free_}) a->assign(n3, 0.0);
-    precond_.assign(9 * std::size_t{n}, 0.0);
-  }
   const bool watch = opt_.health.energy_check_interval > 0;
-  if (watch) watchdog_.baseline_if_needed(sys);
   {
     const auto x = nodes.x(), v = nodes.v();
     std::copy(x.begin(), x.end(), x0_.begin());
@@ -96,7 +130,7 @@ StepReport ImplicitMidpoint::step(System& sys, double h) {
   momentum = std::sqrt(momentum);
   std::fill(dv_.begin(), dv_.end(), 0.0);
 
-  newton_iterations_ = 0;
+  int iterations = 0;
   double residual = 0, scale = 0;
   for (;;) {
     // 1) the midpoint state and the residual r = h F(x̄, v̄) − M Δv (0 on fixed axes)
@@ -121,10 +155,9 @@ StepReport ImplicitMidpoint::step(System& sys, double h) {
     }
     if (!finite) {
       restore(nodes);
-      throw BlowupError("ImplicitMidpoint::step: non-finite forces at the midpoint state after " +
-                            std::to_string(newton_iterations_) + " Newton iterations (h = " + detail::format_number(h) +
-                            " s); the state is unchanged",
-                        invalid_index, "force", steps_ + 1, h / 10);
+      failure_ = "non-finite forces at the midpoint state after " + std::to_string(iterations) + " Newton iterations";
+      failure_residual_ = std::numeric_limits<double>::infinity();
+      return false;
     }
     const double previous = residual;
     residual = norm2(r_);
@@ -132,14 +165,14 @@ StepReport ImplicitMidpoint::step(System& sys, double h) {
     if (residual <= opt_.newton_tolerance * scale) break;
     // Round-off floor: the residual sums forces that each carry their own rounding, so below
     // some level a Newton step no longer shrinks it. Accept that level if it is small.
-    if (newton_iterations_ > 0 && residual > 0.5 * previous && residual <= opt_.stagnation_tolerance * scale) break;
-    if (newton_iterations_ == opt_.max_newton_iterations) {
+    if (iterations > 0 && residual > 0.5 * previous && residual <= opt_.stagnation_tolerance * scale) break;
+    if (iterations == opt_.max_newton_iterations) {
       restore(nodes);
-      throw SolverError("ImplicitMidpoint::step: Newton stopped after " + std::to_string(newton_iterations_) +
-                            " iterations at residual " + detail::format_number(residual) + " (" + detail::format_number(residual / scale) +
-                            " of the momentum and impulse in play, tolerance " + detail::format_number(opt_.newton_tolerance) +
-                            "); try a smaller step; the state is unchanged",
-                        newton_iterations_, residual / scale);
+      failure_ = "Newton stopped after " + std::to_string(iterations) + " iterations at residual " + detail::format_number(residual) +
+                 " (" + detail::format_number(residual / scale) + " of the momentum and impulse in play, tolerance " +
+                 detail::format_number(opt_.newton_tolerance) + ")";
+      failure_residual_ = residual / scale;
+      return false;
     }
     // 2) the Newton matrix M − (h²/4)∂F/∂x − (h/2)∂F/∂v at the midpoint, and δ
     BlockMatrix& A = sys.matrix();
@@ -157,14 +190,15 @@ StepReport ImplicitMidpoint::step(System& sys, double h) {
     rep.cg_relative_residual = cg.relative_residual;
     if (!cg.converged) {
       restore(nodes);
-      throw SolverError("ImplicitMidpoint::step: CG stopped after " + std::to_string(cg.iterations) +
-                            " iterations at relative residual " + detail::format_number(cg.relative_residual) + " (tolerance " +
-                            detail::format_number(opt_.cg_tolerance) + ") in Newton iteration " + std::to_string(newton_iterations_ + 1) +
-                            (cg.breakdown ? "; breakdown: the matrix is not positive definite" : "") +
-                            "; the state is unchanged",
-                        cg.iterations, cg.relative_residual);
+      failure_ = "CG stopped after " + std::to_string(cg.iterations) + " iterations at relative residual " +
+                 detail::format_number(cg.relative_residual) + " (tolerance " + detail::format_number(opt_.cg_tolerance) +
+                 ") in Newton iteration " + std::to_string(iterations + 1) +
+                 (cg.breakdown ? "; breakdown: the matrix is not positive definite" : "");
+      failure_residual_ = cg.relative_residual;
+      return false;
     }
     for (std::size_t k = 0; k < n3; ++k) dv_[k] += delta_[k];
+    ++iterations;
     ++newton_iterations_;
   }
 
@@ -190,7 +224,7 @@ StepReport ImplicitMidpoint::step(System& sys, double h) {
                             detail::format_number(suggested) + " s",
                         blowup->node, "energy", steps_, suggested);
     }
-  return rep;
+  return true;
 }
 
 }  // namespace sewn::physics

@@ -5,14 +5,13 @@
 
 #include <Eigen/Geometry>
 
+#include "hex_corners.hpp"
+
 namespace sewn::physics {
 
 namespace {
 
-// For each corner of a VTK-ordered hexahedron, its three neighbours along edges, in an order
-// that gives every corner of an undistorted box the same sign.
-constexpr std::array<std::array<std::uint8_t, 3>, 8> hex_corners{{
-    {1, 3, 4}, {2, 0, 5}, {3, 1, 6}, {0, 2, 7}, {7, 5, 0}, {4, 6, 1}, {5, 7, 2}, {6, 4, 3}}};
+using solids::detail::hex_corners;
 
 double triple(const Eigen::Vector3d& o, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   return (a - o).dot((b - o).cross(c - o));

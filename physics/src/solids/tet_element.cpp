@@ -11,13 +11,7 @@ namespace sewn::physics::solids {
 
 namespace {
 
-Eigen::Matrix3d cofactor(const Eigen::Matrix3d& F) {
-  Eigen::Matrix3d C;
-  C.col(0) = F.col(1).cross(F.col(2));
-  C.col(1) = F.col(2).cross(F.col(0));
-  C.col(2) = F.col(0).cross(F.col(1));
-  return C;
-}
+using elements::cofactor;
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& a) {
   Eigen::Matrix3d S;

@@ -50,6 +50,9 @@ struct Assembly {
   std::vector<std::uint32_t> material_of_cell;
   std::vector<std::string> material_names;
   std::vector<std::uint32_t> first_cell;  ///< per scene mesh, its first cell in `mesh`
+  std::uint32_t split_asked = 0;  ///< hexahedra too elongated for Baudet's stiffness, split (materials' elongated = "split")
+  std::uint32_t split_cells = 0;  ///< source cells cut into near-cubes (those and their sheets' neighbours)
+  std::uint32_t source_cells = 0; ///< cells before the split
 };
 
 /// Generates or reads every mesh of the scene, places it, and assigns materials by region.
@@ -75,8 +78,11 @@ struct RunSummary {
   double ms_per_step = 0;
   double kinetic_start = 0, kinetic_end = 0, kinetic_max = 0;  ///< J
   std::uint64_t energy_rises = 0;   ///< implicit steps that created energy (see physics::EnergyLedger)
+  std::uint64_t substepped = 0;     ///< midpoint steps Newton could only take in sub-steps (the summary says so)
+  int most_substeps = 0;             ///< the most sub-steps one of them took
   std::string first_energy_rise;    ///< the warning printed for the first of them ("" if none)
   std::uint64_t clamped_cells = 0;   ///< cells whose stiffness the `clamp` policy altered (a warning says so)
+  std::uint64_t split_cells = 0;     ///< source cells the `split` policy cut into near-cubes (a warning says so)
   std::uint64_t inverted_max = 0;   ///< most inverted hexahedra and tetrahedra seen at once (frames, or steps if checked)
   std::string first_inversion;      ///< the first inverted element seen, with step and time ("" if none)
   std::filesystem::path out, pvd, csv, picture;

@@ -33,7 +33,8 @@ struct MaterialSpec {
   double young = 0, poisson = 0, density = 0;
   double thickness = 1;  // 2D cells: membrane thickness (m)
   double area = 0;       // 1D cells: cross-section (m²)
-  bool clamp_elongated = false;  // Baudet edge stiffness < 0: clamp instead of refusing
+  std::string elongated = "refuse";  // Baudet edge stiffness < 0: "refuse", "clamp" or "split"
+  double volume_stiffness = 0;   // bulk stiffness κ of the volume term (Pa), 0 for none
 };
 
 struct LatticeBoxSpec {

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 
 namespace sewn::physics::elements {
 
@@ -37,6 +38,15 @@ double project_psd(Mat<N>& H) {
   d = d.cwiseMax(0.0);
   H = eig.eigenvectors() * d.asDiagonal() * eig.eigenvectors().transpose();
   return lowest;
+}
+
+/// The cofactor matrix of A, ∂det(A)/∂A: columns a₁×a₂, a₂×a₀, a₀×a₁. O(1).
+inline Eigen::Matrix3d cofactor(const Eigen::Matrix3d& A) {
+  Eigen::Matrix3d C;
+  C.col(0) = A.col(1).cross(A.col(2));
+  C.col(1) = A.col(2).cross(A.col(0));
+  C.col(2) = A.col(0).cross(A.col(1));
+  return C;
 }
 
 /// For a linear element of K+1 nodes whose deformation gradient is F = Ds·Dm⁻¹ (Ds's column j

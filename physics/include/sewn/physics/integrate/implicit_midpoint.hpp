@@ -17,10 +17,12 @@
 // dissipation, so only physical damping calms them. With nonlinear springs it is not
 // unconditionally stable: a free cube spun at 100 rad/s with h = 10 ms (a rotation of 1 rad
 // per step) gains energy until the watchdog stops it (Simo & Tarnow 1992 describe this for
-// nonlinear elastodynamics; their energy-momentum variant would fix it). Fixed axes keep their
-// velocity.
+// nonlinear elastodynamics); the springs' discrete-gradient form (the default) removes that.
+// Newton may miss at such a rotation per step: the step is then split into sub-steps
+// (ImplicitMidpointOptions::max_step_halvings). Fixed axes keep their velocity.
 
 #include <cstdint>
+#include <string>
 
 #include "sewn/physics/aligned.hpp"
 #include "sewn/physics/cg.hpp"
@@ -38,6 +40,13 @@ struct ImplicitMidpointOptions {
   /// stagnation_tolerance · that scale; above it that is a SolverError.
   double stagnation_tolerance = 1e-10;
   int max_newton_iterations = 30;
+  /// When Newton (or a CG solve in it) fails, the step is retried as two half steps, each of
+  /// which may be halved again, up to this many times (2^max_step_halvings sub-steps). Each
+  /// sub-step is a midpoint step, so the momenta and energy kept per step are kept over their
+  /// sequence. Newton's matrix is the midpoint forces' Jacobian, not the discrete gradient's, and
+  /// misses where a spring turns by ~1 rad in a step (a cube spun at 100 rad/s, h = 10 ms);
+  /// half that turn converges. 0: fail at once. In [0, 20].
+  int max_step_halvings = 5;
   /// CG relative residual of each Newton step: it sets how many Newton steps are needed, not
   /// the accuracy (the nonlinear residual is evaluated exactly).
   double cg_tolerance = 1e-8;
@@ -58,13 +67,18 @@ struct ImplicitMidpointOptions {
 class ImplicitMidpoint {
  public:
   explicit ImplicitMidpoint(ImplicitMidpointOptions options = {});
-  /// Advances sys by h > 0. Throws InputError on a bad h or option, SolverError (state
-  /// unchanged) if Newton or a CG solve misses its tolerance, BlowupError as the other
-  /// integrators. Cost per Newton iteration: one force and one Jacobian evaluation and a CG
-  /// solve; 2-5 iterations are usual. No allocation once the work arrays are sized.
+  /// Advances sys by h > 0, in sub-steps where Newton needs them (max_step_halvings). Throws
+  /// InputError on a bad h or option, SolverError (state unchanged) if Newton or a CG solve
+  /// misses its tolerance even at the finest sub-step, BlowupError as the other integrators.
+  /// Cost per Newton iteration: one force and one Jacobian evaluation and a CG solve; 2-5
+  /// iterations are usual. No allocation once the work arrays are sized.
   [[nodiscard]] StepReport step(System& sys, double h);
-  /// Newton iterations of the last step.
+  /// Newton iterations of the last step (all its sub-steps).
   [[nodiscard]] int last_newton_iterations() const { return newton_iterations_; }
+  /// Sub-steps the last step took (1 when Newton converged at h), and how many times its
+  /// finest sub-step was halved.
+  [[nodiscard]] int last_substeps() const { return substeps_; }
+  [[nodiscard]] int last_halvings() const { return finest_; }
   [[nodiscard]] ImplicitMidpointOptions& options() { return opt_; }
   /// Forgets the energy baseline.
   void reset() { watchdog_.reset(); }
@@ -72,15 +86,23 @@ class ImplicitMidpoint {
  private:
   // The one place a linear system is solved (A δ = b on the free axes, δ = 0 on fixed ones).
   CgResult solve(const BlockMatrix& A, std::span<const double> b, std::span<double> x);
+  // Advances by h, as two halves (recursively) if Newton fails at h. False if it failed at the
+  // finest sub-step (the state is then part-way: step() restores it).
+  bool advance(System& sys, double h, int depth, StepReport& rep);
+  // One midpoint step by Newton. False (state unchanged, failure_ set) if it did not converge.
+  bool attempt(System& sys, double h, StepReport& rep);
   // Replaces, in the force array, each spring's elastic force at x̄ by its discrete gradient.
   void discrete_gradient(System& sys, double h) const;
   void restore(NodeTable& nodes) const;
 
   ImplicitMidpointOptions opt_;
-  AlignedVector<double> x0_, v0_, dv_, r_, delta_, free_, precond_;
+  AlignedVector<double> x0_, v0_, dv_, r_, delta_, free_, precond_, x_start_, v_start_;
   CgWorkspace ws_;
   std::uint64_t steps_ = 0;
   int newton_iterations_ = 0;
+  int substeps_ = 0, finest_ = 0;
+  std::string failure_;  // why the last failed attempt failed
+  double failure_residual_ = 0.0;
   EnergyWatchdog watchdog_;
 };
 
