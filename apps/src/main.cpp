@@ -119,6 +119,9 @@ int cmd_run(const std::vector<std::string>& args) {
     std::printf("sewn: %s: %llu steps (%.4g s simulated) in %.3g s, %.3g ms/step, %u cut%s; %u frames in %s",
                 scene.name.c_str(), static_cast<unsigned long long>(s.steps), s.simulated, s.wall, s.ms_per_step, s.cuts,
                 s.cuts == 1 ? "" : "s", s.frames, s.out.string().c_str());
+    if (s.refined > 0 || s.coarsened > 0)
+      std::printf("; %llu elements refined, %llu families coarsened", static_cast<unsigned long long>(s.refined),
+                  static_cast<unsigned long long>(s.coarsened));
     if (!s.picture.empty()) std::printf(" (picture: %s)", s.picture.string().c_str());
     std::printf("\n");
   }

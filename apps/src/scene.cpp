@@ -2,6 +2,7 @@
 
 #include "sewn/physics/errors.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -9,6 +10,7 @@
 #include <sstream>
 
 #include "json_file.hpp"
+#include "sewn/apps/refine_keys.hpp"
 #include "sewn/io/render.hpp"
 
 namespace sewn::app {
@@ -20,6 +22,8 @@ constexpr double max_point_index = 4294967294.0;
 constexpr std::size_t max_name_length = 100;
 constexpr double default_memory_limit = 8e9;  // bytes
 constexpr double default_step_limit = 1e8;
+
+}  // namespace
 
 Field selector_schema(std::string key, std::string doc) {
   Field s = field(std::move(key), Kind::object);
@@ -38,6 +42,8 @@ Field selector_schema(std::string key, std::string doc) {
             {field("indices", Kind::number_list).required().whole().at_least(0).at_most(max_point_index).items(1, 1u << 30).doc("Point indices.")});
   return s;
 }
+
+namespace {
 
 Field build_schema() {
   Field material = field("material", Kind::object);
@@ -141,8 +147,8 @@ Field build_schema() {
   Field picture = field("picture", Kind::object);
   picture.doc("A PNG of the last frame.")
       .members({field("enabled", Kind::boolean).fallback(true).doc("Write it."),
-                field("color_by", Kind::string).one_of({"displacement", "speed", "force", "fixed", "material"})
-                    .fallback("displacement").doc("Per-point quantity shown by colour."),
+                field("color_by", Kind::string).one_of({"displacement", "speed", "force", "fixed", "material", "level"})
+                    .fallback("displacement").doc("Per-point quantity shown by colour (`level`: the finest refinement level index of the elements around the point)."),
                 field("style", Kind::string).one_of({"shaded", "wireframe"}).fallback("shaded").doc("Drawing style."),
                 field("width", Kind::integer).fallback(1280).at_least(io::min_render_width).at_most(8192).unit("px").doc("Width."),
                 field("height", Kind::integer).fallback(800).at_least(io::min_render_height).at_most(8192).unit("px").doc("Height.")});
@@ -156,7 +162,7 @@ Field build_schema() {
              "`energy_rises` counts the implicit steps so far that created energy (see `integrator.energy_rise_tolerance`), "
              "`inverted` the hexahedra and tetrahedra inverted in the frame (see `integrator.stop_on_inversion`). "
              "Then: `particles`, `springs`, `elements` alive; `steps` in the frame, `ms_per_step` (stepping only), "
-             "`cg_iterations_mean` and `_max` per step (implicit), `cuts` applied and `faces_cut` so far.")
+             "`cg_iterations_mean` and `_max` per step (implicit), `cuts` applied and `faces_cut` so far, elements `refined` (pre-refinement included) and families `coarsened` so far (`refinement`).")
       .fallback(nlohmann::json::object())
       .members({field("frames", Kind::integer).fallback(50).at_least(1).at_most(100000).doc("Output frames over the run (a ParaView .vtu each, plus frame 0)."),
                 field("vtu", Kind::boolean).fallback(true).doc("Write the ParaView series (.vtu per frame + .pvd)."),
@@ -226,33 +232,11 @@ Field build_schema() {
       field("duration", Kind::number).unit("s").fallback(1.0).above(0).at_most(1e6).doc("Simulated time."),
       field("cuts", Kind::array).of(cut).fallback(nlohmann::json::array()).doc("Scheduled cuts."),
       obstacles_schema(),
+      refinement_schema(),
       output,
       limits,
   });
   return root;
-}
-
-Selector read_selector(const nlohmann::json& j, const Field& schema) {
-  const std::string type = j.at("type").get<std::string>();
-  Reader r(j, schema, type);
-  Selector s;
-  if (type == "all") s.type = Selector::Type::all;
-  if (type == "box") {
-    s.type = Selector::Type::box;
-    s.min = r.vec3("min");
-    s.max = r.vec3("max");
-  } else if (type == "sphere") {
-    s.type = Selector::Type::sphere;
-    s.center = r.vec3("center");
-    s.radius = r.number("radius");
-  } else if (type == "tag") {
-    s.type = Selector::Type::tag;
-    s.tag = static_cast<int>(r.integer("tag"));
-  } else if (type == "points") {
-    s.type = Selector::Type::points;
-    for (const auto& x : r["indices"]) s.points.push_back(static_cast<std::uint32_t>(x.get<double>()));
-  }
-  return s;
 }
 
 std::array<bool, 3> read_axes(const std::string& a) {
@@ -344,8 +328,13 @@ void check_limits(const Scene& s, const nlohmann::json& limits_json, const Field
   double total = 0;
   std::size_t largest = 0;
   std::vector<MeshEstimate> est;
+  // pre-refinement splits each hexahedron 1:8 per level: counted as if it applied to every cell
+  double growth = 1;
+  for (const PreRefineSpec& p : s.refinement.pre_refine) growth = std::max(growth, std::pow(8.0, p.levels));
   for (std::size_t i = 0; i < s.meshes.size(); ++i) {
     est.push_back(estimate(s.meshes[i]));
+    est.back().bytes *= growth;
+    if (growth > 1) est.back().what += " x " + short_number(growth) + " (refinement.pre_refine)";
     total += est.back().bytes;
     if (est.back().bytes > est[largest].bytes) largest = i;
   }
@@ -364,6 +353,29 @@ void check_limits(const Scene& s, const nlohmann::json& limits_json, const Field
                          "; use a longer step or a shorter duration, or raise limits.steps");
 }
 }  // namespace
+
+Selector read_selector(const nlohmann::json& j, const Field& schema) {
+  const std::string type = j.at("type").get<std::string>();
+  Reader r(j, schema, type);
+  Selector s;
+  if (type == "all") s.type = Selector::Type::all;
+  if (type == "box") {
+    s.type = Selector::Type::box;
+    s.min = r.vec3("min");
+    s.max = r.vec3("max");
+  } else if (type == "sphere") {
+    s.type = Selector::Type::sphere;
+    s.center = r.vec3("center");
+    s.radius = r.number("radius");
+  } else if (type == "tag") {
+    s.type = Selector::Type::tag;
+    s.tag = static_cast<int>(r.integer("tag"));
+  } else if (type == "points") {
+    s.type = Selector::Type::points;
+    for (const auto& x : r["indices"]) s.points.push_back(static_cast<std::uint32_t>(x.get<double>()));
+  }
+  return s;
+}
 
 bool Selector::contains(const Vec3& p) const {
   switch (type) {
@@ -528,7 +540,9 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
   }
   s.duration = r.number("duration");
   if (s.step > s.duration) throw SceneError(file, "integrator.step", "is longer than the whole run (duration " + std::to_string(s.duration) + " s)");
+  if (r.has("refinement")) s.refinement = read_refinement(r["refinement"], *schema.member("refinement"), file);
   check_limits(s, r["limits"], *schema.member("limits"));
+  s.refinement.max_elements = Reader(r["limits"], *schema.member("limits")).number("memory") / bytes_per_hexahedron;
 
   const Field& cut_schema = *schema.member("cuts")->element_;
   for (std::size_t i = 0; i < r["cuts"].size(); ++i) {

@@ -24,6 +24,10 @@ set(expect_newton_cantilever     "189;80")   # backward Euler by Newton on the m
 set(expect_solid_cantilever      "189;480")  # the same beam as finite-element tetrahedra
 set(expect_shell_plate           "85;128")   # membranes and hinges on 16x4x2 triangles
 set(expect_obstacles_spike       "81;32")    # rigid obstacles: no cut
+# The 2014 paper's adaptive refinement, stopped once refinement has run (their ends cost minutes
+# under the sanitizers): counts = particles and live hexahedra the criterion has made by then.
+set(expect_refine_fig09_spike    "1421;884;0.25")  # 100 hexahedra, 112 of them refined by t = 0.25 s
+set(expect_refine_fig11_beam     "1045;744;0.5")   # 2 roots pre-refined to 16, then 104 of those and their children
 
 foreach(v SEWN SCENES WORK)
   if(NOT DEFINED ${v})

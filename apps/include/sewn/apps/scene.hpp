@@ -81,6 +81,35 @@ struct CutSpec {
   bool remove = true;                            // pierce: remove the freed volumes
 };
 
+/// One refinement criterion (docs/refinement.md): `diagonal_strain` (threshold, percent),
+/// `region` (where: box, sphere or all, at rest), `point` (point, radius) or `contact` (with the
+/// scene's obstacles).
+struct RefineCriterionSpec {
+  std::string type;
+  double threshold = 0;  // diagonal_strain, percent
+  Selector where;        // region
+  Vec3 point{};          // point
+  double radius = 0;     // point
+};
+
+/// Elements whose rest centroid is in `where`, refined `levels` times before the run.
+struct PreRefineSpec {
+  Selector where;
+  std::uint32_t levels = 1;
+};
+
+/// Hierarchical adaptive refinement during the run (the 2014 paper; `refinement` key).
+struct RefinementSpec {
+  bool enabled = false;  // the key is present
+  std::vector<RefineCriterionSpec> criteria;  // refine where any wants it
+  std::uint32_t max_level = 3;                // as an index, 1 + log2 of the level
+  std::vector<PreRefineSpec> pre_refine;
+  bool coarsen = false;
+  std::uint32_t calm_steps = 20;
+  std::string t_junctions = "reduction";  // or "paper_projection"
+  double max_elements = 0;  // live elements limits.memory allows (not a key: derived from it)
+};
+
 struct Scene {
   std::string file;  // where it was read from ("(default)" for the embedded scene)
   std::string name, description;
@@ -105,11 +134,17 @@ struct Scene {
   bool stop_on_inversion = false;       // check every step, stop at the first inverted element
   std::vector<CutSpec> cuts;
   std::vector<ObstacleSpec> obstacles;
+  RefinementSpec refinement;
   std::uint32_t frames = 50;
   bool write_vtu = true, write_csv = true, write_picture = true;
   std::string color_by = "displacement", style = "shaded";
   std::uint32_t width = 1280, height = 800;
 };
+
+/// The schema of a region key (`where`, `within`): all, box, sphere, tag or points.
+Field selector_schema(std::string key, std::string doc);
+/// Reads a validated region key.
+Selector read_selector(const nlohmann::json& j, const Field& schema);
 
 /// The schema of scene files (see docs/scenes.md, generated from it).
 const Field& scene_schema();
