@@ -11,13 +11,18 @@
 //       T-junction constraints rebuilt (coarsened back, untimed, between repetitions).
 //   refine/t_junctions/forces         the T-junction force distribution of one step on the
 //       adaptive 2-4 state (SlaveNodes::pass_forces: forces of slaves passed to their masters).
+//   The implicit cases also carry "top-edge error (mm)": after 10 000 implicit steps from rest
+//   (the paper's Fig. 11), the largest distance between the configuration's top-edge particles
+//   and the finest configuration's (refined x4; x3 at the small scale, with 2 000 steps).
 // Configurations (level index 1 + log2 l, the paper's "lvl."): coarse (2 hexahedra of level 1),
 // refined x3 (1024 of level 4) and x4 (8192 of level 5), built directly as grids (refining
 // uniformly gives the same model, tests/refine), and adaptive 2-3 / 2-4: the coarse beam refined
 // once (16 of level 2), then run 1000 steps (1 s) adapting after each (diagonal strain above
 // 1.2 %, the paper's threshold, at most one level per step, up to level 3 or 4).
 #include <cmath>
+#include <algorithm>
 #include <map>
+#include <stdexcept>
 #include <memory>
 #include <string>
 #include <vector>
@@ -39,6 +44,7 @@ using Vec3d = Eigen::Vector3d;
 
 constexpr double kE = 1e5, kNu = 0.3, kRho = 100, kG = -9.81, kH = 1e-3, kThreshold = 1.2;
 constexpr int kSettleSteps = 1000, kRestoreEvery = 50;
+constexpr int kAccuracySteps = 10000;  // the paper's Fig. 11: positions after 10 000 steps
 constexpr const char* kSuite = "refine";
 
 struct Config {
@@ -91,6 +97,48 @@ std::unique_ptr<MssModel<3>> build(const Config& c) {
 
 // Live elements per level index (a grid built directly at refined x k has level k + 1, as if
 // refined k times from the coarse beam), T-junctions, particles.
+// The top edge's particles (rest y = 0, z = 1: the paper's "upper particles" seen from the side),
+// rest x -> position, after kAccuracySteps implicit steps from rest (adaptive beams adapting
+// after each step, from the coarse beam refined once).
+std::map<double, Vec3d> top_edge_after_run(const Config& c) {
+  auto m = beam(c.uniform);
+  refine::RefineOptions ro;
+  ro.max_level = c.max_level;
+  if (c.max_level > 0) (void)refine::refine_all(*m, ro);
+  const refine::DiagonalStrain<3> strained(kThreshold);
+  physics::LinearlyImplicitEuler euler(implicit_options());
+  const int n = scale() == Scale::full ? kAccuracySteps : kAccuracySteps / 5;
+  for (int s = 0; s < n; ++s) {
+    (void)euler.step(m->system(), kH);
+    if (c.max_level > 0) (void)refine::adapt(*m, strained, ro);
+  }
+  std::map<double, Vec3d> edge;
+  for (Index i = 0; i < m->nodes().size(); ++i)
+    if (m->nodes().is_alive(i) && m->rest_position(i).y() == 0 && m->rest_position(i).z() == 1)
+      edge[m->rest_position(i).x()] = m->nodes().position(i);
+  return edge;
+}
+
+// The finest configuration of the scale: the reference of the accuracy rows.
+Config finest() { return scale() == Scale::full ? Config{"refined x4", 4, 0} : Config{"refined x3", 3, 0}; }
+
+// Largest distance, in mm, between a configuration's top-edge particles and the reference's at
+// the same rest place (every rest place of a coarser beam is one of the finest grid's), once per
+// configuration and process.
+double top_edge_error_mm(const Config& c) {
+  static std::map<std::string, double> cache;
+  static std::map<double, Vec3d> reference;
+  if (auto it = cache.find(c.name); it != cache.end()) return it->second;
+  if (reference.empty()) reference = top_edge_after_run(finest());
+  double worst = 0;
+  for (const auto& [x, p] : top_edge_after_run(c)) {
+    const auto r = reference.find(x);
+    if (r == reference.end()) throw std::logic_error("bench refine: rest x = " + std::to_string(x) + " is not a particle of the reference");
+    worst = std::max(worst, (p - r->second).norm());
+  }
+  return cache[c.name] = worst * 1e3;
+}
+
 void count(benchmark::State& st, const MssModel<3>& m, int uniform = 0) {
   std::map<int, int> per_level;
   for (const auto& e : m.elements())
@@ -164,6 +212,7 @@ void steps(benchmark::State& st, const Config& c, bool implicit) {
   }
   count(st, *m, c.uniform);
   st.counters["h (ms)"] = h * 1e3;
+  if (implicit && scale() != Scale::smoke) st.counters["top-edge error (mm)"] = top_edge_error_mm(c);
 }
 
 // One hexahedron of the settled adaptive 2-4 beam refined 1:8 (the first live one below level
