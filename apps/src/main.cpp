@@ -114,6 +114,10 @@ int cmd_run(const std::vector<std::string>& args) {
     }
   }
   const sewn::app::Scene scene = scene_path ? sewn::app::load_scene(*scene_path) : sewn::app::default_scene();
+  if (!scene.skip.empty()) {  // optional data absent: nothing is run or written (said even with --quiet)
+    std::fprintf(stderr, "sewn: %s: skipped: %s\n", scene.name.c_str(), scene.skip.c_str());
+    return ok;
+  }
   const sewn::app::RunSummary s = sewn::app::run(scene, opt);
   if (!opt.quiet) {
     std::printf("sewn: %s: %llu steps (%.4g s simulated) in %.3g s, %.3g ms/step, %u cut%s; %u frames in %s",

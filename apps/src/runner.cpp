@@ -21,6 +21,7 @@
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/read.hpp"
 #include "sewn/io/render.hpp"
+#include "sewn/io/surface.hpp"
 #include "sewn/io/write.hpp"
 #include "sewn/physics/integrate/energy_ledger.hpp"
 #include "sewn/physics/integrate/implicit_midpoint.hpp"
@@ -106,6 +107,9 @@ IndexedMesh generate(const MeshSpec& spec, const std::string& file, const std::s
     } catch (const MeshError& e) {
       throw SceneError(file, path + ".points", e.what());
     }
+  } else if (spec.type == "surface") {
+    m = io::voxelize(io::read_surface(spec.path), spec.cells[0], spec.path);
+    transform(m, spec.scale, spec.translate);
   } else if (spec.type == "file") {
     m = io::read_mesh(spec.path);
     // Gmsh and MEDIT files saved without physical groups repeat the faces and edges of volumes

@@ -109,6 +109,14 @@ Field build_schema() {
   mesh.variant("polyline", "A chain of segments (a rope of axial springs).",
                {field("points", Kind::array).of(field("point", Kind::vec3).unit("m")).items(2, 1u << 24).required()
                     .doc("The points, in order.")});
+  mesh.variant("surface",
+               "A closed surface mesh (OFF, OBJ or STL) voxelized into hexahedra: the cubes of a grid with `resolution` cells along the longest side of the surface's bounding box whose centres lie inside it (then scaled and moved).",
+               {field("path", Kind::string).required().doc("Path of the surface file, relative to the scene file."),
+                field("resolution", Kind::integer).required().at_least(1).at_most(1024).doc("Cells along the longest side of the bounding box."),
+                field("scale", Kind::number).fallback(1.0).above(0).doc("Factor applied to coordinates."),
+                field("translate", Kind::vec3).unit("m").fallback({0.0, 0.0, 0.0}).doc("Offset added after scaling."),
+                field("missing", Kind::string).one_of({"error", "skip"}).fallback("error")
+                    .doc("A missing file is an error, or (`skip`) makes `sewn run` skip the whole scene with a message and exit 0: for scenes whose data is optional (the 2014 paper's rabbit, from Debian's libcgal-demo).")});
   mesh.variant("file", "A mesh file.",
                {field("path", Kind::string).required().doc("Path of the file, relative to the scene file."),
                 field("scale", Kind::number).fallback(1.0).above(0).doc("Factor applied to coordinates."),
@@ -315,6 +323,8 @@ MeshEstimate estimate(const MeshSpec& m) {
       cells += static_cast<double>(b.hi[0] - b.lo[0]) * static_cast<double>(b.hi[1] - b.lo[1]) * static_cast<double>(b.hi[2] - b.lo[2]);
     return make(cells, bytes_per_hexahedron, "boxes", "the boxes' cells");
   }
+  if (m.type == "surface")  // at most the whole grid of cells³ (a cube's surface fills it)
+    return make(cx * cx * cx, bytes_per_hexahedron, "resolution", "up to " + short_number(cx) + "³");
   if (m.type == "polyline")
     return make(static_cast<double>(m.points.size()) - 1, bytes_per_segment, "points", "the segments");
   return {};
@@ -485,6 +495,16 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     }
     if (m.type == "polyline")
       for (const auto& p : mr["points"]) m.points.push_back({p[0].get<double>(), p[1].get<double>(), p[2].get<double>()});
+    if (m.type == "surface") {
+      const auto p = std::filesystem::path(mr.string("path"));
+      m.path = (p.is_absolute() || file == "(default)") ? p.string() : (base / p).string();
+      m.cells[0] = static_cast<std::uint32_t>(mr.integer("resolution"));
+      m.scale = mr.number("scale");
+      m.translate = mr.vec3("translate");
+      std::error_code ec;
+      if (mr.string("missing") == "skip" && !std::filesystem::exists(m.path, ec) && s.skip.empty())
+        s.skip = path + ".path: " + m.path + " is not present";
+    }
     if (m.type == "file") {
       const auto p = std::filesystem::path(mr.string("path"));
       m.path = (p.is_absolute() || file == "(default)") ? p.string() : (base / p).string();

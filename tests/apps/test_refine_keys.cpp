@@ -46,6 +46,14 @@ std::string run_refused(const json& j) {
   return "ran";
 }
 
+// The value of column `name` in a frames.csv row.
+double csv_value(const std::string& header, const std::string& row, const std::string& name) {
+  std::size_t col = 0, at = 0;
+  for (std::size_t p = 0; p < header.find(name); ++p) col += header[p] == ',';
+  for (std::size_t c = 0; c < col; ++c) at = row.find(',', at) + 1;
+  return std::stod(row.substr(at));
+}
+
 }  // namespace refine_keys_test
 
 using namespace refine_keys_test;
@@ -132,14 +140,50 @@ TEST_CASE("scene refinement: the Table 1 beam refined adaptively by the run") {
   while (std::getline(csv, row)) last = row;
   CHECK(header.find(",refined,coarsened") != std::string::npos);
   // the last frame's element count is 16 + 7 per refined child
-  const auto count = [&](int column) {
-    std::size_t at = 0;
-    for (int c = 0; c < column; ++c) at = last.find(',', at) + 1;
-    return std::stod(last.substr(at));
-  };
-  CHECK(count(12) == 16 + 7 * static_cast<double>(s.refined - 2));
+  CHECK(csv_value(header, last, "elements") == 16 + 7 * static_cast<double>(s.refined - 2));
 
   // without refinement, the same scene keeps its two elements
   json plain = beam_scene();
   CHECK(run(parse_scene(plain, "beam.json"), o).refined == 0);
+}
+
+TEST_CASE("scene surface meshes: voxelized, refined, and skipped when optional and absent") {
+  const auto dir = std::filesystem::temp_directory_path() / "sewn_refine_keys_surface";
+  std::filesystem::create_directories(dir);
+  {
+    // a 2 m x 1 m x 1 m box, its faces as quads (outward)
+    std::ofstream off(dir / "box.off");
+    off << "OFF\n8 6 0\n0 0 0\n2 0 0\n2 1 0\n0 1 0\n0 0 1\n2 0 1\n2 1 1\n0 1 1\n"
+           "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 2 3 7 6\n4 1 2 6 5\n4 0 4 7 3\n";
+  }
+  json j = beam_scene();
+  j["meshes"] = json::parse(R"([{"type": "surface", "material": "paper", "path": "box.off", "resolution": 4}])");
+  j["refinement"] = json::parse(R"({"pre_refine": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [0.5, 2, 2]}}]})");
+  j["duration"] = 0.002;
+  const Scene s = parse_scene(j, (dir / "scene.json").string());
+  CHECK(s.skip.empty());
+  CHECK(s.meshes[0].path == (dir / "box.off").string());
+  RunOptions o;
+  o.quiet = true;
+  o.out = dir / "out";
+  const RunSummary r = run(s, o);
+  CHECK(r.refined == 4);  // the 4 x 2 x 2 cubes of side 0.5 m: the 4 with x < 0.5 refined
+  std::ifstream csv(r.csv);
+  std::string header, row;
+  std::getline(csv, header);
+  std::getline(csv, row);
+  // 5 x 3 x 3 particles, of which the refined block 0.5 x 1 x 1 had 2 x 3 x 3, now 3 x 5 x 5
+  CHECK(csv_value(header, row, "particles") == 45 - 18 + 75);
+  CHECK(csv_value(header, row, "elements") == 16 - 4 + 32);
+  // a missing file: an error naming it, or a skipped scene when the scene says so
+  j["meshes"][0]["path"] = "none.off";
+  const Scene missing = parse_scene(j, (dir / "scene.json").string());
+  CHECK(missing.skip.empty());
+  CHECK_THROWS_WITH(run(missing, o), doctest::Contains("none.off: no such file"));
+  j["meshes"][0]["missing"] = "skip";
+  CHECK(parse_scene(j, (dir / "scene.json").string()).skip == "meshes[0].path: " + (dir / "none.off").string() + " is not present");
+  // the memory estimate counts the whole grid of resolution³ cells
+  j["meshes"][0]["resolution"] = 1024;
+  CHECK(refused(j).find("meshes[0].resolution: the scene needs about") == 0);
+  std::filesystem::remove_all(dir);
 }

@@ -41,7 +41,7 @@ struct LatticeBoxSpec {
 };
 
 struct MeshSpec {
-  std::string type;  // hex_grid, tet_grid, quad_grid, tri_grid, disc, cylinder, boxes, polyline, file
+  std::string type;  // hex_grid, tet_grid, quad_grid, tri_grid, disc, cylinder, boxes, polyline, surface, file
   std::string name;
   std::string material;
   std::vector<std::pair<Selector, std::string>> regions;  // later rules win
@@ -53,7 +53,7 @@ struct MeshSpec {
   std::uint32_t rings = 0, sectors = 0, layers = 0;
   std::vector<Vec3> points;  // polyline
   std::vector<LatticeBoxSpec> boxes;  // boxes (size holds the lattice spacing)
-  std::string path;          // file (resolved against the scene's folder)
+  std::string path;          // file, surface (resolved against the scene's folder); surface: cells[0] along the longest side
   double scale = 1;
   Vec3 translate{0, 0, 0};
 };
@@ -112,6 +112,7 @@ struct RefinementSpec {
 
 struct Scene {
   std::string file;  // where it was read from ("(default)" for the embedded scene)
+  std::string skip;  // why `sewn run` skips the scene ("" if it runs): optional data not present
   std::string name, description;
   std::map<std::string, MaterialSpec> materials;
   std::vector<MeshSpec> meshes;
