@@ -142,7 +142,7 @@ TEST_CASE("surface files and voxelization: bad input named") {
   Surface open = octahedron();
   open.triangles.pop_back();
   CHECK(message_of<SemanticError>([&] { (void)voxelize(open, 8, "open"); }).find("not closed") != std::string::npos);
-  // a slab 1 cm thick at 1 cell: the one centre, at z = 5 mm... of a 1 m cube cell, is outside
+  // a slab 1 cm thick at 1 cell: the one cell is a 1 m cube whose centre, at z = 0.5 m, is outside
   CHECK(message_of<SemanticError>([&] { (void)voxelize(read_surface(dir.write("slab.off", box_off(1, 1, 0.01))), 1, "slab"); })
             .find("no cell centre lies inside") != std::string::npos);
   CHECK(message_of<SemanticError>([&] { (void)voxelize(octahedron(), 0, "zero"); }).find("at least 1 cell") != std::string::npos);
