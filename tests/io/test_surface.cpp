@@ -117,7 +117,8 @@ TEST_CASE("surface files: OBJ and STL (ASCII, binary) of the same box voxelize t
     ascii += "endloop\nendfacet\n";
   }
   ascii += "endsolid box\n";
-  for (const auto& [name, text] : {std::pair{"box.obj", obj}, std::pair{"box_ascii.stl", ascii}, std::pair{"box_binary.stl", binary}}) {
+  for (const auto& file : {std::pair{"box.obj", obj}, std::pair{"box_ascii.stl", ascii}, std::pair{"box_binary.stl", binary}}) {
+    const std::string name = file.first, text = file.second;  // not a structured binding: clang 14 cannot capture one
     CAPTURE(name);
     const Surface s = read_surface(dir.write(name, text));
     CHECK(s.points.size() == 8);
