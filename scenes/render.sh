@@ -28,7 +28,12 @@ for scene in "${scenes[@]}"; do
   if [[ $name == default ]]; then
     build/release/apps/sewn run --out "out/$name" --quiet
   else
+    rm -f "out/$name/$name.png"
     build/release/apps/sewn run "$scene" --out "out/$name" --quiet
+  fi
+  if [[ ! -e "out/$name/$name.png" ]]; then  # skipped: its optional data is absent (scenes/fetch_data.sh)
+    printf '%-28s skipped\n' "$name"
+    continue
   fi
   cp "out/$name/$name.png" "docs/pictures/$name.png"
   ms=$((($(date +%s%N) - start) / 1000000))

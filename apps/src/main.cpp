@@ -122,11 +122,18 @@ int cmd_run(const std::vector<std::string>& args) {
     }
   }
   const sewn::app::Scene scene = scene_path ? sewn::app::load_scene(*scene_path) : sewn::app::default_scene();
+  if (!scene.skip.empty()) {  // optional data absent: nothing is run or written (said even with --quiet)
+    std::fprintf(stderr, "sewn: %s: skipped: %s\n", scene.name.c_str(), scene.skip.c_str());
+    return ok;
+  }
   const sewn::app::RunSummary s = sewn::app::run(scene, opt);
   if (!opt.quiet) {
     std::printf("sewn: %s: %llu steps (%.4g s simulated) in %.3g s, %.3g ms/step, %u cut%s; %u frames in %s",
                 scene.name.c_str(), static_cast<unsigned long long>(s.steps), s.simulated, s.wall, s.ms_per_step, s.cuts,
                 s.cuts == 1 ? "" : "s", s.frames, s.out.string().c_str());
+    if (s.refined > 0 || s.coarsened > 0)
+      std::printf("; %llu elements refined, %llu families coarsened", static_cast<unsigned long long>(s.refined),
+                  static_cast<unsigned long long>(s.coarsened));
     if (!s.picture.empty()) std::printf(" (picture: %s)", s.picture.string().c_str());
     if (s.substepped > 0)
       std::printf("; midpoint: Newton missed at h in %llu steps, taken in up to %d sub-steps each",

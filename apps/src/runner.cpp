@@ -22,6 +22,7 @@
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/read.hpp"
 #include "sewn/io/render.hpp"
+#include "sewn/io/surface.hpp"
 #include "sewn/io/write.hpp"
 #include "sewn/physics/integrate/energy_ledger.hpp"
 #include "sewn/physics/integrate/implicit_midpoint.hpp"
@@ -33,6 +34,8 @@
 #include "sewn/physics/split_boxes.hpp"
 #include "sewn/physics/stiffness.hpp"
 #include "sewn/refine/cut.hpp"
+#include "sewn/refine/hierarchy.hpp"
+#include "sewn/apps/refine_keys.hpp"
 
 namespace sewn::app {
 
@@ -106,6 +109,9 @@ IndexedMesh generate(const MeshSpec& spec, const std::string& file, const std::s
     } catch (const MeshError& e) {
       throw SceneError(file, path + ".points", e.what());
     }
+  } else if (spec.type == "surface") {
+    m = io::voxelize(io::read_surface(spec.path), spec.cells[0], spec.path);
+    transform(m, spec.scale, spec.translate);
   } else if (spec.type == "file") {
     m = io::read_mesh(spec.path);
     io::drop_unused_points(m);
@@ -129,7 +135,7 @@ CellType cell_type(ElementKind k) {
 // The current state as a mesh of the live elements, for writing and drawing.
 struct Snapshot {
   std::vector<Point3> points, velocity, force, displacement;
-  std::vector<double> speed, force_norm, displacement_norm, fixed_scalar, material_scalar;
+  std::vector<double> speed, force_norm, displacement_norm, fixed_scalar, material_scalar, level_scalar;
   std::vector<std::uint8_t> fixed;
   std::vector<CellType> types;
   std::vector<std::uint32_t> offsets{0}, conn;
@@ -140,7 +146,10 @@ struct Snapshot {
     *this = Snapshot{};
     const auto& n = m.nodes();
     for (Index i = 0; i < n.size(); ++i) {
-      const Vec3d x = n.position(i), v = n.velocity(i), f = n.force(i), u = x - m.rest_position(i);
+      // a slot a coarsening emptied keeps its place (cells index points by slot), inert at rest
+      const bool alive = n.is_alive(i);
+      const Vec3d x = alive ? n.position(i) : m.rest_position(i), v = alive ? n.velocity(i) : Vec3d::Zero(),
+                  f = alive ? n.force(i) : Vec3d::Zero(), u = x - m.rest_position(i);
       points.push_back({x.x(), x.y(), x.z()});
       velocity.push_back({v.x(), v.y(), v.z()});
       force.push_back({f.x(), f.y(), f.z()});
@@ -148,21 +157,24 @@ struct Snapshot {
       speed.push_back(v.norm());
       force_norm.push_back(f.norm());
       displacement_norm.push_back(u.norm());
-      fixed.push_back(n.fixed(i));
-      fixed_scalar.push_back(n.fixed(i) ? 1.0 : 0.0);
+      fixed.push_back(alive ? n.fixed(i) : physics::no_axes);
+      fixed_scalar.push_back(alive && n.fixed(i) ? 1.0 : 0.0);
       material_scalar.push_back(0.0);
+      level_scalar.push_back(1.0);  // a root's level index; points of no live element keep it
     }
     for (Index e = 0; e < m.elements().size(); ++e) {
       const auto& el = m.elements()[e];
       if (!el.alive) continue;
       types.push_back(cell_type(el.kind));
+      const int index = refine::level_index(el.level);
       for (Index q : m.element_nodes(e)) {
         conn.push_back(q);
         material_scalar[q] = el.material;
+        level_scalar[q] = std::max(level_scalar[q], static_cast<double>(index));
       }
       offsets.push_back(static_cast<std::uint32_t>(conn.size()));
       material.push_back(static_cast<std::int32_t>(el.material));
-      level.push_back(0);  // refinement level: every element is a root element until refinement lands
+      level.push_back(index);
       mesh_cell.push_back(static_cast<std::int32_t>(el.mesh_cell));
       element.push_back(e);
     }
@@ -454,6 +466,8 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
       model->nodes().set_velocity(i, v);
     }
   }
+  std::unique_ptr<RefinementRun> refinement;
+  if (scene.refinement.enabled) refinement = std::make_unique<RefinementRun>(scene, *model);
 
   // 3) time line: steps, frames and scheduled cuts
   const double h = scene.step;
@@ -479,7 +493,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
           sum.csv, std::vector<std::string>{"frame", "time", "kinetic_energy", "elastic_energy", "gravity_energy",
                                             "total_energy", "external_work", "dissipated", "energy_rises", "inverted",
                                             "particles", "springs", "elements", "steps", "ms_per_step",
-                                            "cg_iterations_mean", "cg_iterations_max", "cuts", "faces_cut"});
+                                            "cg_iterations_mean", "cg_iterations_max", "cuts", "faces_cut", "refined", "coarsened"});
     });
   }
   // Energy balance of every frame; each implicit step is checked for energy it created (the
@@ -542,7 +556,8 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
                 static_cast<double>(model->springs().num_alive()), static_cast<double>(elements),
                 static_cast<double>(frame_steps), frame_steps ? frame_ms / static_cast<double>(frame_steps) : 0.0,
                 frame_steps ? frame_cg_sum / static_cast<double>(frame_steps) : 0.0, static_cast<double>(frame_cg_max),
-                static_cast<double>(sum.cuts), static_cast<double>(sum.faces_cut)}); });
+                static_cast<double>(sum.cuts), static_cast<double>(sum.faces_cut),
+                static_cast<double>(refinement ? refinement->refined() : 0), static_cast<double>(refinement ? refinement->coarsened() : 0)}); });
     }
     ++frame;
     frame_ms = frame_cg_sum = 0;
@@ -651,6 +666,13 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
         sum.first_energy_rise = msg;
         if (!options.quiet) std::fprintf(stderr, "%ssewn: warning: %s\n", bar ? "\n" : "", msg);
       }
+    // Refinement changes the elastic energy (new springs at their rest lengths under load) and
+    // coarsening dissipates the fine motion: after the step's energy check, the ledger restarts.
+    if (refinement) {
+      const auto r0 = Clock::now();
+      if (refinement->after_step(*model, static_cast<double>(s + 1) * h)) ledger.rebase(model->system());
+      frame_ms += std::chrono::duration<double, std::milli>(Clock::now() - r0).count();
+    }
     sum.kinetic_max = std::max(sum.kinetic_max, model->system().kinetic_energy());
     // frame f is written after step round(f · steps / frames)
     const auto due = static_cast<std::uint64_t>(std::llround(static_cast<double>(frame) * static_cast<double>(steps) / frames));
@@ -674,6 +696,10 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   sum.kinetic_end = model->system().kinetic_energy();
   if (csv) writing([&] { csv->flush(); });
   sum.energy_rises = ledger.rises();
+  if (refinement) {
+    sum.refined = refinement->refined();
+    sum.coarsened = refinement->coarsened();
+  }
 
   // 6) the picture of the last frame
   if (scene.write_picture) {
@@ -684,6 +710,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     if (scene.color_by == "force") scalar = &snap.force_norm, label = "|force| [N]";
     if (scene.color_by == "fixed") scalar = &snap.fixed_scalar, label = "fixed";
     if (scene.color_by == "material") scalar = &snap.material_scalar, label = "material";
+    if (scene.color_by == "level") scalar = &snap.level_scalar, label = "refinement level";
     io::RenderOptions ro;
     ro.width = static_cast<int>(scene.width);
     ro.height = static_cast<int>(scene.height);

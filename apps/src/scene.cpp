@@ -2,6 +2,7 @@
 
 #include "sewn/physics/errors.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -9,6 +10,7 @@
 #include <sstream>
 
 #include "json_file.hpp"
+#include "sewn/apps/refine_keys.hpp"
 #include "sewn/io/render.hpp"
 
 namespace sewn::app {
@@ -20,6 +22,8 @@ constexpr double max_point_index = 4294967294.0;
 constexpr std::size_t max_name_length = 100;
 constexpr double default_memory_limit = 8e9;  // bytes
 constexpr double default_step_limit = 1e8;
+
+}  // namespace
 
 Field selector_schema(std::string key, std::string doc) {
   Field s = field(std::move(key), Kind::object);
@@ -38,6 +42,8 @@ Field selector_schema(std::string key, std::string doc) {
             {field("indices", Kind::number_list).required().whole().at_least(0).at_most(max_point_index).items(1, 1u << 30).doc("Point indices.")});
   return s;
 }
+
+namespace {
 
 Field build_schema() {
   Field material = field("material", Kind::object);
@@ -105,6 +111,14 @@ Field build_schema() {
   mesh.variant("polyline", "A chain of segments (a rope of axial springs).",
                {field("points", Kind::array).of(field("point", Kind::vec3).unit("m")).items(2, 1u << 24).required()
                     .doc("The points, in order.")});
+  mesh.variant("surface",
+               "A closed surface mesh (OFF, OBJ or STL) voxelized into hexahedra: the cubes of a grid with `resolution` cells along the longest side of the surface's bounding box whose centres lie inside it (then scaled and moved).",
+               {field("path", Kind::string).required().doc("Path of the surface file, relative to the scene file."),
+                field("resolution", Kind::integer).required().at_least(1).at_most(1024).doc("Cells along the longest side of the bounding box."),
+                field("scale", Kind::number).fallback(1.0).above(0).doc("Factor applied to coordinates."),
+                field("translate", Kind::vec3).unit("m").fallback({0.0, 0.0, 0.0}).doc("Offset added after scaling."),
+                field("missing", Kind::string).one_of({"error", "skip"}).fallback("error")
+                    .doc("A missing file is an error, or (`skip`) makes `sewn run` skip the whole scene with a message and exit 0: for scenes whose data is optional (the 2014 paper's rabbit, from Debian's libcgal-demo).")});
   mesh.variant("file", "A mesh file.",
                {field("path", Kind::string).required().doc("Path of the file, relative to the scene file."),
                 field("scale", Kind::number).fallback(1.0).above(0).doc("Factor applied to coordinates."),
@@ -143,8 +157,8 @@ Field build_schema() {
   Field picture = field("picture", Kind::object);
   picture.doc("A PNG of the last frame.")
       .members({field("enabled", Kind::boolean).fallback(true).doc("Write it."),
-                field("color_by", Kind::string).one_of({"displacement", "speed", "force", "fixed", "material"})
-                    .fallback("displacement").doc("Per-point quantity shown by colour."),
+                field("color_by", Kind::string).one_of({"displacement", "speed", "force", "fixed", "material", "level"})
+                    .fallback("displacement").doc("Per-point quantity shown by colour (`level`: the finest refinement level index of the elements around the point)."),
                 field("style", Kind::string).one_of({"shaded", "wireframe"}).fallback("shaded").doc("Drawing style."),
                 field("width", Kind::integer).fallback(1280).at_least(io::min_render_width).at_most(8192).unit("px").doc("Width."),
                 field("height", Kind::integer).fallback(800).at_least(io::min_render_height).at_most(8192).unit("px").doc("Height.")});
@@ -158,7 +172,7 @@ Field build_schema() {
              "`energy_rises` counts the implicit steps so far that created energy (see `integrator.energy_rise_tolerance`), "
              "`inverted` the hexahedra and tetrahedra inverted in the frame (see `integrator.stop_on_inversion`). "
              "Then: `particles`, `springs`, `elements` alive; `steps` in the frame, `ms_per_step` (stepping only), "
-             "`cg_iterations_mean` and `_max` per step (implicit), `cuts` applied and `faces_cut` so far.")
+             "`cg_iterations_mean` and `_max` per step (implicit), `cuts` applied and `faces_cut` so far, elements `refined` (pre-refinement included) and families `coarsened` so far (`refinement`).")
       .fallback(nlohmann::json::object())
       .members({field("frames", Kind::integer).fallback(50).at_least(1).at_most(100000).doc("Output frames over the run (a ParaView .vtu each, plus frame 0)."),
                 field("vtu", Kind::boolean).fallback(true).doc("Write the ParaView series (.vtu per frame + .pvd)."),
@@ -239,33 +253,11 @@ Field build_schema() {
       field("duration", Kind::number).unit("s").fallback(1.0).above(0).at_most(1e6).doc("Simulated time."),
       field("cuts", Kind::array).of(cut).fallback(nlohmann::json::array()).doc("Scheduled cuts."),
       obstacles_schema(),
+      refinement_schema(),
       output,
       limits,
   });
   return root;
-}
-
-Selector read_selector(const nlohmann::json& j, const Field& schema) {
-  const std::string type = j.at("type").get<std::string>();
-  Reader r(j, schema, type);
-  Selector s;
-  if (type == "all") s.type = Selector::Type::all;
-  if (type == "box") {
-    s.type = Selector::Type::box;
-    s.min = r.vec3("min");
-    s.max = r.vec3("max");
-  } else if (type == "sphere") {
-    s.type = Selector::Type::sphere;
-    s.center = r.vec3("center");
-    s.radius = r.number("radius");
-  } else if (type == "tag") {
-    s.type = Selector::Type::tag;
-    s.tag = static_cast<int>(r.integer("tag"));
-  } else if (type == "points") {
-    s.type = Selector::Type::points;
-    for (const auto& x : r["indices"]) s.points.push_back(static_cast<std::uint32_t>(x.get<double>()));
-  }
-  return s;
 }
 
 std::array<bool, 3> read_axes(const std::string& a) {
@@ -344,6 +336,8 @@ MeshEstimate estimate(const MeshSpec& m) {
       cells += static_cast<double>(b.hi[0] - b.lo[0]) * static_cast<double>(b.hi[1] - b.lo[1]) * static_cast<double>(b.hi[2] - b.lo[2]);
     return make(cells, bytes_per_hexahedron, "boxes", "the boxes' cells");
   }
+  if (m.type == "surface")  // at most the whole grid of cells³ (a cube's surface fills it)
+    return make(cx * cx * cx, bytes_per_hexahedron, "resolution", "up to " + short_number(cx) + "³");
   if (m.type == "polyline")
     return make(static_cast<double>(m.points.size()) - 1, bytes_per_segment, "points", "the segments");
   return {};
@@ -357,8 +351,13 @@ void check_limits(const Scene& s, const nlohmann::json& limits_json, const Field
   double total = 0;
   std::size_t largest = 0;
   std::vector<MeshEstimate> est;
+  // pre-refinement splits each hexahedron 1:8 per level: counted as if it applied to every cell
+  double growth = 1;
+  for (const PreRefineSpec& p : s.refinement.pre_refine) growth = std::max(growth, std::pow(8.0, p.levels));
   for (std::size_t i = 0; i < s.meshes.size(); ++i) {
     est.push_back(estimate(s.meshes[i]));
+    est.back().bytes *= growth;
+    if (growth > 1) est.back().what += " x " + short_number(growth) + " (refinement.pre_refine)";
     total += est.back().bytes;
     if (est.back().bytes > est[largest].bytes) largest = i;
   }
@@ -377,6 +376,29 @@ void check_limits(const Scene& s, const nlohmann::json& limits_json, const Field
                          "; use a longer step or a shorter duration, or raise limits.steps");
 }
 }  // namespace
+
+Selector read_selector(const nlohmann::json& j, const Field& schema) {
+  const std::string type = j.at("type").get<std::string>();
+  Reader r(j, schema, type);
+  Selector s;
+  if (type == "all") s.type = Selector::Type::all;
+  if (type == "box") {
+    s.type = Selector::Type::box;
+    s.min = r.vec3("min");
+    s.max = r.vec3("max");
+  } else if (type == "sphere") {
+    s.type = Selector::Type::sphere;
+    s.center = r.vec3("center");
+    s.radius = r.number("radius");
+  } else if (type == "tag") {
+    s.type = Selector::Type::tag;
+    s.tag = static_cast<int>(r.integer("tag"));
+  } else if (type == "points") {
+    s.type = Selector::Type::points;
+    for (const auto& x : r["indices"]) s.points.push_back(static_cast<std::uint32_t>(x.get<double>()));
+  }
+  return s;
+}
 
 bool Selector::contains(const Vec3& p) const {
   switch (type) {
@@ -487,6 +509,16 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     }
     if (m.type == "polyline")
       for (const auto& p : mr["points"]) m.points.push_back({p[0].get<double>(), p[1].get<double>(), p[2].get<double>()});
+    if (m.type == "surface") {
+      const auto p = std::filesystem::path(mr.string("path"));
+      m.path = (p.is_absolute() || file == "(default)") ? p.string() : (base / p).string();
+      m.cells[0] = static_cast<std::uint32_t>(mr.integer("resolution"));
+      m.scale = mr.number("scale");
+      m.translate = mr.vec3("translate");
+      std::error_code ec;
+      if (mr.string("missing") == "skip" && !std::filesystem::exists(m.path, ec) && s.skip.empty())
+        s.skip = path + ".path: " + m.path + " is not present";
+    }
     if (m.type == "file") {
       const auto p = std::filesystem::path(mr.string("path"));
       m.path = (p.is_absolute() || file == "(default)") ? p.string() : (base / p).string();
@@ -561,7 +593,9 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
   }
   s.duration = r.number("duration");
   if (s.step > s.duration) throw SceneError(file, "integrator.step", "is longer than the whole run (duration " + std::to_string(s.duration) + " s)");
+  if (r.has("refinement")) s.refinement = read_refinement(r["refinement"], *schema.member("refinement"), file);
   check_limits(s, r["limits"], *schema.member("limits"));
+  s.refinement.max_elements = Reader(r["limits"], *schema.member("limits")).number("memory") / bytes_per_hexahedron;
 
   const Field& cut_schema = *schema.member("cuts")->element_;
   for (std::size_t i = 0; i < r["cuts"].size(); ++i) {

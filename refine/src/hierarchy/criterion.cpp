@@ -48,6 +48,10 @@ RefineReport adapt(MssModel<D>& m, const Criterion<D>& criterion, const RefineOp
     if (el.alive && el.kind == regular && level_index(el.level) < options.max_level && criterion.wants_refinement(m, e))
       chosen.push_back(e);
   }
+  const std::uint64_t after = m.num_live_elements() + (D == 2 ? 3 : 7) * std::uint64_t{chosen.size()};
+  if (after > options.max_elements)
+    throw physics::InputError("adaptive refinement: refining the " + std::to_string(chosen.size()) + " elements the criterion picks would leave " +
+                              std::to_string(after) + " live elements, more than the limit of " + std::to_string(options.max_elements));
   return refine_elements(m, std::span<const Index>(chosen), options);
 }
 

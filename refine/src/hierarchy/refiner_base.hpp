@@ -24,9 +24,12 @@ class RefinerBase {
   using Index = physics::Index;
 
   /// Rest position, position and velocity of the mean of the given particles: the multilinear
-  /// interpolation at the centre of the edge, face or cell they are the corners of.
+  /// interpolation at the centre of the edge, face or cell they are the corners of. An axis
+  /// held on every corner is held on the new particle too: a clamped side or face stays clamped
+  /// along its whole extent once refined, instead of gaining free particles in its middle.
   struct State {
     Vec3 rest = Vec3::Zero(), x = Vec3::Zero(), v = Vec3::Zero();
+    physics::AxisMask fixed = physics::all_axes;
   };
   State mean(std::span<const Index> corners) const {
     State s;
@@ -35,6 +38,7 @@ class RefinerBase {
       s.rest += w * m_.rest_position(n);
       s.x += w * m_.nodes().position(n);
       s.v += w * m_.nodes().velocity(n);
+      s.fixed &= m_.nodes().fixed(n);
     }
     return s;
   }
@@ -46,6 +50,10 @@ class RefinerBase {
   Dart insert_vertex(Dart d, const State& s, std::uint32_t half_level) {
     const DartList around = map_.template cell<1>(d);
     const Index n = A::add_node(m_, s.rest, s.x, s.v);
+    if (s.fixed != physics::no_axes) {
+      m_.nodes().fix(n, s.fixed);
+      m_.nodes().set_velocity(n, s.v);  // fix() zeroes held axes; a kinematic side keeps its motion
+    }
     const Dart nd = map_.insert_vertex_in_edge(d, physics::NodeRef{n});
     A::grow_darts(m_);
     A::link_vertex(m_, n, nd);

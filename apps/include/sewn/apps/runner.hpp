@@ -73,6 +73,8 @@ struct RunSummary {
   std::uint32_t frames = 0;         ///< frames written, frame 0 included
   std::uint32_t cuts = 0;           ///< scheduled cuts applied
   std::uint32_t faces_cut = 0;      ///< facets those cuts unsewed
+  std::uint64_t refined = 0;        ///< elements refined (pre-refinement included)
+  std::uint64_t coarsened = 0;      ///< families merged back into their parent
   double simulated = 0;             ///< s
   double wall = 0;                  ///< s, stepping and cuts (output excluded)
   double ms_per_step = 0;

@@ -42,7 +42,7 @@ struct LatticeBoxSpec {
 };
 
 struct MeshSpec {
-  std::string type;  // hex_grid, tet_grid, quad_grid, tri_grid, disc, cylinder, boxes, polyline, file
+  std::string type;  // hex_grid, tet_grid, quad_grid, tri_grid, disc, cylinder, boxes, polyline, surface, file
   std::string name;
   std::string material;
   std::vector<std::pair<Selector, std::string>> regions;  // later rules win
@@ -54,7 +54,7 @@ struct MeshSpec {
   std::uint32_t rings = 0, sectors = 0, layers = 0;
   std::vector<Vec3> points;  // polyline
   std::vector<LatticeBoxSpec> boxes;  // boxes (size holds the lattice spacing)
-  std::string path;          // file (resolved against the scene's folder)
+  std::string path;          // file, surface (resolved against the scene's folder); surface: cells[0] along the longest side
   double scale = 1;
   Vec3 translate{0, 0, 0};
 };
@@ -89,8 +89,38 @@ struct ModelGroup {
   std::array<double, 2> semi_axes{};  // rod section (a = b: circular); 0: from the material's area
 };
 
+/// One refinement criterion (docs/refinement.md): `diagonal_strain` (threshold, percent),
+/// `region` (where: box, sphere or all, at rest), `point` (point, radius) or `contact` (with the
+/// scene's obstacles).
+struct RefineCriterionSpec {
+  std::string type;
+  double threshold = 0;  // diagonal_strain, percent
+  Selector where;        // region
+  Vec3 point{};          // point
+  double radius = 0;     // point
+};
+
+/// Elements whose rest centroid is in `where`, refined `levels` times before the run.
+struct PreRefineSpec {
+  Selector where;
+  std::uint32_t levels = 1;
+};
+
+/// Hierarchical adaptive refinement during the run (the 2014 paper; `refinement` key).
+struct RefinementSpec {
+  bool enabled = false;  // the key is present
+  std::vector<RefineCriterionSpec> criteria;  // refine where any wants it
+  std::uint32_t max_level = 3;                // as an index, 1 + log2 of the level
+  std::vector<PreRefineSpec> pre_refine;
+  bool coarsen = false;
+  std::uint32_t calm_steps = 20;
+  std::string t_junctions = "reduction";  // or "paper_projection"
+  double max_elements = 0;  // live elements limits.memory allows (not a key: derived from it)
+};
+
 struct Scene {
   std::string file;  // where it was read from ("(default)" for the embedded scene)
+  std::string skip;  // why `sewn run` skips the scene ("" if it runs): optional data not present
   std::string name, description;
   std::map<std::string, MaterialSpec> materials;
   std::vector<MeshSpec> meshes;
@@ -114,11 +144,17 @@ struct Scene {
   bool stop_on_inversion = false;       // check every step, stop at the first inverted element
   std::vector<CutSpec> cuts;
   std::vector<ObstacleSpec> obstacles;
+  RefinementSpec refinement;
   std::uint32_t frames = 50;
   bool write_vtu = true, write_csv = true, write_picture = true;
   std::string color_by = "displacement", style = "shaded";
   std::uint32_t width = 1280, height = 800;
 };
+
+/// The schema of a region key (`where`, `within`): all, box, sphere, tag or points.
+Field selector_schema(std::string key, std::string doc);
+/// Reads a validated region key.
+Selector read_selector(const nlohmann::json& j, const Field& schema);
 
 /// The schema of scene files (see docs/scenes.md, generated from it).
 const Field& scene_schema();

@@ -42,8 +42,9 @@ class DiagonalStrain : public Criterion<D> {
 };
 
 /// Refines, once each, the live quads (2-maps) or hexahedra (3-maps) the criterion wants,
-/// skipping those whose children would pass options.max_level. O(elements · criterion) plus
-/// the refinements.
+/// skipping those whose children would pass options.max_level. Throws physics::InputError, the
+/// model unchanged, if the pass would leave more than options.max_elements live elements.
+/// O(elements · criterion) plus the refinements.
 template <int D>
 RefineReport adapt(MssModel<D>& m, const Criterion<D>& criterion, const RefineOptions& options = {});
 

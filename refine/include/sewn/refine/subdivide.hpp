@@ -25,6 +25,9 @@ using physics::MssModel;
 
 struct RefineOptions {
   int max_level = 6;  ///< the finest level allowed, as an index (1 + log2 l): 6 is l = 32
+  /// adapt() refuses a pass that would leave more live elements than this (a bound on memory:
+  /// an adaptive run whose criterion keeps firing would otherwise grow until memory runs out).
+  std::uint64_t max_elements = std::uint64_t{1} << 32;
 };
 
 /// What a refinement changed.

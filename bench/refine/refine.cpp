@@ -1,0 +1,265 @@
+// bench_refine (issue 13): the 2014 paper's Table 1. Cases, all "ours" (no peer yet):
+//   refine/table1/<config>/implicit   ms per step of the beam of Table 1 (two 1 m hexahedra side
+//       by side, 2 m x 1 m x 1 m, E = 100 kPa, nu = 0.3, rho = 100, g = 9.81, per-spring viscous
+//       damping, clamped at x = 0), linearly implicit Euler, h = 1 ms, CG to 1e-6 (block-Jacobi,
+//       the solver layer's best backend here); an adaptive configuration's step includes its
+//       criterion pass (adapt(): any refinement it makes is timed too). Counters: live elements
+//       per level index ("lvl<k> elements"), T-junctions, particles.
+//   refine/table1/<config>/semi       the same state stepped by the semi-implicit (symplectic)
+//       Euler at 0.9x the system's stable-step bound, with the criterion pass.
+//   refine/subdivision/hex            one hexahedron of the settled adaptive 2-4 beam refined 1:8,
+//       T-junction constraints rebuilt (coarsened back, untimed, between repetitions).
+//   refine/t_junctions/forces         the T-junction force distribution of one step on the
+//       adaptive 2-4 state (SlaveNodes::pass_forces: forces of slaves passed to their masters).
+//   The implicit cases also carry "top-edge error (mm)": after 10 000 implicit steps from rest
+//   (the paper's Fig. 11), the largest distance between the configuration's top-edge particles
+//   and the finest configuration's (refined x4; x3 at the small scale, with 2 000 steps).
+// Configurations (level index 1 + log2 l, the paper's "lvl."): coarse (2 hexahedra of level 1),
+// refined x3 (1024 of level 4) and x4 (8192 of level 5), built directly as grids (refining
+// uniformly gives the same model, tests/refine), and adaptive 2-3 / 2-4: the coarse beam refined
+// once (16 of level 2), then run 1000 steps (1 s) adapting after each (diagonal strain above
+// 1.2 %, the paper's threshold, at most one level per step, up to level 3 or 4).
+#include <cmath>
+#include <algorithm>
+#include <map>
+#include <stdexcept>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sewn/physics/integrators.hpp"
+#include "sewn/physics/mss_model.hpp"
+#include "sewn/refine/coarsen.hpp"
+#include "sewn/refine/criterion.hpp"
+#include "sewn/refine/hierarchy.hpp"
+#include "sewn/refine/subdivide.hpp"
+#include "sewn_bench.hpp"
+
+namespace sewn::bench::refine_suite {
+namespace {
+
+using physics::Index;
+using physics::MssModel;
+using Vec3d = Eigen::Vector3d;
+
+constexpr double kE = 1e5, kNu = 0.3, kRho = 100, kG = -9.81, kH = 1e-3, kThreshold = 1.2;
+constexpr int kSettleSteps = 1000, kRestoreEvery = 50;
+constexpr int kAccuracySteps = 10000;  // the paper's Fig. 11: positions after 10 000 steps
+constexpr const char* kSuite = "refine";
+
+struct Config {
+  std::string name;
+  int uniform = 0;      // refined x uniform, built directly (adaptive: 0)
+  int max_level = 0;    // adaptive: the finest level index (0: not adaptive)
+};
+
+std::unique_ptr<MssModel<3>> beam(int refined) {
+  const std::uint32_t n = 1u << refined;
+  const double a = 1.0 / n;
+  physics::MaterialParams mat;
+  mat.young = kE;
+  mat.poisson = kNu;
+  mat.density = kRho;
+  physics::MssOptions opt;
+  opt.damping = physics::DampingModel::viscous;
+  opt.gravity = Vec3d(0, 0, kG);
+  opt.source = "table1 beam";
+  auto m = std::make_unique<MssModel<3>>(hex_grid(2 * n, n, n, {{a, a, a}, {0, 0, 0}}), std::vector<physics::MaterialParams>{mat},
+                                         std::vector<std::uint32_t>{}, opt);
+  for (Index i = 0; i < m->nodes().size(); ++i)
+    if (m->rest_position(i).x() == 0) m->nodes().fix(i);
+  return m;
+}
+
+physics::ImplicitEulerOptions implicit_options() {
+  physics::ImplicitEulerOptions o;
+  o.solver = physics::solve::Backend::jacobi;
+  o.cg_tolerance = 1e-6;
+  return o;
+}
+
+// The configuration's model in its measured state: uniform grids at rest, adaptive beams after
+// their settling run.
+std::unique_ptr<MssModel<3>> build(const Config& c) {
+  if (c.max_level == 0) return beam(c.uniform);
+  auto m = beam(0);
+  refine::RefineOptions ro;
+  ro.max_level = c.max_level;
+  (void)refine::refine_all(*m, ro);
+  const refine::DiagonalStrain<3> strained(kThreshold);
+  physics::LinearlyImplicitEuler euler(implicit_options());
+  for (int s = 0; s < kSettleSteps; ++s) {
+    (void)euler.step(m->system(), kH);
+    (void)refine::adapt(*m, strained, ro);
+  }
+  return m;
+}
+
+// Live elements per level index (a grid built directly at refined x k has level k + 1, as if
+// refined k times from the coarse beam), T-junctions, particles.
+// The top edge's particles (rest y = 0, z = 1: the paper's "upper particles" seen from the side),
+// rest x -> position, after kAccuracySteps implicit steps from rest (adaptive beams adapting
+// after each step, from the coarse beam refined once).
+std::map<double, Vec3d> top_edge_after_run(const Config& c) {
+  auto m = beam(c.uniform);
+  refine::RefineOptions ro;
+  ro.max_level = c.max_level;
+  if (c.max_level > 0) (void)refine::refine_all(*m, ro);
+  const refine::DiagonalStrain<3> strained(kThreshold);
+  physics::LinearlyImplicitEuler euler(implicit_options());
+  const int n = scale() == Scale::full ? kAccuracySteps : kAccuracySteps / 5;
+  for (int s = 0; s < n; ++s) {
+    (void)euler.step(m->system(), kH);
+    if (c.max_level > 0) (void)refine::adapt(*m, strained, ro);
+  }
+  std::map<double, Vec3d> edge;
+  for (Index i = 0; i < m->nodes().size(); ++i)
+    if (m->nodes().is_alive(i) && m->rest_position(i).y() == 0 && m->rest_position(i).z() == 1)
+      edge[m->rest_position(i).x()] = m->nodes().position(i);
+  return edge;
+}
+
+// The finest configuration of the scale: the reference of the accuracy rows.
+Config finest() { return scale() == Scale::full ? Config{"refined x4", 4, 0} : Config{"refined x3", 3, 0}; }
+
+// Largest distance, in mm, between a configuration's top-edge particles and the reference's at
+// the same rest place (every rest place of a coarser beam is one of the finest grid's), once per
+// configuration and process.
+double top_edge_error_mm(const Config& c) {
+  static std::map<std::string, double> cache;
+  static std::map<double, Vec3d> reference;
+  if (auto it = cache.find(c.name); it != cache.end()) return it->second;
+  if (reference.empty()) reference = top_edge_after_run(finest());
+  double worst = 0;
+  for (const auto& [x, p] : top_edge_after_run(c)) {
+    const auto r = reference.find(x);
+    if (r == reference.end()) throw std::logic_error("bench refine: rest x = " + std::to_string(x) + " is not a particle of the reference");
+    worst = std::max(worst, (p - r->second).norm());
+  }
+  return cache[c.name] = worst * 1e3;
+}
+
+void count(benchmark::State& st, const MssModel<3>& m, int uniform = 0) {
+  std::map<int, int> per_level;
+  for (const auto& e : m.elements())
+    if (e.alive) ++per_level[refine::level_index(e.level) + uniform];
+  for (const auto& [level, n] : per_level) st.counters["lvl" + std::to_string(level) + " elements"] = n;
+  st.counters["T-junctions"] = static_cast<double>(m.system().slaves().slaves().size());
+  st.counters["particles"] = m.nodes().num_alive();
+}
+
+struct Saved {
+  std::vector<double> x, v;
+};
+Saved save(const MssModel<3>& m) {
+  const auto& n = m.nodes();
+  Saved s;
+  s.x.assign(n.positions().data(), n.positions().data() + 3 * n.size());
+  s.v.assign(n.velocities().data(), n.velocities().data() + 3 * n.size());
+  return s;
+}
+void restore(MssModel<3>& m, const Saved& s) {
+  auto& n = m.nodes();
+  std::copy(s.x.begin(), s.x.end(), n.positions().data());
+  std::copy(s.v.begin(), s.v.end(), n.velocities().data());
+}
+
+// A configuration's model in its measured state, built once per process (an adaptive state
+// takes seconds to settle) and restored to that state at every reuse; rebuilt if a criterion
+// pass refined it since.
+struct Built {
+  std::unique_ptr<MssModel<3>> m;
+  Saved start;
+  Index elements = 0;
+};
+MssModel<3>& cached(const Config& c) {
+  static std::map<std::string, Built> cache;
+  Built& b = cache[c.name];
+  if (!b.m || b.m->num_live_elements() != b.elements) {
+    b.m = build(c);
+    b.start = save(*b.m);
+    b.elements = b.m->num_live_elements();
+  } else {
+    restore(*b.m, b.start);
+  }
+  return *b.m;
+}
+
+// Steps of one configuration; the state is restored (untimed) every kRestoreEvery steps so that
+// the measured state stays the configuration's (and so does its element count).
+void steps(benchmark::State& st, const Config& c, bool implicit) {
+  MssModel<3>* m = &cached(c);  // set-up before the timed loop is not timed
+  refine::RefineOptions ro;
+  ro.max_level = c.max_level;
+  const refine::DiagonalStrain<3> strained(kThreshold);
+  physics::LinearlyImplicitEuler euler(implicit_options());
+  physics::SymplecticEuler semi;
+  const double h = implicit ? kH : 0.9 * m->system().stable_step().h_max;
+  int since = 0;
+  for (auto _ : st) {
+    if (implicit)
+      (void)euler.step(m->system(), h);
+    else
+      (void)semi.step(m->system(), h);
+    if (c.max_level > 0) (void)refine::adapt(*m, strained, ro);
+    if (++since == kRestoreEvery) {
+      Untimed pause(st);
+      m = &cached(c);
+      euler.reset();
+      semi.reset();
+      since = 0;
+    }
+  }
+  count(st, *m, c.uniform);
+  st.counters["h (ms)"] = h * 1e3;
+  if (implicit && scale() != Scale::smoke) st.counters["top-edge error (mm)"] = top_edge_error_mm(c);
+}
+
+// One hexahedron of the settled adaptive 2-4 beam refined 1:8 (the first live one below level
+// 4), then coarsened back untimed: refine-then-coarsen gives back the model (tests/refine).
+void subdivision(benchmark::State& st) {
+  std::unique_ptr<MssModel<3>> m = build({"adaptive 2-4", 0, 4});
+  Index pick = physics::invalid_index;
+  for (Index e = 0; e < m->elements().size() && pick == physics::invalid_index; ++e)
+    if (m->elements()[e].alive && refine::level_index(m->elements()[e].level) < 4) pick = e;
+  if (pick == physics::invalid_index) {
+    st.SkipWithError("no hexahedron below level 4 in the adaptive 2-4 beam");
+    return;
+  }
+  for (auto _ : st) {
+    benchmark::DoNotOptimize(refine::refine_element(*m, pick, {}));
+    Untimed pause(st);
+    (void)refine::coarsen(*m, pick);
+  }
+  count(st, *m);
+}
+
+void t_junction_forces(benchmark::State& st) {
+  MssModel<3>* m = &cached({"adaptive 2-4", 0, 4});
+  m->system().compute_forces();
+  const auto& n = m->nodes();
+  std::vector<double> f(n.forces().data(), n.forces().data() + 3 * n.size());
+  for (auto _ : st) {
+    m->system().slaves().pass_forces(f);
+    benchmark::DoNotOptimize(f.data());
+  }
+  count(st, *m);
+}
+
+void register_all() {
+  std::vector<Config> configs{{"coarse", 0, 0}, {"adaptive 2-3", 0, 3}, {"refined x3", 3, 0}};
+  if (scale() != Scale::smoke) configs.push_back({"adaptive 2-4", 0, 4});
+  if (scale() == Scale::full) configs.push_back({"refined x4", 4, 0});
+  for (const Config& c : configs)
+    for (bool implicit : {true, false})
+      ours(kSuite, "table1/" + c.name + (implicit ? "/implicit" : "/semi"), [c, implicit](benchmark::State& st) { steps(st, c, implicit); });
+  if (scale() != Scale::smoke) {
+    ours(kSuite, "subdivision/hex", subdivision);
+    ours(kSuite, "t_junctions/forces", t_junction_forces);
+  }
+}
+
+const Registration reg(&register_all);
+
+}  // namespace
+}  // namespace sewn::bench::refine_suite

@@ -1,0 +1,189 @@
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <string>
+
+#include "cursor.hpp"
+#include "sewn/io/surface.hpp"
+
+namespace sewn::io {
+
+namespace {
+
+using detail::Cursor;
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+Point3 finite_point(Cursor& c, std::uint64_t index) {
+  Point3 p{};
+  for (double& x : p) {
+    x = c.real("a vertex coordinate");
+    if (!std::isfinite(x)) c.fail_semantic("vertex " + std::to_string(index) + " has a non-finite coordinate", c.line());
+  }
+  return p;
+}
+
+// A polygon fanned into triangles from its first vertex.
+void add_polygon(Surface& s, const std::vector<std::uint32_t>& v) {
+  for (std::size_t i = 1; i + 1 < v.size(); ++i) s.triangles.push_back({v[0], v[i], v[i + 1]});
+}
+
+Surface parse_off(std::string_view text, const std::string& source) {
+  Cursor c(text, source, '#');
+  const std::string_view head = c.token("the OFF header");
+  if (head != "OFF") c.fail_expected("the header OFF", head);
+  const std::uint64_t nv = c.count("the vertex count"), nf = c.count("the face count");
+  (void)c.count("the edge count");
+  Surface s;
+  s.points.reserve(std::min<std::uint64_t>(nv, text.size() / 6));
+  for (std::uint64_t i = 0; i < nv; ++i) s.points.push_back(finite_point(c, i));
+  std::vector<std::uint32_t> poly;
+  for (std::uint64_t f = 0; f < nf; ++f) {
+    const std::uint64_t n = c.count("a face's vertex count", 1u << 16);
+    if (n < 3) c.fail_semantic("face " + std::to_string(f) + " has " + std::to_string(n) + " vertices (at least 3 needed)", c.line());
+    poly.clear();
+    for (std::uint64_t k = 0; k < n; ++k) {
+      const std::uint64_t v = c.count("a vertex index");
+      if (v >= nv) c.fail_semantic("face " + std::to_string(f) + " uses vertex " + std::to_string(v) + " of " + std::to_string(nv), c.line());
+      poly.push_back(static_cast<std::uint32_t>(v));
+    }
+    add_polygon(s, poly);
+    (void)c.rest_of_line();  // colours may follow
+  }
+  return s;
+}
+
+Surface parse_obj(std::string_view text, const std::string& source) {
+  Cursor c(text, source, '#');
+  Surface s;
+  std::vector<std::uint32_t> poly;
+  while (!c.at_end()) {
+    const std::string_view key = c.token("a record");
+    if (key == "v") {
+      s.points.push_back(finite_point(c, s.points.size()));
+      (void)c.rest_of_line();  // an optional w or colour
+    } else if (key == "f") {
+      poly.clear();
+      while (auto t = c.peek_on_line()) {
+        const std::string_view item = c.token("a face vertex");
+        const std::string_view index = item.substr(0, item.find('/'));  // v, v/vt, v//vn, v/vt/vn
+        long long v = 0;
+        try {
+          std::size_t used = 0;
+          v = std::stoll(std::string(index), &used);
+          if (used != index.size()) throw std::invalid_argument("trailing");
+        } catch (const std::exception&) {
+          c.fail_expected("a vertex index", item);
+        }
+        const long long n = static_cast<long long>(s.points.size());
+        const long long at = v < 0 ? n + v : v - 1;  // negative: relative to the end
+        if (v == 0 || at < 0 || at >= n)
+          c.fail_semantic("a face uses vertex " + std::to_string(v) + " with " + std::to_string(n) + " vertices defined so far", c.line());
+        poly.push_back(static_cast<std::uint32_t>(at));
+      }
+      if (poly.size() < 3) c.fail_semantic("a face has " + std::to_string(poly.size()) + " vertices (at least 3 needed)", c.line());
+      add_polygon(s, poly);
+    } else {
+      (void)c.rest_of_line();  // vt, vn, g, o, s, usemtl, mtllib, ...
+    }
+  }
+  return s;
+}
+
+// STL vertices merged when bitwise equal (STL repeats them per facet).
+struct StlBuilder {
+  Surface s;
+  std::map<Point3, std::uint32_t> index;
+  std::uint32_t vertex(const Point3& p) {
+    auto [it, fresh] = index.try_emplace(p, static_cast<std::uint32_t>(s.points.size()));
+    if (fresh) s.points.push_back(p);
+    return it->second;
+  }
+};
+
+Surface parse_stl_ascii(std::string_view text, const std::string& source) {
+  Cursor c(text, source);
+  c.expect("solid");
+  (void)c.rest_of_line();
+  StlBuilder b;
+  while (true) {
+    const std::string_view key = c.token("facet or endsolid");
+    if (key == "endsolid") break;
+    if (key != "facet") c.fail_expected("facet or endsolid", key);
+    c.expect("normal");
+    for (int k = 0; k < 3; ++k) (void)c.real("a normal component");
+    c.expect("outer");
+    c.expect("loop");
+    std::array<std::uint32_t, 3> t{};
+    for (auto& v : t) {
+      c.expect("vertex");
+      v = b.vertex(finite_point(c, b.s.points.size()));
+    }
+    c.expect("endloop");
+    c.expect("endfacet");
+    b.s.triangles.push_back(t);
+  }
+  return b.s;
+}
+
+Surface parse_stl_binary(std::string_view bytes, const std::string& source) {
+  if (bytes.size() < 84) throw ParseError(source, 0, "an 84-byte binary STL header", std::to_string(bytes.size()) + " bytes");
+  std::uint32_t n = 0;
+  std::memcpy(&n, bytes.data() + 80, 4);
+  if ((bytes.size() - 84) / 50 < n)
+    throw SemanticError(source, 0, "declares " + std::to_string(n) + " triangles but holds " + std::to_string((bytes.size() - 84) / 50));
+  StlBuilder b;
+  for (std::uint32_t f = 0; f < n; ++f) {
+    const char* rec = bytes.data() + 84 + 50 * static_cast<std::size_t>(f);
+    std::array<std::uint32_t, 3> t{};
+    for (int v = 0; v < 3; ++v) {
+      Point3 p{};
+      for (int k = 0; k < 3; ++k) {
+        float x = 0;
+        std::memcpy(&x, rec + 12 + 12 * v + 4 * k, 4);
+        if (!std::isfinite(x)) throw SemanticError(source, 0, "triangle " + std::to_string(f) + " has a non-finite coordinate");
+        p[static_cast<std::size_t>(k)] = x;
+      }
+      t[static_cast<std::size_t>(v)] = b.vertex(p);
+    }
+    b.s.triangles.push_back(t);
+  }
+  return b.s;
+}
+
+bool starts_with_word(std::string_view text, std::string_view word) {
+  std::size_t i = 0;
+  while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+  return text.substr(i, word.size()) == word;
+}
+
+}  // namespace
+
+Surface read_surface(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  const std::string data = detail::slurp(path);
+  const std::string ext = lower(path.extension().string());
+  Surface s;
+  if (starts_with_word(data, "OFF")) {
+    s = parse_off(data, name);
+  } else if (starts_with_word(data, "solid") && data.find("facet") != std::string::npos) {
+    s = parse_stl_ascii(data, name);
+  } else if (ext == ".stl") {
+    s = parse_stl_binary(data, name);
+  } else if (ext == ".obj") {
+    s = parse_obj(data, name);
+  } else if (ext == ".off") {
+    s = parse_off(data, name);  // reports the missing header
+  } else {
+    throw UnsupportedError(name, 0, "not a surface file Sewn reads (OFF, OBJ or STL, by content or by extension)");
+  }
+  if (s.triangles.empty()) throw SemanticError(name, 0, "has no triangle");
+  return s;
+}
+
+}  // namespace sewn::io

@@ -1,0 +1,117 @@
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+#include <utility>
+
+#include "sewn/io/surface.hpp"
+
+namespace sewn::io {
+
+namespace {
+
+constexpr double max_grid_cells = 268435456.0;  // 2^28, box_union's bound
+
+std::string number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
+
+// Every edge must be shared by exactly two triangles, or the parity of crossings means nothing.
+void require_closed(const Surface& s, const std::string& source) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+  for (const auto& t : s.triangles)
+    for (int e = 0; e < 3; ++e) {
+      const std::uint32_t a = t[static_cast<std::size_t>(e)], b = t[static_cast<std::size_t>((e + 1) % 3)];
+      ++uses[{std::min(a, b), std::max(a, b)}];
+    }
+  for (const auto& [edge, n] : uses)
+    if (n != 2)
+      throw SemanticError(source, 0, "the surface is not closed: the edge between vertices " + std::to_string(edge.first) + " and " +
+                                         std::to_string(edge.second) + " belongs to " + std::to_string(n) +
+                                         " triangles (2 needed to voxelize)");
+}
+
+// Sign of the edge function of edge a -> b (points in the y-z plane) at q, q perturbed by
+// (eps, eps^2): +1 or -1, never 0 for a non-degenerate edge. Computed with the edge oriented
+// from its lower vertex index, then flipped, so two triangles sharing an edge see bitwise
+// opposite values and a point on it falls in exactly one of them.
+int edge_sign(const Surface& s, std::uint32_t ia, std::uint32_t ib, double qy, double qz) {
+  const bool flip = ib < ia;
+  if (flip) std::swap(ia, ib);
+  const Point3& a = s.points[ia];
+  const Point3& b = s.points[ib];
+  const double ey = b[1] - a[1], ez = b[2] - a[2];
+  const double w = ey * (qz - a[2]) - ez * (qy - a[1]);
+  int sign = w > 0 ? 1 : w < 0 ? -1 : (ez != 0 ? (ez > 0 ? -1 : 1) : (ey > 0 ? 1 : -1));
+  return flip ? -sign : sign;
+}
+
+}  // namespace
+
+IndexedMesh voxelize(const Surface& s, std::uint32_t cells, const std::string& source) {
+  if (cells < 1) throw SemanticError(source, 0, "voxelize: at least 1 cell along the longest side is needed");
+  require_closed(s, source);
+  Point3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  for (const Point3& p : s.points)
+    for (std::size_t k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  const double longest = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  if (!(longest > 0)) throw SemanticError(source, 0, "the surface has no extent to voxelize");
+  const double a = longest / cells;
+  std::array<int, 3> n{};
+  double total = 1;
+  for (std::size_t k = 0; k < 3; ++k) {
+    n[k] = std::max(1, static_cast<int>(std::ceil((hi[k] - lo[k]) / a)));
+    total *= n[k];
+  }
+  if (total > max_grid_cells)
+    throw SemanticError(source, 0, "voxelizing at " + std::to_string(cells) + " cells makes a grid of " + number(total) + " cells, more than 2^28");
+
+  // x of every crossing of the ray through each row's cell centres
+  std::vector<std::vector<double>> hits(static_cast<std::size_t>(n[1]) * static_cast<std::size_t>(n[2]));
+  auto centre = [&](int k, int i) { return lo[static_cast<std::size_t>(k)] + (i + 0.5) * a; };
+  auto first_row = [&](int k, double v) { return std::max(0, static_cast<int>(std::ceil((v - lo[static_cast<std::size_t>(k)]) / a - 0.5))); };
+  auto last_row = [&](int k, double v) {
+    return std::min(n[static_cast<std::size_t>(k)] - 1, static_cast<int>(std::floor((v - lo[static_cast<std::size_t>(k)]) / a - 0.5)));
+  };
+  for (const auto& t : s.triangles) {
+    const Point3 &p0 = s.points[t[0]], &p1 = s.points[t[1]], &p2 = s.points[t[2]];
+    const double area = (p1[1] - p0[1]) * (p2[2] - p0[2]) - (p1[2] - p0[2]) * (p2[1] - p0[1]);
+    if (area == 0) continue;  // parallel to the rays: the perturbed rays never cross it
+    const double ylo = std::min({p0[1], p1[1], p2[1]}), yhi = std::max({p0[1], p1[1], p2[1]});
+    const double zlo = std::min({p0[2], p1[2], p2[2]}), zhi = std::max({p0[2], p1[2], p2[2]});
+    for (int k = first_row(2, zlo); k <= last_row(2, zhi); ++k)
+      for (int j = first_row(1, ylo); j <= last_row(1, yhi); ++j) {
+        const double qy = centre(1, j), qz = centre(2, k);
+        const int s0 = edge_sign(s, t[1], t[2], qy, qz), s1 = edge_sign(s, t[2], t[0], qy, qz), s2 = edge_sign(s, t[0], t[1], qy, qz);
+        if (s0 != s1 || s1 != s2) continue;
+        // barycentric weights from the unperturbed edge functions (the crossing's x)
+        auto w = [&](const Point3& u, const Point3& v) { return (v[1] - u[1]) * (qz - u[2]) - (v[2] - u[2]) * (qy - u[1]); };
+        const double w0 = w(p1, p2), w1 = w(p2, p0), w2 = w(p0, p1), sum = w0 + w1 + w2;
+        hits[static_cast<std::size_t>(j) + static_cast<std::size_t>(n[1]) * static_cast<std::size_t>(k)].push_back(
+            (w0 * p0[0] + w1 * p1[0] + w2 * p2[0]) / sum);
+      }
+  }
+
+  std::vector<LatticeBox> boxes;
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j) {
+      auto& h = hits[static_cast<std::size_t>(j) + static_cast<std::size_t>(n[1]) * static_cast<std::size_t>(k)];
+      if (h.size() % 2 != 0)
+        throw SemanticError(source, 0, "the ray along x at y = " + number(centre(1, j)) + ", z = " + number(centre(2, k)) + " crosses the surface " +
+                                           std::to_string(h.size()) + " times, an odd number: the surface does not enclose a volume");
+      std::sort(h.begin(), h.end());
+      for (std::size_t p = 0; p < h.size(); p += 2) {
+        // cells whose centre x lies in [h[p], h[p+1])
+        const int i0 = first_row(0, h[p]);
+        const int i1 = std::min(n[0] - 1, static_cast<int>(std::ceil((h[p + 1] - lo[0]) / a - 0.5)) - 1);
+        if (i1 >= i0) boxes.push_back({{i0, j, k}, {i1 + 1, j + 1, k + 1}});
+      }
+    }
+  if (boxes.empty())
+    throw SemanticError(source, 0, "no cell centre lies inside the surface at " + std::to_string(cells) + " cells along its longest side: use more");
+  return box_union(boxes, GridSpec{{a, a, a}, lo});
+}
+
+}  // namespace sewn::io
