@@ -154,6 +154,8 @@ std::string encode_payload(const Checkpoint& c) {
   e.put(c.implicit.warm_start);
   e.put(c.implicit.steps);
   put_watchdog(e, c.implicit.watchdog);
+  e.put(c.midpoint.steps);
+  put_watchdog(e, c.midpoint.watchdog);
   const auto& l = c.ledger;
   for (double x : {l.total0, l.external0, l.last_total, l.last_moving, l.last_external}) e.put(x);
   e.put(l.rises);
@@ -211,6 +213,8 @@ Checkpoint decode_payload(Decoder& d) {
   d.get(c.implicit.warm_start, "warm start");
   c.implicit.steps = d.get<std::uint64_t>("implicit steps");
   c.implicit.watchdog = get_watchdog(d);
+  c.midpoint.steps = d.get<std::uint64_t>("midpoint steps");
+  c.midpoint.watchdog = get_watchdog(d);
   auto& l = c.ledger;
   for (double* x : {&l.total0, &l.external0, &l.last_total, &l.last_moving, &l.last_external}) *x = d.get<double>("energy ledger");
   l.rises = d.get<std::uint64_t>("energy rises");

@@ -550,6 +550,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     try {
       semi.restore(model->system(), ck.semi);
       implicit.restore(model->system(), ck.implicit);
+      midpoint.restore(model->system(), ck.midpoint);
     } catch (const physics::InputError& e) {
       throw CheckpointError(options.resume.string(), e.what());
     }
@@ -573,6 +574,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     c.v.assign(model->nodes().v().begin(), model->nodes().v().end());
     c.semi = semi.history(model->system());
     if (use_implicit && !use_midpoint) c.implicit = implicit.history(model->system());
+    if (use_midpoint) c.midpoint = midpoint.history(model->system());
     c.ledger = ledger.state();
     c.frame_times = frame_times;
     c.csv_columns = csv ? static_cast<std::uint32_t>(csv->columns()) : 0;

@@ -11,7 +11,8 @@
 //     tables (the map's dart count, masses, fixed axes, spring ends, stiffnesses, rest lengths,
 //     viscosities, live elements) must equal the stored one;
 //   - the integrator's history (symplectic Euler's cached stable step; linearly implicit
-//     Euler's warm start; both step counters and energy watchdogs) and the energy ledger;
+//     Euler's warm start; the step counters and energy watchdogs of these two and of the
+//     implicit midpoint rule; Newton's backward Euler keeps none) and the energy ledger;
 //   - the time line: steps and frames done, the next scheduled cut, the frames listed in the
 //     .pvd and the rows of frames.csv, and the run summary's running figures.
 // Everything else a run holds is rebuilt from the scene or recomputed from the above at the
@@ -31,6 +32,7 @@
 #include <vector>
 
 #include "sewn/physics/integrate/energy_ledger.hpp"
+#include "sewn/physics/integrate/implicit_midpoint.hpp"
 #include "sewn/physics/integrators.hpp"
 
 namespace sewn::app {
@@ -73,6 +75,7 @@ struct Checkpoint {
   std::vector<double> x, v;  ///< 3 per particle
   physics::SymplecticEuler::History semi;
   physics::LinearlyImplicitEuler::History implicit;
+  physics::ImplicitMidpoint::History midpoint;
   physics::EnergyLedger::State ledger;
 
   std::vector<double> frame_times;  ///< of the frames listed in the .pvd
