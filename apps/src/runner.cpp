@@ -418,8 +418,14 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
       throw CheckpointError(file, "holds " + std::to_string(ck.x.size() / 3) + " particles for a model of " + std::to_string(nodes.size()));
     std::copy(ck.x.begin(), ck.x.end(), nodes.x().begin());
     std::copy(ck.v.begin(), ck.v.end(), nodes.v().begin());
-    if (ck.frame_times.size() != (scene.write_vtu ? ck.frame : 0) || ck.csv_columns * ck.frame != (scene.write_csv ? ck.csv_rows.size() : 0))
+    if (ck.frame_times.size() != (scene.write_vtu ? ck.frame : 0) ||
+        std::size_t{ck.csv_columns} * ck.frame != (scene.write_csv ? ck.csv_rows.size() : 0))
       throw CheckpointError(file, "its output record does not match its " + std::to_string(ck.frame) + " frames");
+    // the .pvd will list the frames written before the checkpoint: they must be there
+    for (std::uint32_t f = 0; f < ck.frame_times.size(); ++f)
+      if (!std::filesystem::exists(sum.out / frame_file(f)))
+        throw CheckpointError(file, "its run wrote " + frame_file(f) + ", which " + sum.out.string() +
+                                        " does not hold: resume in the output folder the run wrote to");
     sum.resumed_at = ck.step;
   }
 

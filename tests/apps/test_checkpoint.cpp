@@ -241,6 +241,12 @@ TEST_CASE("a checkpoint that is not this run's, or not whole, is refused with ex
     CHECK(run_tool("run --quiet --resume " + saved.checkpoint.string() + " --out " + scratch("o2").string() + " " + other.string(), log) == 2);
     CHECK(log.find(saved.checkpoint.string() + ": written by another scene") != std::string::npos);
   }
+  SUBCASE("another output folder") {
+    std::string log;
+    const fs::path elsewhere = scratch("elsewhere");
+    CHECK(run_tool("run --quiet --resume " + saved.checkpoint.string() + " --out " + elsewhere.string() + " " + saved.scene.string(), log) == 2);
+    CHECK(log.find("its run wrote frame_00000.vtu, which " + elsewhere.string() + " does not hold") != std::string::npos);
+  }
   SUBCASE("the same scene with other frames") {
     check_refused(saved, saved.checkpoint, "written by a run of 50 steps and 10 frames, but this one has 50 steps and 5 frames", "--frames 5");
   }
