@@ -31,7 +31,7 @@ class Encoder {
   template <class T>
   void put(const std::vector<T>& values) {
     put(static_cast<std::uint64_t>(values.size()));
-    out_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+    if (!values.empty()) out_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
   }
   void put(const std::string& s) {
     put(static_cast<std::uint64_t>(s.size()));
@@ -70,7 +70,7 @@ class Decoder {
       fail(std::string(what) + " claims " + std::to_string(n) + " values, more than the " + std::to_string(in_.size() - at_) +
            " bytes left hold");
     out.resize(static_cast<std::size_t>(n));
-    std::memcpy(out.data(), in_.data() + at_, out.size() * sizeof(T));
+    if (n > 0) std::memcpy(out.data(), in_.data() + at_, out.size() * sizeof(T));  // an empty vector's data() may be null
     at_ += out.size() * sizeof(T);
   }
   void get(std::string& out, const char* what) {
