@@ -12,6 +12,7 @@
 
 #include "sewn/apps/cell_models.hpp"
 #include "sewn/apps/check_topology.hpp"
+#include "sewn/apps/checkpoint.hpp"
 #include "sewn/apps/runner.hpp"
 #include "sewn/apps/scene.hpp"
 #include "sewn/cmap/build.hpp"
@@ -29,6 +30,7 @@ constexpr const char* usage = R"(sewn: simulate deformable bodies whose topology
 
 usage:
   sewn run [SCENE.json] [--out DIR] [--frames N] [--until T] [--quiet]
+           [--checkpoint-every N] [--resume FILE] [--stop-after-checkpoints K]
                           run a scene (with no scene: the built-in default, a cantilever
                           beam sagging under gravity and cut part-way through)
   sewn check MESH [--json]
@@ -44,6 +46,7 @@ exit codes: 0 ok, 1 the run failed, 2 bad input
 )";
 
 constexpr const char* run_usage = R"(usage: sewn run [SCENE.json] [--out DIR] [--frames N] [--until T] [--quiet]
+                [--checkpoint-every N] [--resume FILE] [--stop-after-checkpoints K]
 
 Runs a scene (docs/scenes.md) and writes, in DIR (default out/<scene name>/):
   <name>.pvd + frame_NNNNN.vtu   the ParaView series (cells with material and refinement level;
@@ -57,6 +60,14 @@ Runs a scene (docs/scenes.md) and writes, in DIR (default out/<scene name>/):
   --until T    stop at simulated time T seconds, if that is before the scene's end; cuts
                scheduled after T are not applied
   --quiet      no progress bar and no summary line
+  --checkpoint-every N
+               write <name>.checkpoint in DIR after every N frames (replaced whole each time:
+               a killed run loses at most N frames of work; docs/checkpoints.md)
+  --resume FILE
+               continue the run FILE was written by (same scene, --frames and --until): the
+               outputs come out byte for byte as if the run had never stopped
+  --stop-after-checkpoints K
+               stop after writing K checkpoints (exit 0), to split a long run into jobs
 The progress bar is drawn only when standard error is a terminal.
 )";
 
@@ -86,7 +97,8 @@ int cmd_run(const std::vector<std::string>& args) {
       return ok;
     } else if (a == "--quiet" || a == "-q") {
       opt.quiet = true;
-    } else if (a == "--out" || a == "--frames" || a == "--until") {
+    } else if (a == "--out" || a == "--frames" || a == "--until" || a == "--checkpoint-every" || a == "--resume" ||
+               a == "--stop-after-checkpoints") {
       if (i + 1 >= args.size()) {
         std::fprintf(stderr, "sewn run: %s needs a value\n", a.c_str());
         return bad_input;
@@ -94,6 +106,16 @@ int cmd_run(const std::vector<std::string>& args) {
       const std::string& v = args[++i];
       if (a == "--out") {
         opt.out = v;
+      } else if (a == "--resume") {
+        opt.resume = v;
+      } else if (a == "--checkpoint-every" || a == "--stop-after-checkpoints") {
+        char* end = nullptr;
+        const long n = std::strtol(v.c_str(), &end, 10);
+        if (end == v.c_str() || *end != '\0' || n < 1 || n > 100000) {
+          std::fprintf(stderr, "sewn run: %s needs a whole number between 1 and 100000, got '%s'\n", a.c_str(), v.c_str());
+          return bad_input;
+        }
+        (a == "--checkpoint-every" ? opt.checkpoint_every : opt.stop_after_checkpoints) = static_cast<std::uint32_t>(n);
       } else if (a == "--until") {
         char* end = nullptr;
         const double t = std::strtod(v.c_str(), &end);
@@ -121,6 +143,10 @@ int cmd_run(const std::vector<std::string>& args) {
       scene_path = a;
     }
   }
+  if (opt.stop_after_checkpoints > 0 && opt.checkpoint_every == 0) {
+    std::fprintf(stderr, "sewn run: --stop-after-checkpoints needs --checkpoint-every\n");
+    return bad_input;
+  }
   const sewn::app::Scene scene = scene_path ? sewn::app::load_scene(*scene_path) : sewn::app::default_scene();
   if (!scene.skip.empty()) {  // optional data absent: nothing is run or written (said even with --quiet)
     std::fprintf(stderr, "sewn: %s: skipped: %s\n", scene.name.c_str(), scene.skip.c_str());
@@ -138,6 +164,9 @@ int cmd_run(const std::vector<std::string>& args) {
     if (s.substepped > 0)
       std::printf("; midpoint: Newton missed at h in %llu steps, taken in up to %d sub-steps each",
                   static_cast<unsigned long long>(s.substepped), s.most_substeps);
+    if (s.resumed_at > 0) std::printf("; resumed at step %llu", static_cast<unsigned long long>(s.resumed_at));
+    if (!s.checkpoint.empty()) std::printf("; checkpoint: %s", s.checkpoint.string().c_str());
+    if (s.stopped) std::printf("; stopped after the checkpoint (continue with --resume)");
     std::printf("\n");
   }
   return ok;
@@ -271,6 +300,9 @@ int main(int argc, char** argv) {
   } catch (const sewn::app::OutputError& e) {
     std::fprintf(stderr, "sewn: the run failed: cannot write the output: %s\n", e.what());
     return run_failed;
+  } catch (const sewn::app::CheckpointError& e) {
+    std::fprintf(stderr, "sewn: cannot resume: %s\n", e.what());
+    return bad_input;
   } catch (const sewn::app::SceneError& e) {
     std::fprintf(stderr, "sewn: bad scene: %s\n", e.what());
     return bad_input;

@@ -1,4 +1,5 @@
 #include "sewn/apps/runner.hpp"
+#include "sewn/apps/checkpoint.hpp"
 
 #include <unistd.h>
 
@@ -36,6 +37,8 @@
 #include "sewn/refine/cut.hpp"
 #include "sewn/refine/hierarchy.hpp"
 #include "sewn/apps/refine_keys.hpp"
+
+#include "run_checkpoint.hpp"
 
 namespace sewn::app {
 
@@ -252,6 +255,23 @@ void step_semi_implicit(physics::SymplecticEuler& semi, physics::System& sys, do
                   scene.file.c_str(), h, e.bound(), t, e.bound());
     throw physics::StabilityError(text, e.step(), e.bound());
   }
+}
+
+std::string frame_file(std::uint32_t frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%05u.vtu", frame);
+  return name;
+}
+
+// Keeps the facets a scheduled cut unsews, for a checkpoint to apply again.
+void record_cut(std::vector<AppliedCut>& applied, std::size_t spec, std::span<const refine::Facet> facets) {
+  AppliedCut a;
+  a.spec = static_cast<std::uint32_t>(spec);
+  for (const refine::Facet& f : facets) {
+    a.darts.push_back(f.dart.index());
+    a.betas.push_back(static_cast<std::uint8_t>(f.index));
+  }
+  applied.push_back(std::move(a));
 }
 
 std::string format_seconds(double s) {
@@ -478,22 +498,67 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   for (std::size_t k = 0; k < scene.cuts.size(); ++k) cuts.emplace_back(scene.cuts[k].time, k);
   std::stable_sort(cuts.begin(), cuts.end());
 
+  // A checkpoint to continue from: this scene's run, its cuts applied again, its motion put back.
+  const bool resuming = !options.resume.empty();
+  Checkpoint ck;
+  std::uint64_t run_id = 0;
+  if (resuming || options.checkpoint_every > 0) {
+    const bool rods = std::find(assembly.model_of_cell.begin(), assembly.model_of_cell.end(), CellModel::rod) !=
+                      assembly.model_of_cell.end();
+    detail::require_checkpointable(scene, *model, rods, resuming ? "--resume" : "--checkpoint-every");
+    run_id = detail::run_hash(scene, *model, steps, frames);
+  }
+  if (resuming) {
+    const std::string file = options.resume.string();
+    ck = read_checkpoint(options.resume);
+    if (ck.steps_total != steps || ck.frames_total != frames)
+      throw CheckpointError(file, "written by a run of " + std::to_string(ck.steps_total) + " steps and " +
+                                      std::to_string(ck.frames_total) + " frames, but this one has " + std::to_string(steps) +
+                                      " steps and " + std::to_string(frames) + " frames (resume with the same --frames and --until)");
+    if (ck.run_hash != run_id)
+      throw CheckpointError(file, "written by another scene (" + scene.file + " or its mesh files differ from the run's)");
+    if (ck.cuts.size() > cuts.size()) throw CheckpointError(file, "records more cuts than the scene schedules");
+    for (std::size_t k = 0; k < ck.cuts.size(); ++k)
+      if (ck.cuts[k].spec != cuts[k].second) throw CheckpointError(file, "its cuts are not the scene's, in the scene's order");
+    detail::replay_cuts(*model, ck, file);
+    physics::NodeTable& nodes = model->nodes();
+    if (ck.x.size() != nodes.x().size())
+      throw CheckpointError(file, "holds " + std::to_string(ck.x.size() / 3) + " particles for a model of " + std::to_string(nodes.size()));
+    std::copy(ck.x.begin(), ck.x.end(), nodes.x().begin());
+    std::copy(ck.v.begin(), ck.v.end(), nodes.v().begin());
+    if (ck.frame_times.size() != (scene.write_vtu ? ck.frame : 0) ||
+        std::size_t{ck.csv_columns} * ck.frame != (scene.write_csv ? ck.csv_rows.size() : 0))
+      throw CheckpointError(file, "its output record does not match its " + std::to_string(ck.frame) + " frames");
+    // the .pvd will list the frames written before the checkpoint: they must be there
+    for (std::uint32_t f = 0; f < ck.frame_times.size(); ++f)
+      if (!std::filesystem::exists(sum.out / frame_file(f)))
+        throw CheckpointError(file, "its run wrote " + frame_file(f) + ", which " + sum.out.string() +
+                                        " does not hold: resume in the output folder the run wrote to");
+    sum.resumed_at = ck.step;
+  }
+
   // 4) outputs
   Snapshot snap;
   std::unique_ptr<io::PvdWriter> pvd;
   if (scene.write_vtu) {
     sum.pvd = sum.out / (scene.name + ".pvd");
-    writing([&] { pvd = std::make_unique<io::PvdWriter>(sum.pvd); });
+    std::vector<std::pair<double, std::string>> listed;
+    for (std::uint32_t f = 0; f < ck.frame_times.size(); ++f) listed.emplace_back(ck.frame_times[f], frame_file(f));
+    writing([&] { pvd = std::make_unique<io::PvdWriter>(sum.pvd, std::move(listed)); });
   }
   std::unique_ptr<io::CsvWriter> csv;
   if (scene.write_csv) {
     sum.csv = sum.out / "frames.csv";
+    const std::vector<std::string> columns{"frame", "time", "kinetic_energy", "elastic_energy", "gravity_energy",
+                                           "total_energy", "external_work", "dissipated", "energy_rises", "inverted",
+                                           "particles", "springs", "elements", "steps", "ms_per_step",
+                                           "cg_iterations_mean", "cg_iterations_max", "cuts", "faces_cut", "refined", "coarsened"};
+    if (resuming && ck.csv_columns != columns.size())
+      throw CheckpointError(options.resume.string(), "its frames.csv rows have " + std::to_string(ck.csv_columns) + " columns, not " +
+                                                        std::to_string(columns.size()));
     writing([&] {
-      csv = std::make_unique<io::CsvWriter>(
-          sum.csv, std::vector<std::string>{"frame", "time", "kinetic_energy", "elastic_energy", "gravity_energy",
-                                            "total_energy", "external_work", "dissipated", "energy_rises", "inverted",
-                                            "particles", "springs", "elements", "steps", "ms_per_step",
-                                            "cg_iterations_mean", "cg_iterations_max", "cuts", "faces_cut", "refined", "coarsened"});
+      csv = std::make_unique<io::CsvWriter>(sum.csv, columns);
+      for (std::size_t r = 0; r < ck.frame; ++r) csv->row(std::span<const double>(ck.csv_rows).subspan(r * columns.size(), columns.size()));
     });
   }
   // Energy balance of every frame; each implicit step is checked for energy it created (the
@@ -501,10 +566,18 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   // integrator's watchdog's business).
   physics::EnergyLedger ledger(scene.energy_rise_tolerance);
   ledger.start(model->system());
-  std::uint32_t frame = 0;
-  double frame_ms = 0, frame_cg_sum = 0;
-  int frame_cg_max = 0;
-  std::uint64_t frame_steps = 0;
+  if (resuming) ledger.restore(ck.ledger);
+  std::uint32_t frame = ck.frame;
+  double frame_ms = ck.frame_ms, frame_cg_sum = ck.frame_cg_sum;
+  int frame_cg_max = ck.frame_cg_max;
+  std::uint64_t frame_steps = ck.frame_steps;
+  std::vector<double> frame_times = ck.frame_times, csv_rows = ck.csv_rows;  // what a checkpoint lists
+  sum.cuts = ck.cuts_applied;
+  sum.faces_cut = ck.faces_cut;
+  sum.inverted_max = ck.inverted_max;
+  sum.first_inversion = ck.first_inversion;
+  sum.first_energy_rise = ck.first_energy_rise;
+  sum.kinetic_max = ck.kinetic_max;
   // Inverted elements: counted at every frame, and at every step when the scene stops at the
   // first; the first seen is reported once.
   physics::Index inverted_now = 0;
@@ -523,15 +596,14 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
       throw std::runtime_error(std::string(msg) + "; stopped there (integrator.stop_on_inversion)");
     if (!options.quiet) std::fprintf(stderr, "\nsewn: warning: %s\n", msg);
   };
-  std::uint64_t steps_done = 0;
+  std::uint64_t steps_done = ck.step;
   auto write_frame = [&](double t) {
     physics::System& sys = model->system();
     sys.compute_forces();
     check_inversion(steps_done);
     if (pvd) {
       snap.take(*model);
-      char name[32];
-      std::snprintf(name, sizeof name, "frame_%05u.vtu", frame);
+      const std::string name = frame_file(frame);
       const io::DataArray point_data[] = {
           io::DataArray::vectors("velocity", snap.velocity), io::DataArray::vectors("force", snap.force),
           io::DataArray::vectors("displacement", snap.displacement), io::DataArray::flags("fixed", snap.fixed)};
@@ -546,18 +618,22 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
         io::write_vtu(sum.out / name, snap.points, snap.cells(), point_data, cell_data);
         pvd->add(t, sum.out / name);
       });
+      frame_times.push_back(t);
     }
     if (csv) {
       const auto elements = std::count_if(model->elements().begin(), model->elements().end(), [](const auto& e) { return e.alive; });
       const physics::EnergyBalance e = ledger.balance(sys);
-      writing([&] { csv->row({static_cast<double>(frame), t, e.kinetic, e.elastic, e.external_potential, e.total, e.external_work,
-                e.dissipated, static_cast<double>(ledger.rises()), static_cast<double>(inverted_now),
-                static_cast<double>(model->nodes().num_alive()),
-                static_cast<double>(model->springs().num_alive()), static_cast<double>(elements),
-                static_cast<double>(frame_steps), frame_steps ? frame_ms / static_cast<double>(frame_steps) : 0.0,
-                frame_steps ? frame_cg_sum / static_cast<double>(frame_steps) : 0.0, static_cast<double>(frame_cg_max),
-                static_cast<double>(sum.cuts), static_cast<double>(sum.faces_cut),
-                static_cast<double>(refinement ? refinement->refined() : 0), static_cast<double>(refinement ? refinement->coarsened() : 0)}); });
+      const double row[] = {static_cast<double>(frame), t, e.kinetic, e.elastic, e.external_potential, e.total, e.external_work,
+                            e.dissipated, static_cast<double>(ledger.rises()), static_cast<double>(inverted_now),
+                            static_cast<double>(model->nodes().num_alive()),
+                            static_cast<double>(model->springs().num_alive()), static_cast<double>(elements),
+                            static_cast<double>(frame_steps), frame_steps ? frame_ms / static_cast<double>(frame_steps) : 0.0,
+                            frame_steps ? frame_cg_sum / static_cast<double>(frame_steps) : 0.0, static_cast<double>(frame_cg_max),
+                            static_cast<double>(sum.cuts), static_cast<double>(sum.faces_cut),
+                            static_cast<double>(refinement ? refinement->refined() : 0),
+                            static_cast<double>(refinement ? refinement->coarsened() : 0)};
+      writing([&] { csv->row(row); });
+      csv_rows.insert(csv_rows.end(), std::begin(row), std::end(row));
     }
     ++frame;
     frame_ms = frame_cg_sum = 0;
@@ -588,12 +664,60 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   physics::integrate::NewtonEuler newton(no);
   const bool use_newton = scene.integrator == "newton";
   const bool bar = !options.quiet && options.progress && isatty(STDERR_FILENO);
-  sum.kinetic_start = model->system().kinetic_energy();
-  write_frame(0.0);
-  std::size_t next_cut = 0;
+  std::vector<AppliedCut> applied = ck.cuts;
+  if (resuming) {
+    try {
+      semi.restore(model->system(), ck.semi);
+      implicit.restore(model->system(), ck.implicit);
+      midpoint.restore(model->system(), ck.midpoint);
+    } catch (const physics::InputError& e) {
+      throw CheckpointError(options.resume.string(), e.what());
+    }
+    sum.kinetic_start = ck.kinetic_start;
+  } else {
+    sum.kinetic_start = model->system().kinetic_energy();
+    write_frame(0.0);
+  }
+  // Everything the loop below reads from earlier steps, in the order of checkpoint.hpp.
+  std::uint32_t checkpoints = 0;
+  auto save_checkpoint = [&](double wall) {
+    Checkpoint c;
+    c.run_hash = run_id;
+    c.model_hash = detail::model_hash(*model);
+    c.steps_total = steps;
+    c.frames_total = frames;
+    c.step = steps_done;
+    c.frame = frame;
+    c.cuts = applied;
+    c.x.assign(model->nodes().x().begin(), model->nodes().x().end());
+    c.v.assign(model->nodes().v().begin(), model->nodes().v().end());
+    c.semi = semi.history(model->system());
+    if (use_implicit && !use_midpoint) c.implicit = implicit.history(model->system());
+    if (use_midpoint) c.midpoint = midpoint.history(model->system());
+    c.ledger = ledger.state();
+    c.frame_times = frame_times;
+    c.csv_columns = csv ? static_cast<std::uint32_t>(csv->columns()) : 0;
+    c.csv_rows = csv_rows;
+    c.frame_ms = frame_ms;
+    c.frame_cg_sum = frame_cg_sum;
+    c.frame_cg_max = frame_cg_max;
+    c.frame_steps = frame_steps;
+    c.cuts_applied = sum.cuts;
+    c.faces_cut = sum.faces_cut;
+    c.kinetic_start = sum.kinetic_start;
+    c.kinetic_max = sum.kinetic_max;
+    c.wall = wall;
+    c.inverted_max = sum.inverted_max;
+    c.first_inversion = sum.first_inversion;
+    c.first_energy_rise = sum.first_energy_rise;
+    sum.checkpoint = sum.out / (scene.name + ".checkpoint");
+    writing([&] { write_checkpoint(sum.checkpoint, c); });
+    ++checkpoints;
+  };
+  std::size_t next_cut = ck.cuts.size();
   const auto started = Clock::now();
   auto last_bar = started;
-  for (std::uint64_t s = 0; s < steps; ++s) {
+  for (std::uint64_t s = ck.step; s < steps; ++s) {
     const double t = static_cast<double>(s) * h;
     const auto t0 = Clock::now();
     for (; next_cut < cuts.size() && cuts[next_cut].first <= t + 1e-12 * h; ++next_cut) {
@@ -607,6 +731,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
         const auto facets = refine::facets_across_plane(*model, Vec3d(c.point[0], c.point[1], c.point[2]),
                                                         Vec3d(c.normal[0], c.normal[1], c.normal[2]), within);
         if (facets.empty()) throw SceneError(scene.file, path, "the plane crosses no face between two elements (at its time)");
+        record_cut(applied, k, facets);
         rep = refine::cut(*model, facets);
       } else if (c.type == "faces") {
         std::vector<refine::Facet> facets;
@@ -615,10 +740,12 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
         } catch (const physics::InputError& e) {
           throw SceneError(scene.file, path + ".faces", e.what());
         }
+        record_cut(applied, k, facets);
         rep = refine::cut(*model, facets);
       } else if (c.type == "particles") {
         const auto facets = refine::facets_among_points(*model, c.particles);
         if (facets.empty()) throw SceneError(scene.file, path + ".particles", "no face between two elements has all its points among them");
+        record_cut(applied, k, facets);
         rep = refine::cut(*model, facets);
       } else if (c.type == "pierce") {
         std::vector<Index> elements;
@@ -627,6 +754,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
           if (el.alive && selects_cell(c.where, mesh, el.mesh_cell)) elements.push_back(e);
         }
         if (elements.empty()) throw SceneError(scene.file, path + ".where", "selects no element (at its time)");
+        applied.push_back({static_cast<std::uint32_t>(k), true, c.remove, {}, {}, {elements.begin(), elements.end()}});
         rep = refine::pierce(*model, elements, c.remove);
       }
       if (scene.model != "mass-spring") follow_cut(continuum, *model);
@@ -676,7 +804,17 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     sum.kinetic_max = std::max(sum.kinetic_max, model->system().kinetic_energy());
     // frame f is written after step round(f · steps / frames)
     const auto due = static_cast<std::uint64_t>(std::llround(static_cast<double>(frame) * static_cast<double>(steps) / frames));
-    if (s + 1 >= due && frame <= frames) write_frame(static_cast<double>(s + 1) * h);
+    if (s + 1 >= due && frame <= frames) {
+      write_frame(static_cast<double>(s + 1) * h);
+      if (options.checkpoint_every > 0 && (frame - 1) % options.checkpoint_every == 0) {
+        save_checkpoint(ck.wall + std::chrono::duration<double>(Clock::now() - started).count());
+        if (checkpoints == options.stop_after_checkpoints) {
+          sum.stopped = true;
+          steps_done = s + 1;
+          break;
+        }
+      }
+    }
     if (bar && (Clock::now() - last_bar > std::chrono::milliseconds(100) || s + 1 == steps)) {
       last_bar = Clock::now();
       const double elapsed = std::chrono::duration<double>(last_bar - started).count();
@@ -688,11 +826,11 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     }
   }
   if (bar) std::fputc('\n', stderr);
-  sum.wall = std::chrono::duration<double>(Clock::now() - started).count();
-  sum.steps = steps;
+  sum.wall = ck.wall + std::chrono::duration<double>(Clock::now() - started).count();
+  sum.steps = steps_done;
   sum.frames = frame;
-  sum.simulated = static_cast<double>(steps) * h;
-  sum.ms_per_step = steps ? sum.wall * 1e3 / static_cast<double>(steps) : 0;
+  sum.simulated = static_cast<double>(steps_done) * h;
+  sum.ms_per_step = steps_done ? sum.wall * 1e3 / static_cast<double>(steps_done) : 0;
   sum.kinetic_end = model->system().kinetic_energy();
   if (csv) writing([&] { csv->flush(); });
   sum.energy_rises = ledger.rises();
@@ -700,6 +838,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     sum.refined = refinement->refined();
     sum.coarsened = refinement->coarsened();
   }
+  if (sum.stopped) return sum;
 
   // 6) the picture of the last frame
   if (scene.write_picture) {

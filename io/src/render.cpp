@@ -1,6 +1,6 @@
 #include "sewn/io/render.hpp"
 
-#include "atomic_file.hpp"
+#include "sewn/io/atomic_file.hpp"
 
 #include <cairo.h>
 

@@ -2,7 +2,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "atomic_file.hpp"
+#include "sewn/io/atomic_file.hpp"
 #include "sewn/io/write.hpp"
 
 namespace sewn::io {

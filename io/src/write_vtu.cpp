@@ -8,7 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "atomic_file.hpp"
+#include "sewn/io/atomic_file.hpp"
 #include "sewn/io/write.hpp"
 
 namespace sewn::io {
@@ -188,6 +188,11 @@ void write_vtu(const std::filesystem::path& path, const IndexedMesh& mesh, std::
 }
 
 PvdWriter::PvdWriter(std::filesystem::path path) : path_(std::move(path)) { flush(); }
+
+PvdWriter::PvdWriter(std::filesystem::path path, std::vector<std::pair<double, std::string>> frames)
+    : path_(std::move(path)), entries_(std::move(frames)) {
+  flush();
+}
 
 void PvdWriter::add(double time, const std::filesystem::path& vtu) {
   if (!std::isfinite(time)) throw std::invalid_argument("PvdWriter::add: the time of a frame must be finite");

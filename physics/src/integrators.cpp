@@ -75,6 +75,19 @@ void SymplecticEuler::reset() {
   watchdog_.reset();
 }
 
+SymplecticEuler::History SymplecticEuler::history(const System& sys) const {
+  return {bound_, bound_version_ == sys.version(), steps_, bound_step_, watchdog_.state(sys)};
+}
+
+void SymplecticEuler::restore(const System& sys, const History& h) {
+  bound_ = h.bound;
+  // a bound taken before the last edit is recomputed at the next step, as it would have been
+  bound_version_ = h.bound_current ? sys.version() : sys.version() + 1;
+  steps_ = h.steps;
+  bound_step_ = h.bound_step;
+  watchdog_.restore(sys, h.watchdog);
+}
+
 StepReport SymplecticEuler::step(System& sys, double h) {
   check_step(h, "SymplecticEuler::step");
   sys.require_no_angles("SymplecticEuler::step");
@@ -147,6 +160,29 @@ void LinearlyImplicitEuler::reset() {
   std::fill(dv_.begin(), dv_.end(), 0.0);
   if (solver_) solver_->reset();
   watchdog_.reset();
+}
+
+LinearlyImplicitEuler::History LinearlyImplicitEuler::history(const System& sys) const {
+  const solve::Backend b = opt_.solver == solve::Backend::automatic ? solve::default_backend(sys.nodes().size()) : opt_.solver;
+  if (b != solve::Backend::jacobi)
+    throw InputError("LinearlyImplicitEuler::history: the " + std::string(solve::to_string(b)) +
+                     " solver keeps a factorization across steps, which a history does not hold (use jacobi)");
+  return {std::vector<double>(dv_.begin(), dv_.end()), steps_, watchdog_.state(sys)};
+}
+
+void LinearlyImplicitEuler::restore(const System& sys, const History& h) {
+  const std::size_t n3 = 3 * std::size_t{sys.nodes().size()};
+  if (!h.warm_start.empty() && h.warm_start.size() != n3)
+    throw InputError("LinearlyImplicitEuler::restore: the warm start has " + std::to_string(h.warm_start.size()) +
+                     " values for " + std::to_string(n3) + " degrees of freedom");
+  // the work arrays are sized by the next step; an empty warm start leaves them to it
+  dv_.assign(h.warm_start.begin(), h.warm_start.end());
+  b_.assign(dv_.size(), 0.0);
+  kv_.assign(dv_.size(), 0.0);
+  free_.assign(dv_.size(), 0.0);
+  mass3_.assign(dv_.size(), 0.0);
+  steps_ = h.steps;
+  watchdog_.restore(sys, h.watchdog);
 }
 
 StepReport LinearlyImplicitEuler::step(System& sys, double h) {

@@ -1,5 +1,6 @@
 // The sewn binary on what fuzzing and a new user found (issue 19): paths that cannot be used,
-// outputs cut off by a file size limit, and `check` and `run` agreeing on bad meshes.
+// outputs cut off by a file size limit or a folder the user may not write, and `check` and `run`
+// agreeing on bad meshes.
 #include <doctest/doctest.h>
 
 #include <sys/wait.h>
@@ -179,4 +180,39 @@ TEST_CASE("a number too large for a double: exit 2 with file and key path, not a
       "meshes": [{"type": "hex_grid", "material": "m", "cells": [1, 1, 1], "size": [0.1, 0.1, 0.1]}]})");
   CHECK(run_sewn("run --quiet --out " + tool_scratch("inf").string() + " " + scene.string(), err) == 2);
   CHECK(err.find(scene.string() + ": materials.m.young: the number 1e999 is out of range") != std::string::npos);
+}
+
+TEST_CASE("an output folder the user may not write: exit 1 naming it, the files already there untouched") {
+  // root ignores permissions, so the tool runs as nobody (uid/gid 65534) when this is root
+  std::string as_user;
+  if (::geteuid() == 0) {
+    if (std::system("command -v setpriv > /dev/null 2>&1") == 0)
+      as_user = "setpriv --reuid=65534 --regid=65534 --clear-groups ";
+    else if (std::system("command -v runuser > /dev/null 2>&1") == 0)
+      as_user = "runuser -u nobody -- ";
+    else {
+      MESSAGE("skipped: running as root, and neither setpriv nor runuser exists to drop the privilege");
+      return;
+    }
+  }
+  const fs::path scene = write("ro.json", tiny_scene);
+  std::string err;
+  const fs::path out = scratch("read_only");
+  fs::remove_all(out);
+  REQUIRE(sewn("run --quiet --out " + out.string() + " " + scene.string(), err) == 0);
+  const std::string csv_before = read(out / "frames.csv");
+  fs::permissions(out, fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read | fs::perms::group_exec |
+                           fs::perms::others_read | fs::perms::others_exec);
+  // the folder exists but is not writable: refused before any work
+  CHECK(sewn("run --quiet --out " + out.string() + " " + scene.string(), err, as_user) == 1);
+  CHECK_MESSAGE(err.find("cannot write the output: " + out.string() + ": cannot be written: Permission denied") != std::string::npos, err);
+  CHECK(read(out / "frames.csv") == csv_before);
+  // a folder to create inside it
+  CHECK(sewn("run --quiet --out " + (out / "sub").string() + " " + scene.string(), err, as_user) == 1);
+  CHECK_MESSAGE(err.find((out / "sub").string() + ": cannot be created: Permission denied") != std::string::npos, err);
+  // a checkpoint to resume there: the same
+  CHECK(sewn("run --quiet --checkpoint-every 10 --out " + out.string() + " " + scene.string(), err, as_user) == 1);
+  CHECK_MESSAGE(err.find("Permission denied") != std::string::npos, err);
+  for (const auto& e : fs::directory_iterator(out)) CHECK_MESSAGE(e.path().extension() != ".part", e.path());
+  fs::permissions(out, fs::perms::owner_write, fs::perm_options::add);
 }

@@ -13,6 +13,15 @@ void EnergyLedger::start(const System& sys) {
   rises_ = 0;
 }
 
+void EnergyLedger::restore(const State& s) {
+  total0_ = s.total0;
+  external0_ = s.external0;
+  last_total_ = s.last_total;
+  last_moving_ = s.last_moving;
+  last_external_ = s.last_external;
+  rises_ = s.rises;
+}
+
 void EnergyLedger::rebase(const System& sys) {
   last_external_ = sys.potential_energy(EnergyKind::external);
   last_moving_ = sys.kinetic_energy() + sys.potential_energy(EnergyKind::internal);

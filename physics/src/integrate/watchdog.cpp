@@ -25,6 +25,20 @@ bool EnergyWatchdog::baseline_if_needed(const System& sys) {
   return true;
 }
 
+EnergyWatchdog::State EnergyWatchdog::state(const System& sys) const {
+  return {has_baseline_, has_baseline_ && version_ == sys.version(), internal0_, external0_, speed_at_check_, peak_speed_};
+}
+
+void EnergyWatchdog::restore(const System& sys, const State& s) {
+  has_baseline_ = s.has_baseline;
+  // a stale baseline must be retaken at the next step, as it would have been
+  version_ = s.baseline_current ? sys.version() : sys.version() + 1;
+  internal0_ = s.internal0;
+  external0_ = s.external0;
+  speed_at_check_ = s.speed_at_check;
+  peak_speed_ = s.peak_speed;
+}
+
 std::optional<EnergyBlowup> EnergyWatchdog::after_step(const System& sys, const HealthOptions& opt, std::uint64_t step,
                                                        double max_speed) {
   if (opt.energy_check_interval <= 0 || !has_baseline_) return std::nullopt;

@@ -66,6 +66,14 @@ struct RunOptions {
   std::optional<double> until;               ///< s; ends the run early (never extends it)
   bool quiet = false;                        ///< no progress bar, no summary
   bool progress = true;                      ///< draw the progress bar (only on a terminal)
+  /// Write <name>.checkpoint in the output folder after every this many frames (0: never).
+  std::uint32_t checkpoint_every = 0;
+  /// Continue the run saved in this checkpoint (written by the same scene with the same
+  /// frames and end) instead of starting it: the outputs come out as the run never stopped.
+  std::filesystem::path resume;
+  /// Stop (successfully, without the picture) once this many checkpoints were written by this
+  /// call (0: run to the end): a long run split into jobs.
+  std::uint32_t stop_after_checkpoints = 0;
 };
 
 struct RunSummary {
@@ -88,6 +96,9 @@ struct RunSummary {
   std::uint64_t inverted_max = 0;   ///< most inverted hexahedra and tetrahedra seen at once (frames, or steps if checked)
   std::string first_inversion;      ///< the first inverted element seen, with step and time ("" if none)
   std::filesystem::path out, pvd, csv, picture;
+  std::filesystem::path checkpoint;  ///< the last checkpoint written ("" if none)
+  std::uint64_t resumed_at = 0;      ///< the step the run resumed at (0: started afresh)
+  bool stopped = false;              ///< stopped after a checkpoint (stop_after_checkpoints)
 };
 
 /// Runs the scene to its end. Throws SceneError / io errors / physics::InputError / OutputPathError
@@ -96,7 +107,9 @@ struct RunSummary {
 /// the run fails (exit 1). Every output file is replaced whole (written aside and renamed), the
 /// .pvd lists only frames whose .vtu is complete, and nothing is written outside the output
 /// folder. Throws std::runtime_error naming the element at the first inversion if the scene
-/// stops there (exit 1).
+/// stops there (exit 1). With a checkpoint to resume from, throws CheckpointError (exit 2) if it
+/// cannot be read or was not written by this scene and run; SceneError if the scene's integrator
+/// or solver keeps state checkpoints do not hold (and one is asked for).
 RunSummary run(const Scene& scene, const RunOptions& options);
 
 }  // namespace sewn::app

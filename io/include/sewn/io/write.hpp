@@ -90,12 +90,17 @@ class PvdWriter {
  public:
   /// Starts an empty series at `path` (overwriting an old one). Throws FileError.
   explicit PvdWriter(std::filesystem::path path);
+  /// Continues a series whose first frames are `frames` (time, file relative to the .pvd's
+  /// folder), as a run resumed from a checkpoint does: writes them at once. Throws FileError.
+  PvdWriter(std::filesystem::path path, std::vector<std::pair<double, std::string>> frames);
   /// Records `vtu` (stored relative to the .pvd's folder) at time `time`. Throws FileError.
   void add(double time, const std::filesystem::path& vtu);
   /// The .pvd file.
   [[nodiscard]] const std::filesystem::path& path() const { return path_; }
   /// Frames recorded so far.
   [[nodiscard]] std::size_t size() const { return entries_.size(); }
+  /// The frames recorded so far, as (time, file relative to the .pvd's folder).
+  [[nodiscard]] const std::vector<std::pair<double, std::string>>& frames() const { return entries_; }
 
  private:
   void flush() const;

@@ -58,6 +58,17 @@ class SymplecticEuler {
   /// Forgets the cached bound and the energy baseline.
   void reset();
 
+  /// Everything a step reads from earlier steps (the cached bound, the step counters, the
+  /// watchdog), so that a run restored from a checkpoint takes the same steps.
+  struct History {
+    StableStep bound{};
+    bool bound_current = false;  ///< taken at the system's present version
+    std::uint64_t steps = 0, bound_step = 0;
+    EnergyWatchdog::State watchdog;
+  };
+  [[nodiscard]] History history(const System& sys) const;
+  void restore(const System& sys, const History& h);
+
  private:
   SymplecticEulerOptions opt_;
   StableStep bound_{std::numeric_limits<double>::quiet_NaN()};
@@ -99,6 +110,18 @@ class LinearlyImplicitEuler {
   [[nodiscard]] ImplicitEulerOptions& options() { return opt_; }
   /// Forgets the warm start, the solver's factorizations and the energy baseline.
   void reset();
+
+  /// What a step reads from earlier steps with the jacobi backend: the warm start (the last
+  /// ΔV), the step counter and the watchdog. The CHOLMOD backends also keep a factorization,
+  /// which this does not hold: history() throws InputError for them.
+  struct History {
+    std::vector<double> warm_start;  ///< empty before the first step
+    std::uint64_t steps = 0;
+    EnergyWatchdog::State watchdog;
+  };
+  [[nodiscard]] History history(const System& sys) const;
+  /// Throws InputError if the warm start does not have 3 values per node of sys.
+  void restore(const System& sys, const History& h);
 
  private:
   ImplicitEulerOptions opt_;

@@ -50,6 +50,14 @@ class EnergyLedger {
   /// Number of steps reported so far.
   [[nodiscard]] std::uint64_t rises() const { return rises_; }
 
+  /// Everything the ledger holds, for a checkpoint (restore continues from it exactly).
+  struct State {
+    double total0 = 0, external0 = 0, last_total = 0, last_moving = 0, last_external = 0;
+    std::uint64_t rises = 0;
+  };
+  [[nodiscard]] State state() const { return {total0_, external0_, last_total_, last_moving_, last_external_, rises_}; }
+  void restore(const State& s);
+
  private:
   double tolerance_;
   double total0_ = 0, external0_ = 0;

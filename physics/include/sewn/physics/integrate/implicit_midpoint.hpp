@@ -83,6 +83,18 @@ class ImplicitMidpoint {
   /// Forgets the energy baseline.
   void reset() { watchdog_.reset(); }
 
+  /// What a step reads from earlier steps (each step starts Newton from ΔV = 0): the step
+  /// counter and the watchdog, so that a run restored from a checkpoint takes the same steps.
+  struct History {
+    std::uint64_t steps = 0;
+    EnergyWatchdog::State watchdog;
+  };
+  [[nodiscard]] History history(const System& sys) const { return {steps_, watchdog_.state(sys)}; }
+  void restore(const System& sys, const History& h) {
+    steps_ = h.steps;
+    watchdog_.restore(sys, h.watchdog);
+  }
+
  private:
   // The one place a linear system is solved (A δ = b on the free axes, δ = 0 on fixed ones).
   CgResult solve(const BlockMatrix& A, std::span<const double> b, std::span<double> x);

@@ -54,6 +54,18 @@ class EnergyWatchdog {
   [[nodiscard]] std::optional<EnergyBlowup> check(const System& sys, const HealthOptions& opt, std::uint64_t step) const;
   void reset() { has_baseline_ = false; }
 
+  /// What the watchdog remembers, for a checkpoint: its baseline, the speeds its triggered
+  /// checks compare against, and whether the baseline belongs to the system as it is now.
+  struct State {
+    bool has_baseline = false;
+    bool baseline_current = false;  ///< taken at the system's present version
+    double internal0 = 0, external0 = 0, speed_at_check = 0, peak_speed = 0;
+  };
+  [[nodiscard]] State state(const System& sys) const;
+  /// Continues from `s` on `sys` (a system rebuilt to the same state): a current baseline
+  /// stays current whatever sys.version() now counts.
+  void restore(const System& sys, const State& s);
+
  private:
   bool has_baseline_ = false;
   double internal0_ = 0, external0_ = 0;
