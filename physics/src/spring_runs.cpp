@@ -226,6 +226,20 @@ void chunk_loop(const Arrays& A, const Chunk* __restrict chunks, const std::uint
 }
 #endif
 
+// The springs of chunks [c0, c1) into the force arrays of s (k8, l8, g8: 8 lanes per chunk).
+template <RunDamping D, class Chunk>
+void chunk_range(const Soa& s, const Chunk* chunks, const std::uint8_t* masks, const double* k8, const double* l8,
+                 const double* g8, std::size_t c0, std::size_t c1, double beta) {
+#ifdef SEWN_RUNS_AVX512
+  const Arrays A{s.a[X], s.a[Y], s.a[Z], s.a[VX], s.a[VY], s.a[VZ], {s.a[FX], s.a[FY], s.a[FZ]}};
+  chunk_loop<D>(A, chunks + c0, masks + c0, c1 - c0, k8 + 8 * c0, l8 + 8 * c0, g8 + 8 * c0, beta);
+#else
+  for (std::size_t c = c0; c < c1; ++c)
+    for (std::size_t q = 0; q < 8; ++q)
+      if ((masks[c] >> q) & 1u) one_spring<D>(s, chunks[c].i0 + q, chunks[c].j0 + q, k8[c * 8 + q], l8[c * 8 + q], g8[c * 8 + q], beta);
+#endif
+}
+
 }  // namespace
 
 void SpringRuns::ensure_lane_index(Index count) {
@@ -421,21 +435,10 @@ void SpringRuns::forces(const SpringArrays& a, RunDamping damping, double beta, 
     joined_to = end;
   };
   const auto run = [&]<RunDamping D>() {
-#ifdef SEWN_RUNS_AVX512
-    const Arrays A{s.a[X], s.a[Y], s.a[Z], s.a[VX], s.a[VY], s.a[VZ], {s.a[FX], s.a[FY], s.a[FZ]}};
-#endif
     for (std::size_t b = 0, c0 = 0; c0 < chunks_.size(); ++b, c0 += block_chunks) {
       const std::size_t c1 = std::min(c0 + block_chunks, chunks_.size());
       split_until(reach_[b]);
-#ifdef SEWN_RUNS_AVX512
-      chunk_loop<D>(A, chunks_.data() + c0, mask_.data() + c0, c1 - c0, k_.data() + lanes * c0, l_.data() + lanes * c0,
-                    g_.data() + lanes * c0, beta);
-#else
-      for (std::size_t c = c0; c < c1; ++c)
-        for (int q = 0; q < lanes; ++q)
-          if ((mask_[c] >> q) & 1u)
-            one_spring<D>(s, chunks_[c].i0 + q, chunks_[c].j0 + q, k_[c * lanes + q], l_[c * lanes + q], g_[c * lanes + q], beta);
-#endif
+      chunk_range<D>(s, chunks_.data(), mask_.data(), k_.data(), l_.data(), g_.data(), c0, c1, beta);
       join_until(floor_[b]);
     }
     split_until(n);
@@ -475,16 +478,7 @@ void SpringRuns::forces_threads(const SpringArrays& a, RunDamping damping, doubl
     Soa own = s;
     for (int axis = 0; axis < 3; ++axis) own.a[FX + axis] = force_array(t, axis);
     const std::size_t c0 = range_begin(chunks_.size(), parts, t), c1 = range_begin(chunks_.size(), parts, t + 1);
-#ifdef SEWN_RUNS_AVX512
-    const Arrays A{s.a[X], s.a[Y], s.a[Z], s.a[VX], s.a[VY], s.a[VZ], {own.a[FX], own.a[FY], own.a[FZ]}};
-    chunk_loop<D>(A, chunks_.data() + c0, mask_.data() + c0, c1 - c0, k_.data() + lanes * c0, l_.data() + lanes * c0,
-                  g_.data() + lanes * c0, beta);
-#else
-    for (std::size_t c = c0; c < c1; ++c)
-      for (int q = 0; q < lanes; ++q)
-        if ((mask_[c] >> q) & 1u)
-          one_spring<D>(own, chunks_[c].i0 + q, chunks_[c].j0 + q, k_[c * lanes + q], l_[c * lanes + q], g_[c * lanes + q], beta);
-#endif
+    chunk_range<D>(own, chunks_.data(), mask_.data(), k_.data(), l_.data(), g_.data(), c0, c1, beta);
     if (t == parts - 1)
       for (const Index r : rest_)
         if (a.alive[r] != 0) one_spring<D>(own, a.ni[r], a.nj[r], a.k[r], a.l[r], a.g[r], beta);

@@ -39,6 +39,21 @@ std::unique_ptr<MssModel<3>> block_model() {
   return m;
 }
 
+// The block with every position moved by up to 0.2 mm and random velocities (up to 2 cm/s):
+// springs in every direction, stretched and compressed.
+std::unique_ptr<MssModel<3>> jiggled_block(unsigned seed) {
+  auto m = block_model();
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(-2e-4, 2e-4);
+  auto x = m->nodes().x();
+  auto v = m->nodes().v();
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    x[k] += jitter(rng);
+    v[k] = 100 * jitter(rng);
+  }
+  return m;
+}
+
 // A cut as the cutting code makes one: the particles of the plane x = 0.03 above z = 0.035
 // are duplicated (mass shared) and the springs reaching them from x > 0.03 move to the copies.
 void cut_plane(MssModel<3>& m) {
@@ -116,15 +131,7 @@ TEST_CASE("threads: the count is set by the API or SEWN_THREADS, and bad values 
 
 TEST_CASE("threads: the block-sparse product and the springs' Jacobian are bitwise equal at 1, 2 and 3 threads") {
   using threads_test::Threads;
-  auto m = threads_test::block_model();
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> jitter(-2e-4, 2e-4);
-  auto x = m->nodes().x();
-  auto v = m->nodes().v();
-  for (std::size_t k = 0; k < x.size(); ++k) {
-    x[k] += jitter(rng);
-    v[k] = 100 * jitter(rng);
-  }
+  auto m = threads_test::jiggled_block(7);
   System& sys = m->system();
   const Index n = m->nodes().size();
   REQUIRE(m->springs().num_alive() >= 2 * 4096);  // the springs split at 2 threads
@@ -161,15 +168,7 @@ TEST_CASE("threads: the block-sparse product and the springs' Jacobian are bitwi
 
 TEST_CASE("threads: spring forces at 2 threads equal 1 thread's to round-off, and repeat bitwise") {
   using threads_test::Threads;
-  auto m = threads_test::block_model();
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> jitter(-2e-4, 2e-4);
-  auto x = m->nodes().x();
-  auto v = m->nodes().v();
-  for (std::size_t k = 0; k < x.size(); ++k) {
-    x[k] += jitter(rng);
-    v[k] = 100 * jitter(rng);
-  }
+  auto m = threads_test::jiggled_block(11);
   const auto forces = [&](int threads) {
     Threads scope(threads);
     m->system().compute_forces();
