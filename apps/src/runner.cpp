@@ -30,10 +30,12 @@
 #include "sewn/physics/integrate/newton_euler.hpp"
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
+#include "sewn/physics/shells/shell_terms.hpp"
 #include "sewn/physics/solids/inversion.hpp"
 #include "sewn/physics/solids/volume_term.hpp"
 #include "sewn/physics/split_boxes.hpp"
 #include "sewn/physics/stiffness.hpp"
+#include "sewn/physics/threads.hpp"
 #include "sewn/refine/cut.hpp"
 #include "sewn/refine/hierarchy.hpp"
 #include "sewn/apps/refine_keys.hpp"
@@ -641,7 +643,11 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     frame_steps = 0;
   };
 
-  // 5) stepping
+  // 5) stepping, on the scene's thread count, or SEWN_THREADS's (a bad value is named here)
+  if (scene.threads > 0)
+    physics::set_thread_count(static_cast<int>(scene.threads));
+  else
+    (void)physics::thread_count();
   physics::SymplecticEulerOptions so;
   so.enforce_stable_step = !scene.allow_unstable;
   physics::ImplicitEulerOptions io_opt;

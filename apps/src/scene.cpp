@@ -1,6 +1,7 @@
 #include "sewn/apps/scene.hpp"
 
 #include "sewn/physics/errors.hpp"
+#include "sewn/physics/threads.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -252,6 +253,8 @@ Field build_schema() {
       integrator,
       field("duration", Kind::number).unit("s").fallback(1.0).above(0).at_most(1e6).doc("Simulated time."),
       field("cuts", Kind::array).of(cut).fallback(nlohmann::json::array()).doc("Scheduled cuts."),
+      field("threads", Kind::integer).fallback(0).at_least(0).at_most(physics::max_threads)
+          .doc("Threads of the force, Jacobian and solver kernels (docs/solvers.md): results are deterministic for a given count and differ between counts in round-off only. 0: the environment variable SEWN_THREADS, else 1."),
       obstacles_schema(),
       refinement_schema(),
       output,
@@ -592,6 +595,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     s.stop_on_inversion = in.boolean("stop_on_inversion");
   }
   s.duration = r.number("duration");
+  s.threads = static_cast<std::uint32_t>(r.integer("threads"));
   if (s.step > s.duration) throw SceneError(file, "integrator.step", "is longer than the whole run (duration " + std::to_string(s.duration) + " s)");
   if (r.has("refinement")) s.refinement = read_refinement(r["refinement"], *schema.member("refinement"), file);
   check_limits(s, r["limits"], *schema.member("limits"));

@@ -8,7 +8,8 @@
 // step: solver iterations, factorizations, and the solver's own analyse / factor / solve times.
 // "error" is the position error after `error_steps` steps against a direct solve whose every step
 // reached a relative residual below 1e-12, relative to that solve's displacement (once per case,
-// the same number in every repetition). Threads: the solver backends run on one thread here.
+// the same number in every repetition). The backends run on one thread; the threads/ cases
+// time 2 threads against 1 (wall time) on the semi-implicit and implicit steps of 16³ and 32³.
 
 #include <algorithm>
 #include <cmath>
@@ -22,6 +23,7 @@
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/solve/linear_solver.hpp"
+#include "sewn/physics/threads.hpp"
 #include "sewn_bench.hpp"
 
 namespace sewn::bench::solve_suite {
@@ -190,7 +192,65 @@ void run(benchmark::State& st, const Case& c, solve::Backend b) {
   st.counters["reference residual"] = k.reference_residual;
 }
 
+// Threads: the same steps at `threads` threads (ours: 2) and at one (peer), wall time (the
+// harness's CPU time is the stepping thread's alone). Semi-implicit steps at 0.9 of the
+// stable-step bound of the rest state, implicit ones at the case's step.
+std::vector<Case> thread_cases(Scale scale) {
+  std::vector<Case> c;
+  if (scale == Scale::smoke) {
+    c.push_back({"threads/N4", [] { return clamped(hex_grid(4, 4, 4, cubes(0.1 / 4)), 2); }, 1e-4, 3, 0});
+    return c;
+  }
+  c.push_back({"threads/N16", [] { return clamped(hex_grid(16, 16, 16, cubes(0.1 / 16)), 2); }, 1e-4, 20, 0});
+  if (scale == Scale::full)
+    c.push_back({"threads/N32", [] { return clamped(hex_grid(32, 32, 32, cubes(0.1 / 32)), 2); }, 1e-5, 10, 0});
+  return c;
+}
+
+void run_threads(benchmark::State& st, const Case& c, bool implicit, int threads) {
+  Kept& k = kept(c);
+  const int before = thread_count();
+  set_thread_count(threads);
+  restore(k);
+  SymplecticEulerOptions so;
+  so.enforce_stable_step = false;
+  so.health.energy_check_interval = 0;
+  const double h = implicit ? c.h : 0.9 * k.model->system().stable_step().h_max;
+  double iterations = 0;
+  int s = 0;
+  std::unique_ptr<LinearlyImplicitEuler> ie;
+  std::unique_ptr<SymplecticEuler> se;
+  for (auto _ : st) {
+    if (s % c.steps == 0) {
+      const Untimed untimed(st);
+      restore(k);
+      ie = std::make_unique<LinearlyImplicitEuler>(options_for(solve::Backend::jacobi, solve::default_tolerance, solve::default_absolute_tolerance));
+      se = std::make_unique<SymplecticEuler>(so);
+    }
+    if (implicit)
+      iterations += ie->step(k.model->system(), h).solve.iterations;
+    else
+      (void)se->step(k.model->system(), h);
+    ++s;
+  }
+  restore(k);
+  set_thread_count(before);
+  using C = benchmark::Counter;
+  st.counters["threads"] = threads;
+  if (implicit) st.counters["iterations"] = C(iterations, C::kAvgIterations);
+}
+
 void register_all() {
+  for (const Case& c : thread_cases(scale()))
+    for (const bool implicit : {false, true}) {
+      const std::string name = c.name + (implicit ? "/implicit" : "/semi_implicit") + "/2_threads";
+      ours(suite, name, [c, implicit](benchmark::State& st) { run_threads(st, c, implicit, 2); })
+          ->Iterations(c.steps * (implicit ? 1 : 20))
+          ->UseRealTime();
+      peer(suite, name, "1 thread", [c, implicit](benchmark::State& st) { run_threads(st, c, implicit, 1); })
+          ->Iterations(c.steps * (implicit ? 1 : 20))
+          ->UseRealTime();
+    }
   for (const Case& c : cases(scale())) {
     for (solve::Backend b : solve::available_backends()) {
       if (b == solve::Backend::jacobi) continue;

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "sewn/physics/errors.hpp"
+#include "parallel/ranges.hpp"
 
 #if defined(__AVX512F__) && defined(__AVX512VL__)
 #include <immintrin.h>
@@ -68,6 +69,15 @@ Index BlockMatrix::find(Index i, Index j) const {
 void BlockMatrix::set_zero() { std::fill(val_.begin(), val_.end(), 0.0); }
 
 void BlockMatrix::multiply(std::span<const double> x, std::span<double> y) const {
+  // Rows are independent: each thread computes whole rows, the same way as one thread would.
+  const int parts = detail::parts_for(n_, multiply_grain);
+  detail::run_parts(parts, [&](int t) {
+    multiply_rows(x, y, static_cast<Index>(detail::range_begin(n_, parts, t)),
+                  static_cast<Index>(detail::range_begin(n_, parts, t + 1)));
+  });
+}
+
+void BlockMatrix::multiply_rows(std::span<const double> x, std::span<double> y, Index first, Index last) const {
   const double* __restrict xv = x.data();
   double* __restrict yv = y.data();
   const double* __restrict val = val_.data();
@@ -75,7 +85,7 @@ void BlockMatrix::multiply(std::span<const double> x, std::span<double> y) const
   // A block's columns are 3 contiguous doubles: one masked 256-bit load each, times a
   // broadcast of x; three accumulators keep the FMA chains independent.
   constexpr __mmask8 xyz = 0x7;
-  for (Index i = 0; i < n_; ++i) {
+  for (Index i = first; i < last; ++i) {
     __m256d a0 = _mm256_setzero_pd(), a1 = _mm256_setzero_pd(), a2 = _mm256_setzero_pd();
     for (Index k = row_[i]; k < row_[i + 1]; ++k) {
       const double* b = val + 9 * std::size_t{k};
@@ -87,7 +97,7 @@ void BlockMatrix::multiply(std::span<const double> x, std::span<double> y) const
     _mm256_mask_storeu_pd(yv + 3 * std::size_t{i}, xyz, _mm256_add_pd(_mm256_add_pd(a0, a1), a2));
   }
 #else
-  for (Index i = 0; i < n_; ++i) {
+  for (Index i = first; i < last; ++i) {
     double y0 = 0, y1 = 0, y2 = 0;
     for (Index k = row_[i]; k < row_[i + 1]; ++k) {
       const double* b = val + 9 * std::size_t{k};

@@ -5,6 +5,8 @@
 
 #include <Eigen/LU>
 
+#include "parallel/ranges.hpp"
+
 #if defined(__AVX512F__) && defined(__AVX512VL__)
 #include <immintrin.h>
 #define SEWN_CG_AVX512 1
@@ -14,13 +16,16 @@ namespace sewn::physics {
 
 namespace {
 
+using detail::range_begin;
+using detail::run_parts;
+// Nodes per thread below which CG uses fewer threads: an iteration forks four times.
+constexpr std::size_t cg_grain = 1024;
+
 // Eight independent partial sums: a single running sum is bound by the add latency, and
 // the compiler may not reorder it itself (no -ffast-math). Fixed order: deterministic.
-double dot(std::span<const double> a, std::span<const double> b) {
+double dot_range(const double* __restrict x, const double* __restrict y, std::size_t n) {
   double part[8] = {};
-  const std::size_t n = a.size(), n8 = n - n % 8;
-  const double* __restrict x = a.data();
-  const double* __restrict y = b.data();
+  const std::size_t n8 = n - n % 8;
   for (std::size_t k = 0; k < n8; k += 8)
     for (std::size_t q = 0; q < 8; ++q) part[q] += x[k + q] * y[k + q];
   double s = ((part[0] + part[1]) + (part[2] + part[3])) + ((part[4] + part[5]) + (part[6] + part[7]));
@@ -28,16 +33,92 @@ double dot(std::span<const double> a, std::span<const double> b) {
   return s;
 }
 
+double dot(std::span<const double> a, std::span<const double> b) { return dot_range(a.data(), b.data(), a.size()); }
+
+// z = S P S r for nodes [first, last).
 void apply_precond(std::span<const double> P, std::span<const double> r, std::span<const double> free_dof,
-                   std::span<double> z) {
-  const std::size_t n = r.size() / 3;
-  for (std::size_t i = 0; i < n; ++i) {
+                   std::span<double> z, std::size_t first, std::size_t last) {
+  for (std::size_t i = first; i < last; ++i) {
     const double* B = P.data() + 9 * i;
     const double r0 = r[3 * i], r1 = r[3 * i + 1], r2 = r[3 * i + 2];
     z[3 * i] = free_dof[3 * i] * (B[0] * r0 + B[3] * r1 + B[6] * r2);
     z[3 * i + 1] = free_dof[3 * i + 1] * (B[1] * r0 + B[4] * r1 + B[7] * r2);
     z[3 * i + 2] = free_dof[3 * i + 2] * (B[2] * r0 + B[5] * r1 + B[8] * r2);
   }
+}
+
+void apply_precond(std::span<const double> P, std::span<const double> r, std::span<const double> free_dof,
+                   std::span<double> z) {
+  apply_precond(P, r, free_dof, z, 0, r.size() / 3);
+}
+
+// filtered_pcg on `parts` threads, each owning a contiguous range of nodes: every pass is split
+// by rows and its dot products are summed per range, then over ranges in order (deterministic
+// for a given count). The packed symmetric product of the one-thread path scatters into rows of
+// other ranges, so the full matrix is used, a row at a time.
+CgResult pcg_threads(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
+                     std::span<const double> P, double b_norm, double stop, int max_iterations, CgWorkspace& ws, int parts) {
+  const std::size_t n = b.size() / 3;
+  std::span<double> r(ws.r), z(ws.z), p(ws.p), q(ws.q);
+  double part_a[max_threads], part_b[max_threads];
+  const auto node = [&](int t) { return range_begin(n, parts, t); };
+  const auto sum = [&](const double* part) {
+    double s = 0;
+    for (int t = 0; t < parts; ++t) s += part[t];
+    return s;
+  };
+  // r = S(b - Ax), z = S P S r, p = z; r·r and r·z.
+  run_parts(parts, [&](int t) {
+    const std::size_t i0 = node(t), i1 = node(t + 1), k0 = 3 * i0, k1 = 3 * i1;
+    A.multiply_rows(x, q, static_cast<Index>(i0), static_cast<Index>(i1));
+    for (std::size_t k = k0; k < k1; ++k) r[k] = free_dof[k] * (b[k] - q[k]);
+    apply_precond(P, r, free_dof, z, i0, i1);
+    for (std::size_t k = k0; k < k1; ++k) p[k] = z[k];
+    part_a[t] = dot_range(r.data() + k0, r.data() + k0, k1 - k0);
+    part_b[t] = dot_range(r.data() + k0, z.data() + k0, k1 - k0);
+  });
+  double r_norm = std::sqrt(sum(part_a));
+  double rz = sum(part_b);
+  CgResult out;
+  int it = 0;
+  while (r_norm > stop && it < max_iterations) {
+    // q = S A p; p·q.
+    run_parts(parts, [&](int t) {
+      const std::size_t i0 = node(t), i1 = node(t + 1), k0 = 3 * i0, k1 = 3 * i1;
+      A.multiply_rows(p, q, static_cast<Index>(i0), static_cast<Index>(i1));
+      for (std::size_t k = k0; k < k1; ++k) q[k] *= free_dof[k];
+      part_a[t] = dot_range(p.data() + k0, q.data() + k0, k1 - k0);
+    });
+    const double pq = sum(part_a);
+    if (!(pq > 0.0)) {
+      out.breakdown = true;
+      break;
+    }
+    const double alpha = rz / pq;
+    // x, r, z; r·r and r·z.
+    run_parts(parts, [&](int t) {
+      const std::size_t i0 = node(t), i1 = node(t + 1), k0 = 3 * i0, k1 = 3 * i1;
+      for (std::size_t k = k0; k < k1; ++k) {
+        x[k] += alpha * p[k];
+        r[k] -= alpha * q[k];
+      }
+      apply_precond(P, r, free_dof, z, i0, i1);
+      part_a[t] = dot_range(r.data() + k0, r.data() + k0, k1 - k0);
+      part_b[t] = dot_range(r.data() + k0, z.data() + k0, k1 - k0);
+    });
+    ++it;
+    r_norm = std::sqrt(sum(part_a));
+    const double rz_new = sum(part_b);
+    const double beta = rz_new / rz;
+    rz = rz_new;
+    run_parts(parts, [&](int t) {
+      for (std::size_t k = 3 * node(t); k < 3 * node(t + 1); ++k) p[k] = z[k] + beta * p[k];
+    });
+  }
+  out.iterations = it;
+  out.relative_residual = r_norm / b_norm;
+  out.converged = !out.breakdown && std::isfinite(r_norm) && r_norm <= stop;
+  return out;
 }
 
 #ifdef SEWN_CG_AVX512
@@ -274,6 +355,8 @@ CgResult filtered_pcg(const BlockMatrix& A, std::span<const double> b, std::span
   const double b_norm = std::sqrt(b_norm2);
   // The floor: near rest b is round-off, and a tolerance relative to it alone chases noise.
   const double stop = std::max(tolerance * b_norm, absolute_floor);
+  if (const int parts = detail::parts_for(n3 / 3, cg_grain); parts > 1)
+    return pcg_threads(A, b, x, free_dof, P, b_norm, stop, max_iterations, ws, parts);
 #ifdef SEWN_CG_AVX512
   if (pack_symmetric(A, ws)) return pcg_packed(b, x, free_dof, P, b_norm, stop, max_iterations, ws);
 #endif

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "parallel/ranges.hpp"
+
 #if defined(__AVX512F__)
 #include <immintrin.h>
 #define SEWN_RUNS_AVX512 1
@@ -12,6 +14,9 @@ namespace sewn::physics::detail {
 
 namespace {
 
+using detail::range_begin;
+using detail::run_parts;
+
 // The springs term's degenerate-spring guard (springs.cpp): no force below d² = 1e-18 l².
 constexpr double degenerate_ratio_sq = 1e-18;
 constexpr std::uint32_t no_lane = ~std::uint32_t{0};
@@ -19,6 +24,8 @@ constexpr std::uint32_t no_lane = ~std::uint32_t{0};
 constexpr int min_chunk_lanes = 4;
 // Chunks per block of the split / join window (see forces()).
 constexpr std::size_t block_chunks = 32;
+// Chunks per thread below which forces() uses fewer threads.
+constexpr std::size_t thread_grain_chunks = 512;
 
 // The per-axis arrays inside soa_, each `stride` long.
 enum Axis : int { X, Y, Z, VX, VY, VZ, FX, FY, FZ, num_arrays };
@@ -219,6 +226,20 @@ void chunk_loop(const Arrays& A, const Chunk* __restrict chunks, const std::uint
 }
 #endif
 
+// The springs of chunks [c0, c1) into the force arrays of s (k8, l8, g8: 8 lanes per chunk).
+template <RunDamping D, class Chunk>
+void chunk_range(const Soa& s, const Chunk* chunks, const std::uint8_t* masks, const double* k8, const double* l8,
+                 const double* g8, std::size_t c0, std::size_t c1, double beta) {
+#ifdef SEWN_RUNS_AVX512
+  const Arrays A{s.a[X], s.a[Y], s.a[Z], s.a[VX], s.a[VY], s.a[VZ], {s.a[FX], s.a[FY], s.a[FZ]}};
+  chunk_loop<D>(A, chunks + c0, masks + c0, c1 - c0, k8 + 8 * c0, l8 + 8 * c0, g8 + 8 * c0, beta);
+#else
+  for (std::size_t c = c0; c < c1; ++c)
+    for (std::size_t q = 0; q < 8; ++q)
+      if ((masks[c] >> q) & 1u) one_spring<D>(s, chunks[c].i0 + q, chunks[c].j0 + q, k8[c * 8 + q], l8[c * 8 + q], g8[c * 8 + q], beta);
+#endif
+}
+
 }  // namespace
 
 void SpringRuns::ensure_lane_index(Index count) {
@@ -374,13 +395,20 @@ void SpringRuns::forces(const SpringArrays& a, RunDamping damping, double beta, 
   // Room for an unmasked 8-lane access starting at the last node, and a quarter of headroom
   // when the arrays grow, so that a cut adding particles does not re-allocate (and fault in)
   // all twelve arrays before its first step.
+  const int parts = chunks_.size() >= 2 * thread_grain_chunks ? detail::parts_for(chunks_.size(), thread_grain_chunks) : 1;
+  // Threads past the first accumulate into three arrays of their own.
+  const std::size_t arrays = num_arrays + 3 * static_cast<std::size_t>(parts - 1);
   const std::size_t needed = (std::size_t{n} + 2 * lanes - 1) / lanes * lanes;
-  if (needed > stride_ || needed + needed / 2 < stride_) {
+  if (needed > stride_ || needed + needed / 2 < stride_ || soa_.size() < arrays * stride_) {
     const std::size_t stride = (needed + needed / 4 + lanes - 1) / lanes * lanes;
-    soa_.assign(num_arrays * stride, 0.0);
+    soa_.assign(arrays * stride, 0.0);
     stride_ = stride;
   }
   const std::size_t stride = stride_;
+  if (parts > 1) {
+    forces_threads(a, damping, beta, x, v, f, accumulate, n, parts);
+    return;
+  }
   const Soa s = soa_view(soa_.data(), stride);
   const bool damped = damping != RunDamping::none;
   // Nodes are split into the per-axis arrays just before the first block of chunks that
@@ -407,21 +435,10 @@ void SpringRuns::forces(const SpringArrays& a, RunDamping damping, double beta, 
     joined_to = end;
   };
   const auto run = [&]<RunDamping D>() {
-#ifdef SEWN_RUNS_AVX512
-    const Arrays A{s.a[X], s.a[Y], s.a[Z], s.a[VX], s.a[VY], s.a[VZ], {s.a[FX], s.a[FY], s.a[FZ]}};
-#endif
     for (std::size_t b = 0, c0 = 0; c0 < chunks_.size(); ++b, c0 += block_chunks) {
       const std::size_t c1 = std::min(c0 + block_chunks, chunks_.size());
       split_until(reach_[b]);
-#ifdef SEWN_RUNS_AVX512
-      chunk_loop<D>(A, chunks_.data() + c0, mask_.data() + c0, c1 - c0, k_.data() + lanes * c0, l_.data() + lanes * c0,
-                    g_.data() + lanes * c0, beta);
-#else
-      for (std::size_t c = c0; c < c1; ++c)
-        for (int q = 0; q < lanes; ++q)
-          if ((mask_[c] >> q) & 1u)
-            one_spring<D>(s, chunks_[c].i0 + q, chunks_[c].j0 + q, k_[c * lanes + q], l_[c * lanes + q], g_[c * lanes + q], beta);
-#endif
+      chunk_range<D>(s, chunks_.data(), mask_.data(), k_.data(), l_.data(), g_.data(), c0, c1, beta);
       join_until(floor_[b]);
     }
     split_until(n);
@@ -435,6 +452,57 @@ void SpringRuns::forces(const SpringArrays& a, RunDamping damping, double beta, 
   }
   // Every spring is done: the nodes not joined yet are final.
   join_axes(s, f.data(), joined_to, n, accumulate);
+}
+
+// The threaded force pass: the chunks split into `parts` ranges, each thread accumulating into
+// force arrays of its own (thread 0 into FX FY FZ); the last also takes the rest list. Then the
+// threads' arrays are summed per node in thread order: deterministic for a given count, and
+// equal to the one-thread sums to round-off (a node two ranges touch sums in another order).
+void SpringRuns::forces_threads(const SpringArrays& a, RunDamping damping, double beta, std::span<const double> x,
+                                std::span<const double> v, std::span<double> f, bool accumulate, Index n, int parts) const {
+  const std::size_t stride = stride_;
+  const Soa s = soa_view(soa_.data(), stride);
+  const auto force_array = [&](int t, int axis) {
+    return t == 0 ? s.a[FX + axis] : soa_.data() + (num_arrays + 3 * static_cast<std::size_t>(t - 1) + axis) * stride;
+  };
+  // Node ranges start at multiples of 8: the per-axis arrays are stored 8 aligned at a time.
+  const std::size_t blocks8 = (std::size_t{n} + lanes - 1) / lanes;
+  const auto node = [&](int t) { return std::min<std::size_t>(lanes * range_begin(blocks8, parts, t), n); };
+  const bool damped = damping != RunDamping::none;
+  run_parts(parts, [&](int t) {
+    const std::size_t p = node(t), len = node(t + 1) - p;
+    split_axes(x.data() + 3 * p, s.a[X] + p, s.a[Y] + p, s.a[Z] + p, len);
+    if (damped) split_axes(v.data() + 3 * p, s.a[VX] + p, s.a[VY] + p, s.a[VZ] + p, len);
+  });
+  const auto run = [&]<RunDamping D>(int t) {
+    Soa own = s;
+    for (int axis = 0; axis < 3; ++axis) own.a[FX + axis] = force_array(t, axis);
+    const std::size_t c0 = range_begin(chunks_.size(), parts, t), c1 = range_begin(chunks_.size(), parts, t + 1);
+    chunk_range<D>(own, chunks_.data(), mask_.data(), k_.data(), l_.data(), g_.data(), c0, c1, beta);
+    if (t == parts - 1)
+      for (const Index r : rest_)
+        if (a.alive[r] != 0) one_spring<D>(own, a.ni[r], a.nj[r], a.k[r], a.l[r], a.g[r], beta);
+  };
+  run_parts(parts, [&](int t) {
+    switch (damping) {
+      case RunDamping::none: run.template operator()<RunDamping::none>(t); break;
+      case RunDamping::viscous: run.template operator()<RunDamping::viscous>(t); break;
+      case RunDamping::stiffness_proportional: run.template operator()<RunDamping::stiffness_proportional>(t); break;
+    }
+  });
+  run_parts(parts, [&](int t) {
+    double* out = f.data();
+    for (int axis = 0; axis < 3; ++axis)
+      for (std::size_t p = node(t); p < node(t + 1); ++p) {
+        double sum = 0.0;
+        for (int u = 0; u < parts; ++u) {
+          double* acc = force_array(u, axis);
+          sum += acc[p];
+          acc[p] = 0.0;
+        }
+        out[3 * p + axis] = accumulate ? out[3 * p + axis] + sum : sum;
+      }
+  });
 }
 
 }  // namespace sewn::physics::detail

@@ -194,3 +194,16 @@ TEST_CASE("integrator.solver and the solver defaults: one iteration limit for th
   j["integrator"] = json::parse(R"({"absolute_tolerance": -1})");
   expect_error(j, "integrator.absolute_tolerance", ">= 0");
 }
+
+TEST_CASE("threads: the scene key sets the count, 0 (the default) leaves it to SEWN_THREADS") {
+  CHECK(parse_scene(minimal(), "beam.json").threads == 0);
+  json j = minimal();
+  j["threads"] = 2;
+  CHECK(parse_scene(j, "beam.json").threads == 2);
+  j["threads"] = -1;
+  expect_error(j, "threads", ">= 0");
+  j["threads"] = 1.5;
+  expect_error(j, "threads", "whole number");
+  j["threads"] = 1000;
+  expect_error(j, "threads", "256");
+}

@@ -143,6 +143,7 @@ struct Scene {
   double energy_rise_tolerance = 1e-4;  // relative, see physics::EnergyLedger
   bool stop_on_inversion = false;       // check every step, stop at the first inverted element
   std::vector<CutSpec> cuts;
+  std::uint32_t threads = 0;  // 0: SEWN_THREADS, else 1
   std::vector<ObstacleSpec> obstacles;
   RefinementSpec refinement;
   std::uint32_t frames = 50;

@@ -46,8 +46,13 @@ class BlockMatrix {
   [[nodiscard]] std::span<const Index> columns() const { return col_; }
   /// Zeroes every value, keeping the pattern. O(blocks).
   void set_zero();
-  /// y = A x for 3n vectors. O(blocks).
+  /// y = A x for 3n vectors, rows split over thread_count() threads (threads.hpp); the
+  /// result is the same bitwise for every count. O(blocks).
   void multiply(std::span<const double> x, std::span<double> y) const;
+  /// Rows [first, last) of y = A x, on the calling thread. O(blocks of those rows).
+  void multiply_rows(std::span<const double> x, std::span<double> y, Index first, Index last) const;
+  /// Rows per thread below which multiply() uses fewer threads.
+  static constexpr Index multiply_grain = 512;
   /// The same matrix as an Eigen sparse matrix (3n×3n), for tests and direct solvers. O(blocks).
   [[nodiscard]] Eigen::SparseMatrix<double> to_sparse() const;
   /// Changes whenever build_pattern() runs, unique across all matrices (0: never built); terms
@@ -55,6 +60,7 @@ class BlockMatrix {
   [[nodiscard]] std::uint64_t pattern_version() const { return version_; }
 
  private:
+
   Index n_ = 0;
   std::vector<Index> row_, col_, diag_;
   AlignedVector<double> val_;

@@ -15,4 +15,5 @@
 #include "sewn/physics/springs.hpp"
 #include "sewn/physics/stiffness.hpp"
 #include "sewn/physics/system.hpp"
+#include "sewn/physics/threads.hpp"
 #include "sewn/physics/types.hpp"

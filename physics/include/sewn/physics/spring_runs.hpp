@@ -75,6 +75,9 @@ class SpringRuns {
   struct Chunk {
     Index i0, j0;  // lane q joins nodes i0 + q and j0 + q
   };
+  // forces() on `parts` threads (spring_runs.cpp).
+  void forces_threads(const SpringArrays& a, RunDamping damping, double beta, std::span<const double> x,
+                      std::span<const double> v, std::span<double> f, bool accumulate, Index n, int parts) const;
   void ensure_lane_index(Index count);
   void to_rest(Index s);
   // Switches off spring s's lane, if it has one.
@@ -92,8 +95,8 @@ class SpringRuns {
   std::vector<Index> floor_;        // per block: the lowest node a later block touches
   std::size_t rest_at_build_ = 0;
   Index chunked_ = 0, live_ = 0;
-  // Per-axis node arrays: x y z, vx vy vz, and the force accumulators fx fy fz, which are all
-  // zero between calls.
+  // Per-axis node arrays: x y z, vx vy vz, and the force accumulators fx fy fz, then three more
+  // accumulators per thread past the first; the accumulators are all zero between calls.
   mutable AlignedVector<double> soa_;
   mutable std::size_t stride_ = 0;
 };

@@ -109,6 +109,12 @@ class Springs final : public ForceTerm {
   // The AoS path: every spring from rows of 4 doubles per node.
   void forces_by_rows(const StateView& s, std::span<double> f, bool accumulate) const;
   [[nodiscard]] detail::SpringArrays arrays() const;
+  bool spring_jacobian(const StateView& st, const JacobianRequest& req, Index s, Eigen::Matrix3d& Jx, Eigen::Matrix3d& B) const;
+  [[nodiscard]] Eigen::Vector3d spring_product(const JacobianRequest& req, Index s, const Eigen::Matrix3d& Jx) const;
+  // add_jacobians on `parts` threads (springs.cpp): the same result, bitwise.
+  void add_jacobians_threads(const StateView& st, const JacobianRequest& req, int parts) const;
+  // Springs per thread below which add_jacobians uses fewer threads.
+  static constexpr Index jacobian_grain = 4096;
 
   // Structure of arrays: the force loop streams these in order.
   AlignedVector<Index> ni_, nj_;
@@ -129,6 +135,12 @@ class Springs final : public ForceTerm {
   mutable AlignedVector<double> x_rows_, v_rows_, acc_;
   // The chunked path for springs numbered in runs (spring_runs.hpp), used when most are.
   mutable detail::SpringRuns runs_;
+  // The threaded assembly: each node's springs (2s + 0 at its i end, 2s + 1 at its j end, in
+  // spring order), built per topology, and per-spring blocks, products and "has a direction".
+  mutable std::vector<Index> incidence_row_, incidence_;
+  mutable std::uint64_t incidence_topology_ = ~std::uint64_t{0};
+  mutable AlignedVector<double> jac_blocks_, jac_products_;
+  mutable std::vector<std::uint8_t> jac_ok_;
 };
 
 }  // namespace sewn::physics

@@ -1,0 +1,32 @@
+#pragma once
+// How many threads the physics kernels use: spring forces and Jacobians, the block-sparse
+// product and the vector passes of block-Jacobi CG. Work is split into one contiguous range
+// per thread and per-thread partial results are combined in thread order, so a run is
+// deterministic for a given thread count; with different counts results agree to round-off
+// (reductions regroup), the Jacobian assembly and the product are bitwise equal.
+//
+// One thread unless asked: the count changes results in the last bits, so a program opts in,
+// through set_thread_count() or the environment variable SEWN_THREADS (read when the count is
+// first needed). Without OpenMP at build time (SEWN_WITH_OPENMP=OFF, or no OpenMP found) the
+// same per-thread split is run one range after the other: results equal those of a parallel
+// build with that count, only not faster.
+
+namespace sewn::physics {
+
+/// Largest thread count accepted.
+inline constexpr int max_threads = 256;
+
+/// The thread count in force (>= 1): the last set_thread_count(), else SEWN_THREADS, else 1.
+/// Throws InputError naming SEWN_THREADS if it is set to anything but an integer in
+/// [1, max_threads] and no count was set.
+[[nodiscard]] int thread_count();
+/// Sets the thread count for every later physics call of this process. Throws InputError
+/// (count unchanged) outside [1, max_threads]. Not to be called while a step runs.
+void set_thread_count(int threads);
+/// Parses a thread count as SEWN_THREADS and the tool's `threads` key give it; throws
+/// InputError naming `what` on anything but an integer in [1, max_threads].
+[[nodiscard]] int parse_thread_count(const char* text, const char* what);
+/// True if this build runs ranges in parallel (OpenMP found at build time).
+[[nodiscard]] bool parallel_build();
+
+}  // namespace sewn::physics

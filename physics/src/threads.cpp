@@ -1,0 +1,48 @@
+#include "sewn/physics/threads.hpp"
+
+#include <cerrno>
+#include <cstdlib>
+#include <string>
+
+#include "sewn/physics/errors.hpp"
+
+namespace sewn::physics {
+
+namespace {
+int chosen = 0;  // 0: not set, SEWN_THREADS decides
+}  // namespace
+
+int parse_thread_count(const char* text, const char* what) {
+  const std::string s = text != nullptr ? text : "";
+  char* end = nullptr;
+  errno = 0;
+  const long v = std::strtol(s.c_str(), &end, 10);
+  // strtol would skip leading blanks and take a sign: only plain digits are a count
+  if (s.empty() || s[0] < '0' || s[0] > '9' || end != s.c_str() + s.size() || errno != 0 || v < 1 || v > max_threads)
+    throw InputError(std::string(what) + ": expected a thread count, an integer from 1 to " + std::to_string(max_threads) +
+                     ", got '" + s + "'");
+  return static_cast<int>(v);
+}
+
+int thread_count() {
+  if (chosen > 0) return chosen;
+  const char* env = std::getenv("SEWN_THREADS");  // NOLINT(concurrency-mt-unsafe): read-only use
+  return env == nullptr ? 1 : parse_thread_count(env, "SEWN_THREADS");
+}
+
+void set_thread_count(int threads) {
+  if (threads < 1 || threads > max_threads)
+    throw InputError("set_thread_count: expected an integer from 1 to " + std::to_string(max_threads) + ", got " +
+                     std::to_string(threads));
+  chosen = threads;
+}
+
+bool parallel_build() {
+#ifdef SEWN_HAVE_OPENMP
+  return true;
+#else
+  return false;
+#endif
+}
+
+}  // namespace sewn::physics
