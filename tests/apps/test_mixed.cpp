@@ -85,9 +85,7 @@ int sewn_stdout(const std::string& args, std::string& out) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-}  // namespace mixed_test
 
-using namespace mixed_test;
 
 TEST_CASE("cell models: faces and edges of higher cells are labels unless a group names them") {
   const IndexedMesh m = block_flap_rod();
@@ -282,3 +280,5 @@ TEST_CASE("sewn check reports the simulated complex of a mesh with a face list, 
   CHECK(out.find("; 1 component (cells sharing a point)") != std::string::npos);
   CHECK(out.find("  tag 4 \"top\": ") != std::string::npos);
 }
+
+}  // namespace mixed_test

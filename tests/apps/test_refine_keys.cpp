@@ -54,9 +54,7 @@ double csv_value(const std::string& header, const std::string& row, const std::s
   return std::stod(row.substr(at));
 }
 
-}  // namespace refine_keys_test
 
-using namespace refine_keys_test;
 
 TEST_CASE("scene refinement: defaults, criteria and pre-refined regions") {
   CHECK_FALSE(parse_scene(beam_scene(), "s.json").refinement.enabled);
@@ -187,3 +185,5 @@ TEST_CASE("scene surface meshes: voxelized, refined, and skipped when optional a
   CHECK(refused(j).find("meshes[0].resolution: the scene needs about") == 0);
   std::filesystem::remove_all(dir);
 }
+
+}  // namespace refine_keys_test

@@ -58,9 +58,7 @@ struct SolidBody {
   }
 };
 
-}  // namespace solid_cuts_test
 
-using namespace solid_cuts_test;
 
 TEST_CASE("solid cut: energy and mass unchanged at the cut, the map valid, the two halves free") {
   SolidBody b(4, 1, 1);
@@ -132,3 +130,5 @@ TEST_CASE("solid cut: random sequences of plane cuts keep the map valid, energy,
     CHECK(b.model->nodes().size() > 64);  // particles were duplicated
   }
 }
+
+}  // namespace solid_cuts_test

@@ -195,23 +195,23 @@ TEST_CASE("an output folder the user may not write: exit 1 naming it, the files 
       return;
     }
   }
-  const fs::path scene = write("ro.json", tiny_scene);
+  const fs::path scene = tool_write("ro.json", tiny_scene);
   std::string err;
-  const fs::path out = scratch("read_only");
+  const fs::path out = tool_scratch("read_only");
   fs::remove_all(out);
-  REQUIRE(sewn("run --quiet --out " + out.string() + " " + scene.string(), err) == 0);
+  REQUIRE(run_sewn("run --quiet --out " + out.string() + " " + scene.string(), err) == 0);
   const std::string csv_before = read(out / "frames.csv");
   fs::permissions(out, fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read | fs::perms::group_exec |
                            fs::perms::others_read | fs::perms::others_exec);
   // the folder exists but is not writable: refused before any work
-  CHECK(sewn("run --quiet --out " + out.string() + " " + scene.string(), err, as_user) == 1);
+  CHECK(run_sewn("run --quiet --out " + out.string() + " " + scene.string(), err, as_user) == 1);
   CHECK_MESSAGE(err.find("cannot write the output: " + out.string() + ": cannot be written: Permission denied") != std::string::npos, err);
   CHECK(read(out / "frames.csv") == csv_before);
   // a folder to create inside it
-  CHECK(sewn("run --quiet --out " + (out / "sub").string() + " " + scene.string(), err, as_user) == 1);
+  CHECK(run_sewn("run --quiet --out " + (out / "sub").string() + " " + scene.string(), err, as_user) == 1);
   CHECK_MESSAGE(err.find((out / "sub").string() + ": cannot be created: Permission denied") != std::string::npos, err);
   // a checkpoint to resume there: the same
-  CHECK(sewn("run --quiet --checkpoint-every 10 --out " + out.string() + " " + scene.string(), err, as_user) == 1);
+  CHECK(run_sewn("run --quiet --checkpoint-every 10 --out " + out.string() + " " + scene.string(), err, as_user) == 1);
   CHECK_MESSAGE(err.find("Permission denied") != std::string::npos, err);
   for (const auto& e : fs::directory_iterator(out)) CHECK_MESSAGE(e.path().extension() != ".part", e.path());
   fs::permissions(out, fs::perms::owner_write, fs::perm_options::add);

@@ -18,6 +18,8 @@ using namespace sewn;
 using namespace sewn::connect;
 using Eigen::VectorXd;
 
+namespace test_point {  // one namespace per file: the unity build compiles several files as one
+
 namespace {
 
 constexpr double pi = std::numbers::pi;
@@ -416,3 +418,5 @@ TEST_CASE("point connection: cost of the chained and the nested-AD Hessian (repo
                                                                           << nested / chained << "x)");
   CHECK(chained > 0);
 }
+
+}  // namespace test_point

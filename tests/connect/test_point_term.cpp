@@ -62,9 +62,7 @@ struct RodInShell {
 
 double unwrap_to(double raw, double previous) { return raw + 2 * pi * std::round((previous - raw) / (2 * pi)); }
 
-}  // namespace point_term_test
 
-using namespace point_term_test;
 
 TEST_CASE("point connections term: forces, torques and Jacobian of a rod-shell joint against finite differences") {
   RodInShell s(TwistUpdate::incremental_ii);
@@ -188,7 +186,6 @@ TEST_CASE("point connections term: singular configurations have infinite energy,
   CHECK(s.sys.angles().values()[s.theta] == before);
 }
 
-namespace point_term_test {
 
 // A horizontal cantilever of two rods sharing node 5 (rod A: nodes 0..5, clamped at 0, 1 and
 // θ^0; rod B: nodes 5..10), joined at node 5 with stiffness k (none: a free hinge), or one
@@ -230,7 +227,6 @@ CantileverResult settled_cantilever(bool split, PointStiffness k) {
   return out;
 }
 
-}  // namespace point_term_test
 
 TEST_CASE("point connections term: a split cantilever rejoined with k_b = EI/D bends like the rod; the stiff option holds the joint rigid") {
   const auto sec = physics::rods::Section::circular(1e8, 0.3, 0.005);
@@ -264,3 +260,5 @@ TEST_CASE("point connections term: a rod side needs the rods' twist as angle DOF
   CHECK(joints.add("tip", RodEdgeRef{0, 0}, TriangleSide{{a, c, d}, std::nullopt}, {1, 1}, sys.state()) == 0);
   CHECK_THROWS_AS((void)rigid_stiffness(physics::rods::Section::circular(1e6, 0.3, 0.01), 0.0), physics::InputError);
 }
+
+}  // namespace point_term_test

@@ -18,6 +18,8 @@ using physics::rods::Points;
 using physics::rods::Rod;
 using physics::rods::Section;
 
+namespace test_split_rod {  // one namespace per file: the unity build compiles several files as one
+
 namespace {
 
 // A straight rod along x with uneven edges (lengths 0.1·(1 + 0.3 sin j)).
@@ -182,3 +184,5 @@ TEST_CASE("a rod split by a point connection with k_b = EI/D bends like the unsp
     previous = rel;
   }
 }
+
+}  // namespace test_split_rod

@@ -63,9 +63,7 @@ class StepCounter final : public ForceTerm {
   int steps = 0;
 };
 
-}  // namespace angle_dofs_test
 
-using namespace angle_dofs_test;
 
 TEST_CASE("rod angle DOFs: torques and forces are minus the gradient, the Jacobian its second derivative") {
   System sys;
@@ -203,3 +201,5 @@ TEST_CASE("rod angle DOFs: integrators that cannot integrate them refuse, Newton
   for (int s = 0; s < 3; ++s) (void)newton.step(sys, 1e-3);
   CHECK(counter.steps == 3);
 }
+
+}  // namespace angle_dofs_test

@@ -30,9 +30,7 @@ Index live_hexahedra(const MssModel<3>& m) {
   return n;
 }
 
-}  // namespace criteria_test
 
-using namespace criteria_test;
 
 TEST_CASE("refine criteria: a region at rest picks the elements whose rest centroid is in it") {
   MssModel<3> m = bar();
@@ -150,3 +148,5 @@ TEST_CASE("a kinematic face keeps its motion on the particles refinement adds") 
       CHECK(m.nodes().velocity(i).z() == doctest::Approx(0.5));
     }
 }
+
+}  // namespace criteria_test
