@@ -406,6 +406,9 @@ void add_volume_term(const Scene& scene, const std::vector<std::string>& materia
       throw SceneError(scene.file, "materials." + name + ".volume_stiffness",
                        "the volume term is not supported with cuts yet (its stencils would keep the nodes of before a cut)");
   }
+  // Materials past the scene's own are copies apply_rod_sections made for rod cells, which have
+  // no volume to keep.
+  kappa.resize(model.materials().size(), 0.0);
   (void)physics::solids::add_volume_preservation(model, kappa);
 }
 
