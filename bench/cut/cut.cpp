@@ -40,6 +40,7 @@
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/refine/cut.hpp"
+#include "mss_setup.hpp"
 #include "sewn_bench.hpp"
 
 namespace sewn::bench::cut {
@@ -61,15 +62,7 @@ struct MeshCase {
 };
 
 std::unique_ptr<MssModel<3>> build_model(const MeshCase& c) {
-  physics::MaterialParams mat;
-  mat.young = kE;
-  mat.poisson = kNu;
-  mat.density = kRho;
-  physics::MssOptions opt;
-  opt.damping = physics::DampingModel::viscous;
-  opt.gravity = Vec3d(0, 0, kG);
-  opt.source = c.name;
-  auto m = std::make_unique<MssModel<3>>(c.mesh, std::vector<physics::MaterialParams>{mat}, std::vector<std::uint32_t>{}, opt);
+  auto m = viscous_model(c.mesh, kE, kNu, kRho, kG, c.name);
   double lo = INFINITY;
   for (physics::Index i = 0; i < m->nodes().size(); ++i) lo = std::min(lo, m->rest_position(i)[c.clamp_axis]);
   for (physics::Index i = 0; i < m->nodes().size(); ++i)

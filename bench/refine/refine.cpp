@@ -33,6 +33,7 @@
 #include "sewn/refine/criterion.hpp"
 #include "sewn/refine/hierarchy.hpp"
 #include "sewn/refine/subdivide.hpp"
+#include "mss_setup.hpp"
 #include "sewn_bench.hpp"
 
 namespace sewn::bench::refine_suite {
@@ -56,16 +57,7 @@ struct Config {
 std::unique_ptr<MssModel<3>> beam(int refined) {
   const std::uint32_t n = 1u << refined;
   const double a = 1.0 / n;
-  physics::MaterialParams mat;
-  mat.young = kE;
-  mat.poisson = kNu;
-  mat.density = kRho;
-  physics::MssOptions opt;
-  opt.damping = physics::DampingModel::viscous;
-  opt.gravity = Vec3d(0, 0, kG);
-  opt.source = "table1 beam";
-  auto m = std::make_unique<MssModel<3>>(hex_grid(2 * n, n, n, {{a, a, a}, {0, 0, 0}}), std::vector<physics::MaterialParams>{mat},
-                                         std::vector<std::uint32_t>{}, opt);
+  auto m = viscous_model(hex_grid(2 * n, n, n, {{a, a, a}, {0, 0, 0}}), kE, kNu, kRho, kG, "table1 beam");
   for (Index i = 0; i < m->nodes().size(); ++i)
     if (m->rest_position(i).x() == 0) m->nodes().fix(i);
   return m;
