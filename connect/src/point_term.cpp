@@ -5,8 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include <Eigen/Eigenvalues>
-
+#include "sewn/physics/elements/element_math.hpp"
 #include "sewn/physics/nodes.hpp"
 
 namespace sewn::connect {
@@ -20,28 +19,6 @@ PointStiffness rigid_stiffness(const physics::rods::Section& section, double res
                      std::to_string(rest_length));
   return {factor * section.GJ / rest_length, factor * std::min(section.EI1, section.EI2) / rest_length};
 }
-
-namespace {
-
-// Eigenvalues clamped at 0, on a fixed-size copy (stencils have 14, 16 or 18 DOFs): Eigen's
-// dynamic-size eigensolver draws GCC 12's AVX-512 false positives.
-template <int N>
-void project_fixed(Eigen::MatrixXd& H) {
-  const Eigen::Matrix<double, N, N> A = H;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> es(A);
-  H = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).asDiagonal() * es.eigenvectors().transpose();
-}
-
-void project_psd(Eigen::MatrixXd& H) {
-  switch (H.rows()) {
-    case 14: project_fixed<14>(H); break;
-    case 16: project_fixed<16>(H); break;
-    case 18: project_fixed<18>(H); break;
-    default: throw std::logic_error("point connections: a stencil of " + std::to_string(H.rows()) + " DOFs");
-  }
-}
-
-}  // namespace
 
 PointConnections::PointConnections(const physics::rods::Rods* rods, TwistUpdate update) : rods_(rods), update_(update) {}
 
@@ -164,7 +141,7 @@ void PointConnections::add_jacobians(const StateView& s, const physics::Jacobian
   for (const Item& it : items_) {
     Eigen::MatrixXd H;
     (void)it.connection.evaluate(gather(it.dofs, s, it.connection.name()), update_, true, &H);
-    if (req.options.project_element_hessians) project_psd(H);
+    if (req.options.project_element_hessians) physics::elements::project_psd(H);
     const std::size_t nb = it.blocks.size();
     for (std::size_t i = 0; i < it.dofs.size(); ++i)
       for (std::size_t j = 0; j < it.dofs.size(); ++j) {

@@ -8,6 +8,8 @@
 #include <numbers>
 #include <random>
 
+#include <Eigen/Eigenvalues>
+
 #include "elastic_helpers.hpp"
 #include "helpers.hpp"
 #include "sewn/physics/shells/shell_terms.hpp"
@@ -179,14 +181,14 @@ TEST_CASE("PSD projection clamps negative eigenvalues and keeps PSD matrices") {
   Eigen::SelfAdjointEigenSolver<elements::Mat<12>> before(A);
   REQUIRE(before.eigenvalues().minCoeff() < 0.0);
   elements::Mat<12> P = A;
-  const double lowest = elements::project_psd<12>(P);
+  const double lowest = elements::project_psd(P);
   CHECK(lowest == doctest::Approx(before.eigenvalues().minCoeff()));
   Eigen::SelfAdjointEigenSolver<elements::Mat<12>> after(P);
   const auto expect = before.eigenvalues().cwiseMax(0.0).eval();
   CHECK((after.eigenvalues() - expect).cwiseAbs().maxCoeff() < 1e-12);
   elements::Mat<12> Q = P * P + elements::Mat<12>::Identity();  // positive definite: unchanged
   const elements::Mat<12> keep = Q;
-  CHECK(elements::project_psd<12>(Q) == 0.0);
+  CHECK(elements::project_psd(Q) == 0.0);
   CHECK((Q - keep).cwiseAbs().maxCoeff() < 1e-12 * keep.cwiseAbs().maxCoeff());
 }
 

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <random>
 
+#include <Eigen/Eigenvalues>
+
 #include "helpers.hpp"
 
 using namespace sewn::physics;

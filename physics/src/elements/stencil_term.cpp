@@ -84,7 +84,7 @@ void StencilTerm<N>::add_jacobians(const StateView& s, const JacobianRequest& re
   if (req.cx == 0.0 && !product) return;
   for (Index e = 0; e < size(); ++e) {
     Hessian H = element_hessian(e, gather(s, e));
-    if (req.options.project_element_hessians) project_psd<3 * N>(H);
+    if (req.options.project_element_hessians) project_psd(H);
     const Nodes& n = nodes_[e];
     if (req.matrix != nullptr && req.cx != 0.0)
       for (int a = 0; a < N; ++a)
@@ -105,7 +105,7 @@ template <int N>
 void StencilTerm<N>::add_stability_rows(const StateView& s, StabilityRows& rows) const {
   for (Index e = 0; e < size(); ++e) {
     Hessian H = element_hessian(e, gather(s, e));
-    project_psd<3 * N>(H);
+    project_psd(H);
     const Nodes& n = nodes_[e];
     for (int a = 0; a < N; ++a) {
       rows.add_diagonal(StabilityRows::stiffness, n[a], H.template block<3, 3>(3 * a, 3 * a));

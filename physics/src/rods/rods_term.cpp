@@ -4,8 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include <Eigen/Eigenvalues>
-
+#include "sewn/physics/elements/element_math.hpp"
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/nodes.hpp"
 
@@ -14,10 +13,9 @@ namespace sewn::physics::rods {
 namespace {
 
 template <int N>
-Eigen::Matrix<double, N, N> project_psd(const Eigen::Matrix<double, N, N>& H) {
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> es(H);
-  const Eigen::Matrix<double, N, 1> lambda = es.eigenvalues().cwiseMax(0.0);
-  return es.eigenvectors() * lambda.asDiagonal() * es.eigenvectors().transpose();
+Eigen::Matrix<double, N, N> projected(Eigen::Matrix<double, N, N> H) {
+  elements::project_psd(H);
+  return H;
 }
 
 }  // namespace
@@ -221,7 +219,7 @@ void Rods::for_each_block(const Entry& e, const Points& x, bool project, Visit&&
                                        e.rod.theta()[static_cast<std::size_t>(ed[1])], e.rod.stencil_rest(s),
                                        e.rod.stencil_frames(s), Want::hessian);
     Eigen::Matrix<double, 9, 9> H = b.hessian.topLeftCorner<9, 9>();
-    if (project) H = project_psd<9>(H);
+    if (project) H = projected<9>(H);
     for (int a = 0; a < 3; ++a)
       for (int c = 0; c < 3; ++c, ++slot) visit(v[static_cast<std::size_t>(a)], v[static_cast<std::size_t>(c)], Eigen::Matrix3d(H.block<3, 3>(3 * a, 3 * c)), slot);
   }
@@ -230,7 +228,7 @@ void Rods::for_each_block(const Entry& e, const Points& x, bool project, Visit&&
     const int v[2] = {j, (j + 1) % n};
     const StretchEval st = stretch(x.col(v[0]), x.col(v[1]), e.rod.section().EA, e.rod.rest_length(j), true);
     Eigen::Matrix<double, 6, 6> H = st.hessian;
-    if (project) H = project_psd<6>(H);
+    if (project) H = projected<6>(H);
     for (int a = 0; a < 2; ++a)
       for (int c = 0; c < 2; ++c, ++slot) visit(v[a], v[c], Eigen::Matrix3d(H.block<3, 3>(3 * a, 3 * c)), slot);
   }
@@ -277,14 +275,14 @@ void Rods::add_jacobians_with_angles(const StateView& s, const JacobianRequest& 
       std::array<Index, 5> block{};
       std::array<int, 11> comp{};
       stencil_blocks(e, st, block, comp);
-      scatter_hessian<11>(project_ ? project_psd<11>(b.hessian) : b.hessian, block, comp, stencil_group, slots.subspan(slot), req);
+      scatter_hessian<11>(project_ ? projected<11>(b.hessian) : b.hessian, block, comp, stencil_group, slots.subspan(slot), req);
     }
     const int n = e.rod.num_vertices();
     for (int j = 0; j < e.rod.num_edges(); ++j, slot += 4) {
       const int v[2] = {j, (j + 1) % n};
       const StretchEval st = stretch(x.col(v[0]), x.col(v[1]), e.rod.section().EA, e.rod.rest_length(j), true);
       const std::array<Index, 2> block{e.nodes[static_cast<std::size_t>(v[0])], e.nodes[static_cast<std::size_t>(v[1])]};
-      scatter_hessian<6>(project_ ? project_psd<6>(st.hessian) : st.hessian, block, edge_comp, edge_group, slots.subspan(slot), req);
+      scatter_hessian<6>(project_ ? projected<6>(st.hessian) : st.hessian, block, edge_comp, edge_group, slots.subspan(slot), req);
     }
   }
 }
