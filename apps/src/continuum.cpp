@@ -244,7 +244,8 @@ std::vector<Point3> rod_directors(const ContinuumParts& parts, const physics::Ms
   std::vector<Point3> out(elements.size(), Point3{0, 0, 0});
   if (!parts.rods) return out;
   // read through the const term: its non-const rod() forgets the last θ solve, and writing a
-  // frame must not change the run (a re-solve from a solved θ moves its last bits)
+  // frame has no reason to cost the next force evaluation a twist solve (a no-op from a solved
+  // θ: it stops at once, its Newton step below 1e-13)
   const physics::rods::Rods& rods = *parts.rods;
   const auto x = model.nodes().x();
   std::map<Index, physics::rods::Points> positions;  // per rod, gathered once
