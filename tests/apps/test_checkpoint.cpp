@@ -346,6 +346,14 @@ TEST_CASE("adaptive refinement resumes to the same bytes: its edits are done aga
     const std::string csv = slurp(scratch("refining_whole") / "frames.csv");
     CHECK(csv.find(",1,4,50,32\n") != std::string::npos);  // the last row: 1 cut of 4 faces, 50 refined, 32 coarsened
   }
+  SUBCASE("stopped while families are counting their calm steps") {
+    // 24 families merge at frame 7 after 8 calm steps, a count that runs across the checkpoint
+    // of frame 6 (5 steps a frame): the hysteresis counters must come back with the model
+    std::string slow = refining;
+    slow.replace(slow.find("\"calm_steps\": 3"), 15, "\"calm_steps\": 8");
+    check_continuation("refining_calm", beam("refining_calm", implicit_h, plane_cut, slow + "}"), 1, {6});
+    CHECK(slurp(scratch("refining_calm_whole") / "frames.csv").find(",1,4,36,24\n") != std::string::npos);
+  }
   SUBCASE("T-junctions by the paper's projection, cholmod-pcg, stopped at every frame") {
     if (!have_cholmod()) return;
     check_continuation("refining_pcg",
