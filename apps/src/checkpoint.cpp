@@ -122,6 +122,46 @@ physics::EnergyWatchdog::State get_watchdog(Decoder& d) {
   return w;
 }
 
+void put_vec3s(Encoder& e, const std::vector<physics::rods::Vec3>& v) {
+  std::vector<double> flat;
+  for (const auto& p : v) flat.insert(flat.end(), {p.x(), p.y(), p.z()});
+  e.put(flat);
+}
+
+std::vector<physics::rods::Vec3> get_vec3s(Decoder& d, const char* what, std::size_t expected) {
+  std::vector<double> flat;
+  d.get(flat, what);
+  if (flat.size() != 3 * expected)
+    d.fail(std::string(what) + ": " + std::to_string(flat.size()) + " coordinates for " + std::to_string(expected) + " edges");
+  std::vector<physics::rods::Vec3> v;
+  for (std::size_t k = 0; k < flat.size(); k += 3) v.emplace_back(flat[k], flat[k + 1], flat[k + 2]);
+  return v;
+}
+
+void put_rods(Encoder& e, const std::vector<physics::rods::Rods::RodHistory>& rods) {
+  e.put(static_cast<std::uint64_t>(rods.size()));
+  for (const auto& r : rods) {
+    e.put(r.rod.theta);
+    put_vec3s(e, r.rod.tangent);
+    put_vec3s(e, r.rod.director);
+    e.put(r.rod.reference_twist);
+    e.put(r.solved_at);
+  }
+}
+
+std::vector<physics::rods::Rods::RodHistory> get_rods(Decoder& d) {
+  std::vector<physics::rods::Rods::RodHistory> rods(d.count("rods", 5 * 8));
+  for (auto& r : rods) {
+    d.get(r.rod.theta, "rod angles");
+    r.rod.tangent = get_vec3s(d, "rod tangents", r.rod.theta.size());
+    r.rod.director = get_vec3s(d, "rod directors", r.rod.theta.size());
+    d.get(r.rod.reference_twist, "rod reference twists");
+    d.get(r.solved_at, "rod solve positions");
+    if (r.solved_at.size() % 3 != 0) d.fail(std::to_string(r.solved_at.size()) + " rod solve coordinates (3 per vertex)");
+  }
+  return rods;
+}
+
 std::string encode_payload(const Checkpoint& c) {
   Encoder e;
   e.put(c.run_hash);
@@ -135,6 +175,7 @@ std::string encode_payload(const Checkpoint& c) {
     e.put(a.spec);
     e.put<std::uint8_t>(a.pierce);
     e.put<std::uint8_t>(a.remove);
+    e.put(a.refinement);
     e.put(a.darts);
     e.put(a.betas);
     e.put(a.elements);
@@ -154,11 +195,18 @@ std::string encode_payload(const Checkpoint& c) {
   e.put(c.implicit.warm_start);
   e.put(c.implicit.steps);
   put_watchdog(e, c.implicit.watchdog);
+  e.put(c.implicit.solver.factored);
+  e.put<std::uint8_t>(c.implicit.solver.refresh_due);
   e.put(c.midpoint.steps);
   put_watchdog(e, c.midpoint.watchdog);
   const auto& l = c.ledger;
   for (double x : {l.total0, l.external0, l.last_total, l.last_moving, l.last_external}) e.put(x);
   e.put(l.rises);
+  put_rods(e, c.rods);
+  e.put(c.refinement.refined);
+  e.put(c.refinement.coarsened);
+  e.put(c.refinement.dissipated);
+  e.put(c.refinement.calm);
   e.put(c.frame_times);
   e.put(c.csv_columns);
   e.put(c.csv_rows);
@@ -185,16 +233,19 @@ Checkpoint decode_payload(Decoder& d) {
   c.frames_total = d.get<std::uint32_t>("frame count");
   c.step = d.get<std::uint64_t>("steps done");
   c.frame = d.get<std::uint32_t>("frames done");
-  c.cuts.resize(d.count("applied cuts", 4 + 2 + 3 * 8));
+  c.cuts.resize(d.count("applied cuts", 4 + 3 + 3 * 8));
   for (AppliedCut& a : c.cuts) {
     a.spec = d.get<std::uint32_t>("cut index");
     a.pierce = d.flag("pierce flag");
     a.remove = d.flag("remove flag");
+    a.refinement = d.get<std::uint8_t>("refinement kind");
+    if (a.refinement > 2) d.fail("refinement kind " + std::to_string(a.refinement) + " (0 to 2)");
     d.get(a.darts, "cut darts");
     d.get(a.betas, "cut betas");
-    d.get(a.elements, "pierced elements");
+    d.get(a.elements, "edited elements");
     if (a.darts.size() != a.betas.size()) d.fail("a cut lists " + std::to_string(a.darts.size()) + " darts but " +
                                                  std::to_string(a.betas.size()) + " beta indices");
+    if (a.refinement != 0 && (a.pierce || !a.darts.empty())) d.fail("a refinement or coarsening that also cuts or pierces");
   }
   d.get(c.x, "positions");
   d.get(c.v, "velocities");
@@ -213,11 +264,18 @@ Checkpoint decode_payload(Decoder& d) {
   d.get(c.implicit.warm_start, "warm start");
   c.implicit.steps = d.get<std::uint64_t>("implicit steps");
   c.implicit.watchdog = get_watchdog(d);
+  d.get(c.implicit.solver.factored, "factored matrix");
+  c.implicit.solver.refresh_due = d.flag("factorization refresh flag");
   c.midpoint.steps = d.get<std::uint64_t>("midpoint steps");
   c.midpoint.watchdog = get_watchdog(d);
   auto& l = c.ledger;
   for (double* x : {&l.total0, &l.external0, &l.last_total, &l.last_moving, &l.last_external}) *x = d.get<double>("energy ledger");
   l.rises = d.get<std::uint64_t>("energy rises");
+  c.rods = get_rods(d);
+  c.refinement.refined = d.get<std::uint64_t>("refinements");
+  c.refinement.coarsened = d.get<std::uint64_t>("coarsenings");
+  c.refinement.dissipated = d.get<double>("coarsening dissipation");
+  d.get(c.refinement.calm, "calm counters");
   d.get(c.frame_times, "frame times");
   c.csv_columns = d.get<std::uint32_t>("csv columns");
   d.get(c.csv_rows, "csv rows");

@@ -243,14 +243,18 @@ std::vector<Point3> rod_directors(const ContinuumParts& parts, const physics::Ms
                                   std::span<const physics::Index> elements) {
   std::vector<Point3> out(elements.size(), Point3{0, 0, 0});
   if (!parts.rods) return out;
+  // read through the const term: its non-const rod() forgets the last θ solve, and writing a
+  // frame has no reason to cost the next force evaluation a twist solve (a no-op from a solved
+  // θ: it stops at once, its Newton step below 1e-13)
+  const physics::rods::Rods& rods = *parts.rods;
   const auto x = model.nodes().x();
   std::map<Index, physics::rods::Points> positions;  // per rod, gathered once
   for (std::size_t k = 0; k < elements.size(); ++k) {
     const auto [r, edge] = parts.rod_edge_of_element[elements[k]];
     if (r == physics::invalid_index) continue;
     auto it = positions.find(r);
-    if (it == positions.end()) it = positions.emplace(r, parts.rods->gather(r, x)).first;
-    const Vec3d m1 = parts.rods->rod(r).material_directors(it->second, edge).first;
+    if (it == positions.end()) it = positions.emplace(r, rods.gather(r, x)).first;
+    const Vec3d m1 = rods.rod(r).material_directors(it->second, edge).first;
     out[k] = {m1.x(), m1.y(), m1.z()};
   }
   return out;

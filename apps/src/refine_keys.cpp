@@ -121,6 +121,7 @@ struct RefinementRun::Impl {
   std::string file;
   std::unique_ptr<refine::Criterion<3>> criterion;
   std::unique_ptr<refine::Adapter<3>> adapter;
+  refine::RefineOptions options;
   double max_elements = 0;
 };
 
@@ -140,6 +141,7 @@ RefinementRun::RefinementRun(const Scene& scene, physics::MssModel<3>& model) : 
   refine::RefineOptions options;
   options.max_level = static_cast<int>(spec.max_level);
   options.max_elements = static_cast<std::uint64_t>(spec.max_elements);
+  impl_->options = options;
   for (std::size_t i = 0; i < spec.pre_refine.size(); ++i) {
     const PreRefineSpec& p = spec.pre_refine[i];
     const std::string path = "refinement.pre_refine[" + std::to_string(i) + "]";
@@ -186,6 +188,8 @@ RefinementRun::RefinementRun(const Scene& scene, physics::MssModel<3>& model) : 
 RefinementRun::~RefinementRun() = default;
 
 bool RefinementRun::after_step(physics::MssModel<3>& model, double t) {
+  last_refined_.clear();
+  last_coarsened_.clear();
   if (!impl_->adapter) return false;
   refine::Adapter<3>::Report rep;
   try {
@@ -200,7 +204,30 @@ bool RefinementRun::after_step(physics::MssModel<3>& model, double t) {
   refined_ += rep.refined.elements;
   coarsened_ += rep.coarsened;
   dissipated_ += rep.dissipated_energy;
+  last_refined_ = std::move(rep.refined_elements);
+  last_coarsened_ = std::move(rep.coarsened_parents);
   return rep.refined.elements > 0 || rep.coarsened > 0;
+}
+
+void RefinementRun::redo(physics::MssModel<3>& model, bool coarsening, std::span<const physics::Index> elements) const {
+  if (!coarsening) {
+    (void)refine::refine_elements(model, elements, impl_->options);
+    return;
+  }
+  for (physics::Index p : elements) (void)refine::coarsen(model, p);  // it refuses what it cannot merge, naming it
+}
+
+RefinementRun::State RefinementRun::state() const {
+  State s{refined_, coarsened_, dissipated_, {}};
+  if (impl_->adapter) s.calm.assign(impl_->adapter->calm_counts().begin(), impl_->adapter->calm_counts().end());
+  return s;
+}
+
+void RefinementRun::restore(const State& s) {
+  refined_ = s.refined;
+  coarsened_ = s.coarsened;
+  dissipated_ = s.dissipated;
+  if (impl_->adapter) impl_->adapter->restore_calm_counts(std::vector<int>(s.calm.begin(), s.calm.end()));
 }
 
 }  // namespace sewn::app

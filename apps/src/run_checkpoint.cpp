@@ -1,5 +1,6 @@
 #include "run_checkpoint.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -30,29 +31,6 @@ struct Hasher {
 };
 
 }  // namespace
-
-void require_checkpointable(const Scene& scene, const physics::MssModel<3>& model, bool simulates_rods,
-                            const std::string& option) {
-  if (scene.refinement.enabled)
-    throw SceneError(scene.file, "refinement",
-                     option + " is not available with adaptive refinement yet: the hierarchy and its T-junctions are not saved in checkpoints");
-  if (simulates_rods)
-    throw SceneError(scene.file, "model.type",
-                     option + " is not available with rods yet: their reference frames and twist are not saved in checkpoints");
-  if (scene.model != "mass-spring" && !scene.cuts.empty())
-    throw SceneError(scene.file, "cuts",
-                     option + " is not available when a \"" + scene.model +
-                         "\" model cuts yet: a resumed run would not move its elements onto the duplicated particles");
-  // Newton's backward Euler starts every step afresh (from x + h·v, with no watchdog), and the
-  // midpoint integrator's history is in checkpoints; only the linear solver's is not.
-  if (scene.integrator != "implicit") return;
-  const auto asked = physics::solve::parse_backend(scene.solver);
-  const auto b = asked == physics::solve::Backend::automatic ? physics::solve::default_backend(model.nodes().size()) : asked;
-  if (b != physics::solve::Backend::jacobi)
-    throw SceneError(scene.file, "integrator.solver",
-                     option + " is not available with the \"" + std::string(physics::solve::to_string(b)) +
-                         "\" solver yet: the factorization it keeps across steps is not saved in checkpoints (use \"jacobi\")");
-}
 
 std::uint64_t model_hash(const physics::MssModel<3>& model) {
   Hasher h;
@@ -102,9 +80,19 @@ std::uint64_t run_hash(const Scene& scene, const physics::MssModel<3>& model, st
   return h.h;
 }
 
-void replay_cuts(physics::MssModel<3>& model, const Checkpoint& c, const std::string& file) {
+void replay_cuts(physics::MssModel<3>& model, const RefinementRun* refinement, const Checkpoint& c, const std::string& file) {
   for (std::size_t k = 0; k < c.cuts.size(); ++k) {
     const AppliedCut& a = c.cuts[k];
+    if (a.refinement != 0) {
+      const std::string which = std::string("recorded ") + (a.refinement == 1 ? "refinement" : "coarsening") + " " + std::to_string(k + 1);
+      if (!refinement) throw CheckpointError(file, which + " in a run of a scene that refines nothing");
+      try {
+        refinement->redo(model, a.refinement == 2, std::span<const physics::Index>(a.elements));
+      } catch (const physics::InputError& e) {
+        throw CheckpointError(file, which + " does not fit the scene's model: " + e.what());
+      }
+      continue;
+    }
     const std::string which = "recorded cut " + std::to_string(k + 1) + " (cuts[" + std::to_string(a.spec) + "])";
     if (a.pierce) {
       for (std::uint32_t e : a.elements)
@@ -130,6 +118,45 @@ void replay_cuts(physics::MssModel<3>& model, const Checkpoint& c, const std::st
   if (model_hash(model) != c.model_hash)
     throw CheckpointError(file, "its cuts, applied to the scene's model, give a different model than the run had: "
                                 "the scene or a mesh file changed since, or the checkpoint is corrupt");
+}
+
+std::size_t check_cut_schedule(const Checkpoint& c, std::span<const std::pair<double, std::size_t>> cuts, const std::string& file) {
+  std::size_t done = 0;
+  for (const AppliedCut& a : c.cuts) {
+    if (a.refinement != 0) continue;
+    if (done == cuts.size()) throw CheckpointError(file, "records more cuts than the scene schedules");
+    if (a.spec != cuts[done].second) throw CheckpointError(file, "its cuts are not the scene's, in the scene's order");
+    ++done;
+  }
+  return done;
+}
+
+void restore_model(physics::MssModel<3>& model, const ContinuumParts& continuum, RefinementRun* refinement, const Checkpoint& c,
+                   const std::string& file) {
+  replay_cuts(model, refinement, c, file);
+  if (refinement) {
+    if (c.refinement.calm.size() > model.elements().size())
+      throw CheckpointError(file, "holds " + std::to_string(c.refinement.calm.size()) + " calm counters for a model of " +
+                                      std::to_string(model.elements().size()) + " elements");
+    refinement->restore(c.refinement);
+  }
+  // the run moved its tetrahedra onto the duplicated particles after each cut; once after all
+  // of them gives the same node lists, as each follows the model's elements as they end up
+  if (continuum.tets) follow_cut(continuum, model);
+  physics::NodeTable& nodes = model.nodes();
+  if (c.x.size() != nodes.x().size())
+    throw CheckpointError(file, "holds " + std::to_string(c.x.size() / 3) + " particles for a model of " + std::to_string(nodes.size()));
+  std::copy(c.x.begin(), c.x.end(), nodes.x().begin());
+  std::copy(c.v.begin(), c.v.end(), nodes.v().begin());
+  if (!continuum.rods) {
+    if (!c.rods.empty()) throw CheckpointError(file, "holds " + std::to_string(c.rods.size()) + " rods, and the scene's model has none");
+    return;
+  }
+  try {
+    continuum.rods->restore(c.rods);
+  } catch (const physics::InputError& e) {
+    throw CheckpointError(file, std::string("its rods do not fit the scene's: ") + e.what());
+  }
 }
 
 }  // namespace sewn::app::detail

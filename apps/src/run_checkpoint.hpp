@@ -1,23 +1,19 @@
 #pragma once
-// The runner's side of checkpoints (sewn/apps/checkpoint.hpp holds the file format): which
-// runs can be checkpointed, what identifies a run and a model, and bringing a freshly built
-// model to a checkpoint's topology and motion.
+// The runner's side of checkpoints (sewn/apps/checkpoint.hpp holds the file format): what
+// identifies a run and a model, and bringing a freshly built model to a checkpoint's topology,
+// motion and history.
 
 #include <cstdint>
+#include <span>
 #include <string>
+#include <utility>
 
 #include "sewn/apps/checkpoint.hpp"
+#include "sewn/apps/continuum.hpp"
 #include "sewn/apps/scene.hpp"
 #include "sewn/physics/mss_model.hpp"
 
 namespace sewn::app::detail {
-
-/// Throws SceneError naming the key when the scene's run keeps state a checkpoint does not
-/// hold (a CHOLMOD factorization, the refinement hierarchy, rods' frames and twist, the elastic
-/// terms' node lists after a cut), so that a resumed run never continues differently. `option`
-/// names the command-line option asked for; `simulates_rods` says whether any cell is a rod.
-void require_checkpointable(const Scene& scene, const physics::MssModel<3>& model, bool simulates_rods,
-                            const std::string& option);
 
 /// A hash of everything of the model that topology edits change: dart count, node masses,
 /// fixed axes and rest positions, springs (ends, stiffness, rest length, viscosity, liveness),
@@ -30,9 +26,23 @@ void require_checkpointable(const Scene& scene, const physics::MssModel<3>& mode
 [[nodiscard]] std::uint64_t run_hash(const Scene& scene, const physics::MssModel<3>& model, std::uint64_t steps,
                                      std::uint32_t frames);
 
-/// Applies the checkpoint's recorded cuts to a model built from its scene, then checks the
-/// result against the stored model hash. Throws CheckpointError (naming `file`) for a cut that
-/// does not fit the model (a dart or element that does not exist) or a different result.
-void replay_cuts(physics::MssModel<3>& model, const Checkpoint& c, const std::string& file);
+/// Applies the checkpoint's recorded topology edits, in their order, to a model built from its
+/// scene (refinements and coarsenings through `refinement`, null if the scene refines
+/// nothing), then checks the result against the stored model hash. Throws CheckpointError
+/// (naming `file`) for an edit that does not fit the model (a dart or element that does not
+/// exist, a refinement in a scene without) or a different result.
+void replay_cuts(physics::MssModel<3>& model, const RefinementRun* refinement, const Checkpoint& c, const std::string& file);
+
+/// Checks the checkpoint's scheduled cuts against the scene's, in time order (`cuts`: time and
+/// index in the scene's cuts) and returns how many were applied. Throws CheckpointError.
+[[nodiscard]] std::size_t check_cut_schedule(const Checkpoint& c, std::span<const std::pair<double, std::size_t>> cuts,
+                                             const std::string& file);
+
+/// Brings a model (and its continuum terms) freshly built from the checkpoint's scene to the
+/// checkpoint's state: the recorded edits applied again (replay_cuts) and followed by the
+/// tetrahedra, the positions and velocities, the rods' own state, the refinement's counters.
+/// Throws CheckpointError (naming `file`) for anything that does not fit the model. O(model).
+void restore_model(physics::MssModel<3>& model, const ContinuumParts& continuum, RefinementRun* refinement, const Checkpoint& c,
+                   const std::string& file);
 
 }  // namespace sewn::app::detail

@@ -507,12 +507,8 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   const bool resuming = !options.resume.empty();
   Checkpoint ck;
   std::uint64_t run_id = 0;
-  if (resuming || options.checkpoint_every > 0) {
-    const bool rods = std::find(assembly.model_of_cell.begin(), assembly.model_of_cell.end(), CellModel::rod) !=
-                      assembly.model_of_cell.end();
-    detail::require_checkpointable(scene, *model, rods, resuming ? "--resume" : "--checkpoint-every");
-    run_id = detail::run_hash(scene, *model, steps, frames);
-  }
+  if (resuming || options.checkpoint_every > 0) run_id = detail::run_hash(scene, *model, steps, frames);
+  std::size_t next_cut = 0;  // the first scheduled cut not applied yet
   if (resuming) {
     const std::string file = options.resume.string();
     ck = read_checkpoint(options.resume);
@@ -522,15 +518,8 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
                                       " steps and " + std::to_string(frames) + " frames (resume with the same --frames and --until)");
     if (ck.run_hash != run_id)
       throw CheckpointError(file, "written by another scene (" + scene.file + " or its mesh files differ from the run's)");
-    if (ck.cuts.size() > cuts.size()) throw CheckpointError(file, "records more cuts than the scene schedules");
-    for (std::size_t k = 0; k < ck.cuts.size(); ++k)
-      if (ck.cuts[k].spec != cuts[k].second) throw CheckpointError(file, "its cuts are not the scene's, in the scene's order");
-    detail::replay_cuts(*model, ck, file);
-    physics::NodeTable& nodes = model->nodes();
-    if (ck.x.size() != nodes.x().size())
-      throw CheckpointError(file, "holds " + std::to_string(ck.x.size() / 3) + " particles for a model of " + std::to_string(nodes.size()));
-    std::copy(ck.x.begin(), ck.x.end(), nodes.x().begin());
-    std::copy(ck.v.begin(), ck.v.end(), nodes.v().begin());
+    next_cut = detail::check_cut_schedule(ck, cuts, file);
+    detail::restore_model(*model, continuum, refinement.get(), ck, file);
     if (ck.frame_times.size() != (scene.write_vtu ? ck.frame : 0) ||
         std::size_t{ck.csv_columns} * ck.frame != (scene.write_csv ? ck.csv_rows.size() : 0))
       throw CheckpointError(file, "its output record does not match its " + std::to_string(ck.frame) + " frames");
@@ -704,6 +693,8 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     if (use_implicit && !use_midpoint) c.implicit = implicit.history(model->system());
     if (use_midpoint) c.midpoint = midpoint.history(model->system());
     c.ledger = ledger.state();
+    if (refinement) c.refinement = refinement->state();
+    if (continuum.rods) c.rods = continuum.rods->history();
     c.frame_times = frame_times;
     c.csv_columns = csv ? static_cast<std::uint32_t>(csv->columns()) : 0;
     c.csv_rows = csv_rows;
@@ -723,7 +714,6 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     writing([&] { write_checkpoint(sum.checkpoint, c); });
     ++checkpoints;
   };
-  std::size_t next_cut = ck.cuts.size();
   const auto started = Clock::now();
   auto last_bar = started;
   for (std::uint64_t s = ck.step; s < steps; ++s) {
@@ -763,7 +753,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
           if (el.alive && selects_cell(c.where, mesh, el.mesh_cell)) elements.push_back(e);
         }
         if (elements.empty()) throw SceneError(scene.file, path + ".where", "selects no element (at its time)");
-        applied.push_back({static_cast<std::uint32_t>(k), true, c.remove, {}, {}, {elements.begin(), elements.end()}});
+        applied.push_back({static_cast<std::uint32_t>(k), true, c.remove, {}, {}, {elements.begin(), elements.end()}, 0});
         rep = refine::pierce(*model, elements, c.remove);
       }
       if (scene.model != "mass-spring") follow_cut(continuum, *model);
@@ -807,7 +797,14 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     // coarsening dissipates the fine motion: after the step's energy check, the ledger restarts.
     if (refinement) {
       const auto r0 = Clock::now();
-      if (refinement->after_step(*model, static_cast<double>(s + 1) * h)) ledger.rebase(model->system());
+      if (refinement->after_step(*model, static_cast<double>(s + 1) * h)) {
+        ledger.rebase(model->system());
+        // kept in order with the cuts, for a checkpoint to do them again
+        for (const std::uint8_t kind : {std::uint8_t{1}, std::uint8_t{2}}) {
+          const auto& elements = kind == 1 ? refinement->last_refined() : refinement->last_coarsened();
+          if (!elements.empty()) applied.push_back({0, false, false, {}, {}, {elements.begin(), elements.end()}, kind});
+        }
+      }
       frame_ms += std::chrono::duration<double, std::milli>(Clock::now() - r0).count();
     }
     sum.kinetic_max = std::max(sum.kinetic_max, model->system().kinetic_energy());

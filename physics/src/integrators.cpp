@@ -163,18 +163,17 @@ void LinearlyImplicitEuler::reset() {
 }
 
 LinearlyImplicitEuler::History LinearlyImplicitEuler::history(const System& sys) const {
-  const solve::Backend b = opt_.solver == solve::Backend::automatic ? solve::default_backend(sys.nodes().size()) : opt_.solver;
-  if (b != solve::Backend::jacobi)
-    throw InputError("LinearlyImplicitEuler::history: the " + std::string(solve::to_string(b)) +
-                     " solver keeps a factorization across steps, which a history does not hold (use jacobi)");
-  return {std::vector<double>(dv_.begin(), dv_.end()), steps_, watchdog_.state(sys)};
+  History h{std::vector<double>(dv_.begin(), dv_.end()), steps_, watchdog_.state(sys), {}};
+  if (solver_ && sys.topology_key() == solved_topology_) h.solver = solver_->state();
+  return h;
 }
 
-void LinearlyImplicitEuler::restore(const System& sys, const History& h) {
-  const std::size_t n3 = 3 * std::size_t{sys.nodes().size()};
-  if (!h.warm_start.empty() && h.warm_start.size() != n3)
+void LinearlyImplicitEuler::restore(System& sys, const History& h) {
+  // A warm start of another size is from before the topology changed (a refinement after the
+  // last solve): the next step drops it, as it would have dropped it in the run it came from.
+  if (h.warm_start.size() % 3 != 0)
     throw InputError("LinearlyImplicitEuler::restore: the warm start has " + std::to_string(h.warm_start.size()) +
-                     " values for " + std::to_string(n3) + " degrees of freedom");
+                     " values, not 3 per node");
   // the work arrays are sized by the next step; an empty warm start leaves them to it
   dv_.assign(h.warm_start.begin(), h.warm_start.end());
   b_.assign(dv_.size(), 0.0);
@@ -183,6 +182,16 @@ void LinearlyImplicitEuler::restore(const System& sys, const History& h) {
   mass3_.assign(dv_.size(), 0.0);
   steps_ = h.steps;
   watchdog_.restore(sys, h.watchdog);
+  if (h.solver.factored.empty() && !h.solver.refresh_due) return;
+  make_solver(sys.nodes().size());
+  solver_->restore(sys.matrix(), h.solver);
+  solved_topology_ = sys.topology_key();
+}
+
+void LinearlyImplicitEuler::make_solver(Index nodes) {
+  if (solver_ && solver_asked_ == opt_.solver) return;
+  solver_ = solve::make_solver(opt_.solver, {}, nodes);
+  solver_asked_ = opt_.solver;
 }
 
 StepReport LinearlyImplicitEuler::step(System& sys, double h) {
@@ -206,10 +215,7 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
     free_.assign(n3, 0.0);
     mass3_.assign(n3, 0.0);
   }
-  if (!solver_ || solver_asked_ != opt_.solver) {
-    solver_ = solve::make_solver(opt_.solver, {}, n);
-    solver_asked_ = opt_.solver;
-  }
+  make_solver(n);
   solve::SolverOptions& so = solver_->options();
   so.tolerance = opt_.cg_tolerance;
   so.absolute_tolerance = opt_.cg_absolute_tolerance;
@@ -267,6 +273,7 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
       sr.converged = cg.converged;
     } else {
       sr = solver_->solve(A, b_, dv_, free_, mass3_);
+      solved_topology_ = sys.topology_key();
     }
   } catch (const SolverError& e) {
     std::fill(dv_.begin(), dv_.end(), 0.0);

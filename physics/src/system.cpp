@@ -79,10 +79,15 @@ void System::require_no_angles(const char* integrator) const {
                      " angle DOFs (rods with integrated twist), which only the Newton integrator integrates");
 }
 
-bool System::refresh() {
+std::uint64_t System::topology_key() const {
   // Counters only increase, so their sum (plus the term count) changes iff one of them does.
   std::uint64_t key = nodes_.topology_version() + angles_.topology_version() + terms_.size();
   for (const auto& t : terms_) key += t->topology_version();
+  return key;
+}
+
+bool System::refresh() {
+  const std::uint64_t key = topology_key();
   if (key == seen_topology_) return false;
   for (const auto& t : terms_) t->check_nodes(nodes_);
   seen_topology_ = key;

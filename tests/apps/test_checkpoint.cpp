@@ -6,6 +6,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -85,10 +87,9 @@ void check_same_outputs(const fs::path& a, const fs::path& b) {
 // Runs `scene` through once, then again stopped after `stops` checkpoints (of one every
 // `every` frames) and resumed from the last, possibly several times; the two output folders
 // must hold the same bytes.
-void check_continuation(const std::string& label, const std::string& scene_json, int every, const std::vector<int>& stops,
-                        const std::string& extra = "") {
+void check_continuation_of(const std::string& label, const fs::path& scene, int every, const std::vector<int>& stops,
+                           const std::string& extra = "") {
   INFO(label);
-  const fs::path scene = put(label + ".json", scene_json);
   const fs::path whole = scratch(label + "_whole"), pieces = scratch(label + "_pieces");
   fs::remove_all(whole);
   fs::remove_all(pieces);
@@ -113,6 +114,43 @@ void check_continuation(const std::string& label, const std::string& scene_json,
   check_same_outputs(pieces, whole);
 }
 
+// The same for a scene given as text; `label` is its name.
+void check_continuation(const std::string& label, const std::string& scene_json, int every, const std::vector<int>& stops,
+                        const std::string& extra = "") {
+  check_continuation_of(label, put(label + ".json", scene_json), every, stops, extra);
+}
+
+// A helix of 16 segments hanging from its two first points: a discrete elastic rod whose
+// curvature couples bending and twist, so that θ, the time-parallel frames and the reference
+// twists all carry over from step to step.
+std::string helix_rod() {
+  std::string points;
+  for (int k = 0; k <= 16; ++k) {
+    char p[96];
+    std::snprintf(p, sizeof p, "%s[%.6f, %.6f, %.6f]", k ? ", " : "", 0.05 * std::cos(0.5 * k), 0.05 * std::sin(0.5 * k), -0.01 * k);
+    points += p;
+  }
+  return R"({"name": "helix", "materials": {"wire": {"young": 1e8, "poisson": 0.3, "density": 1500}},
+    "meshes": [{"type": "polyline", "material": "wire", "points": [)" + points + R"(]}],
+    "model": {"type": "mixed", "groups": [{"tag": 0, "as": "rod", "semi_axes": [0.004, 0.002]}]},
+    "damping": {"model": "rayleigh", "alpha": 0.5},
+    "fixed": [{"where": {"type": "points", "indices": [0, 1]}}],
+    "velocities": [{"where": {"type": "all"}, "linear": [0.2, 0, 0]}],
+    "integrator": {"type": "newton", "step": 0.002}, "duration": 0.04,
+    "output": {"frames": 8, "picture": {"width": 200, "height": 150}}})";
+}
+
+// A beam of tetrahedra (finite elements, not springs), cut by a plane.
+std::string solid_beam(const std::string& name, const std::string& cut_time) {
+  return R"({"name": ")" + name + R"(", "materials": {"m": {"young": 1e6, "density": 1000}},
+    "meshes": [{"type": "tet_grid", "material": "m", "split": "kuhn6", "cells": [6, 2, 2], "size": [0.3, 0.1, 0.1]}],
+    "model": {"type": "solid"}, "damping": {"model": "rayleigh", "alpha": 1},
+    "fixed": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [0.001, 1, 1]}}],
+    "integrator": {"type": "newton", "step": 0.002}, "duration": 0.1,
+    "cuts": [{"type": "plane", "time": )" + cut_time + R"(, "point": [0.15, 0, 0], "normal": [1, 0, 0]}],
+    "output": {"frames": 10, "picture": {"width": 200, "height": 150}}})";
+}
+
 std::string beam(const std::string& name, const std::string& integrator, const std::string& cuts, const std::string& more = "") {
   return R"({"name": ")" + name + R"(", "materials": {"m": {"young": 1e6, "density": 1000}},
     "meshes": [{"type": "hex_grid", "material": "m", "cells": [6, 2, 2], "size": [0.3, 0.1, 0.1]}],
@@ -123,6 +161,16 @@ std::string beam(const std::string& name, const std::string& integrator, const s
 
 const std::string implicit_h = R"({"type": "implicit", "step": 0.002})";
 const std::string plane_cut = R"({"type": "plane", "time": 0.03, "point": [0.15, 0, 0], "normal": [1, 0, 0]})";
+
+// Whether this build has the CHOLMOD backends (a run asking for one says "not built" if not).
+bool have_cholmod() {
+  std::string log;
+  const fs::path scene = put("probe.json", beam("probe", R"({"type": "implicit", "step": 0.002, "solver": "cholmod"})", ""));
+  const int code = run_tool("run --quiet --frames 1 --until 0.002 --out " + scratch("probe_out").string() + " " + scene.string(), log);
+  INFO(log);
+  REQUIRE((code == 0 || log.find("not built") != std::string::npos));
+  return code == 0;
+}
 
 // A small cube thrown sideways onto a plane with friction, whose lagged normal forces are taken
 // again from the restored positions.
@@ -187,6 +235,35 @@ TEST_CASE("a resumed run writes the same bytes as the run that never stopped") {
   }
 }
 
+TEST_CASE("rods resume to the same bytes: their angles, frames and reference twists are in the checkpoint") {
+  SUBCASE("a helix, stopped twice") { check_continuation("helix", helix_rod(), 2, {1, 2}); }
+  SUBCASE("the mixed scene: tetrahedra, a shell fin and a rod on one map") {
+    check_continuation_of("mixed_fin", fs::path(SEWN_SOURCE_DIR) / "scenes" / "mixed_fin.json", 2, {1}, "--until 0.06 --frames 6");
+  }
+}
+
+TEST_CASE("cuts of finite-element tetrahedra resume to the same bytes") {
+  SUBCASE("the cut before the checkpoint") { check_continuation("solid_before", solid_beam("solid_before", "0.03"), 5, {1}); }
+  SUBCASE("the cut after the checkpoint") { check_continuation("solid_after", solid_beam("solid_after", "0.05"), 2, {1}); }
+}
+
+TEST_CASE("the CHOLMOD backends resume to the same bytes: cholmod-pcg's kept factorization is in the checkpoint") {
+  if (!have_cholmod()) {
+    MESSAGE("skipped: this build has no CHOLMOD backends");
+    return;
+  }
+  SUBCASE("cholmod-pcg, a plane cut before the checkpoint") {
+    check_continuation("pcg_before", beam("pcg_before", R"({"type": "implicit", "step": 0.002, "solver": "cholmod-pcg"})", plane_cut), 5, {1});
+  }
+  SUBCASE("cholmod-pcg, the cut after the checkpoint, stopped at every frame") {
+    check_continuation("pcg_every", beam("pcg_every", R"({"type": "implicit", "step": 0.002, "solver": "cholmod-pcg"})", plane_cut), 1,
+                       {1, 1, 1, 1});
+  }
+  SUBCASE("cholmod, a plane cut before the checkpoint") {
+    check_continuation("direct", beam("direct", R"({"type": "implicit", "step": 0.002, "solver": "cholmod"})", plane_cut), 5, {1});
+  }
+}
+
 TEST_CASE("a run killed at any moment after its first checkpoint resumes to the same bytes") {
   // The kill lands wherever the run is then (between checkpoints, or after the end): frames
   // written after the last checkpoint are written again, whole, by the resumed run.
@@ -227,8 +304,10 @@ TEST_CASE("a checkpoint that is not this run's, or not whole, is refused with ex
   }
   SUBCASE("another format version") {
     std::string bad = bytes;
-    bad[8] = 2;
-    check_refused(saved, put("v2.checkpoint", bad), "format version 2, but this sewn reads version 1 only");
+    bad[8] = 1;  // the format before rods and solver state
+    check_refused(saved, put("v1.checkpoint", bad), "format version 1, but this sewn reads version 2 only");
+    bad[8] = 3;
+    check_refused(saved, put("v3.checkpoint", bad), "format version 3, but this sewn reads version 2 only");
   }
   SUBCASE("not a checkpoint") { check_refused(saved, saved.scene, "not a Sewn checkpoint"); }
   SUBCASE("missing") { check_refused(saved, scratch("nowhere.checkpoint"), "cannot be opened: No such file or directory"); }
@@ -249,52 +328,39 @@ TEST_CASE("a checkpoint that is not this run's, or not whole, is refused with ex
   }
 }
 
-TEST_CASE("a run whose solver keeps state checkpoints do not hold refuses --checkpoint-every") {
+TEST_CASE("--stop-after-checkpoints needs --checkpoint-every") {
   std::string log;
-  const fs::path scene = put("cholmod.json", beam("cholmod", R"({"type": "implicit", "step": 0.002, "solver": "cholmod-pcg"})", ""));
-  const int code = run_tool("run --quiet --checkpoint-every 2 --out " + scratch("cholmod_out").string() + " " + scene.string(), log);
-  if (log.find("not built") != std::string::npos) {
-    const std::string why = "skipped: this build has no CHOLMOD backends (" + log + ")";
-    MESSAGE(why);
-  } else {
-    CHECK(code == 2);
-    CHECK(log.find("integrator.solver: --checkpoint-every is not available with the \"cholmod-pcg\" solver yet") != std::string::npos);
-  }
+  const fs::path scene = put("stop_alone.json", beam("stop_alone", implicit_h, ""));
   CHECK(run_tool("run --quiet --stop-after-checkpoints 2 " + scene.string(), log) == 2);
   CHECK(log.find("--stop-after-checkpoints needs --checkpoint-every") != std::string::npos);
 }
 
-TEST_CASE("a run whose models keep state checkpoints do not hold refuses --checkpoint-every, naming the key") {
-  struct Case {
-    const char* name;
-    std::string scene;
-    const char* expected;
-  };
-  const Case cases[] = {
-      {"refining", beam("refining", implicit_h, "", R"(, "refinement": {"criteria": [{"type": "diagonal_strain", "threshold": 1.2}], "max_level": 3})"),
-       "refinement: --checkpoint-every is not available with adaptive refinement yet"},
-      {"solid_cut", R"({"name": "solid_cut", "materials": {"m": {"young": 1e6, "density": 1000}},
-         "meshes": [{"type": "tet_grid", "material": "m", "split": "kuhn6", "cells": [6, 2, 2], "size": [0.3, 0.1, 0.1]}],
-         "model": {"type": "solid"}, "damping": {"model": "none"},
-         "fixed": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [0.001, 1, 1]}}],
-         "integrator": {"type": "newton", "step": 0.002}, "duration": 0.1, "cuts": [)" + plane_cut + R"(],
-         "output": {"frames": 10}})",
-       "cuts: --checkpoint-every is not available when a \"solid\" model cuts yet"},
-  };
-  for (const Case& c : cases) {
-    CAPTURE(c.name);
-    std::string log;
-    const fs::path scene = put(std::string(c.name) + ".json", c.scene);
-    CHECK(run_tool("run --quiet --checkpoint-every 2 --out " + scratch(std::string(c.name) + "_out").string() + " " + scene.string(), log) == 2);
-    CAPTURE(log);
-    CHECK(log.find(c.expected) != std::string::npos);
+TEST_CASE("adaptive refinement resumes to the same bytes: its edits are done again and its counters restored") {
+  // refined as the beam sags (36 elements by frame 3), cut, coarsened back as it calms down (32
+  // families by frame 7, calm_steps 3) and refined again
+  const std::string refining = R"(, "refinement": {"criteria": [{"type": "diagonal_strain", "threshold": 0.2}], "max_level": 3,
+                                     "coarsen": true, "calm_steps": 3)";
+  SUBCASE("refined, cut and coarsened before and after the checkpoints") {
+    const std::string scene = beam("refining", implicit_h, plane_cut, refining + "}");
+    check_continuation("refining", scene, 3, {1, 2});
+    const std::string csv = slurp(scratch("refining_whole") / "frames.csv");
+    CHECK(csv.find(",1,4,50,32\n") != std::string::npos);  // the last row: 1 cut of 4 faces, 50 refined, 32 coarsened
   }
-  // The mixed scene's mast is a rod, whose frames and twist live outside the positions.
-  std::string log;
-  const fs::path mixed = fs::path(SEWN_SOURCE_DIR) / "scenes" / "mixed_fin.json";
-  CHECK(run_tool("run --quiet --checkpoint-every 2 --out " + scratch("mixed_out").string() + " " + mixed.string(), log) == 2);
-  CAPTURE(log);
-  CHECK(log.find("model.type: --checkpoint-every is not available with rods yet") != std::string::npos);
+  SUBCASE("stopped while families are counting their calm steps") {
+    // 24 families merge at frame 7 after 8 calm steps, a count that runs across the checkpoint
+    // of frame 6 (5 steps a frame): the hysteresis counters must come back with the model
+    std::string slow = refining;
+    slow.replace(slow.find("\"calm_steps\": 3"), 15, "\"calm_steps\": 8");
+    check_continuation("refining_calm", beam("refining_calm", implicit_h, plane_cut, slow + "}"), 1, {6});
+    CHECK(slurp(scratch("refining_calm_whole") / "frames.csv").find(",1,4,36,24\n") != std::string::npos);
+  }
+  SUBCASE("T-junctions by the paper's projection, cholmod-pcg, stopped at every frame") {
+    if (!have_cholmod()) return;
+    check_continuation("refining_pcg",
+                       beam("refining_pcg", R"({"type": "implicit", "step": 0.002, "solver": "cholmod-pcg"})", plane_cut,
+                            refining + R"(, "t_junctions": "paper_projection"})"),
+                       1, {1, 1, 1, 1, 1});
+  }
 }
 
 TEST_CASE("the checkpoint format: every field comes back, and every shorter file is refused") {
@@ -305,8 +371,10 @@ TEST_CASE("the checkpoint format: every field comes back, and every shorter file
   c.frames_total = 3;
   c.step = 20;
   c.frame = 2;
-  c.cuts.push_back({4, false, false, {7, 9}, {3, 3}, {}});
-  c.cuts.push_back({5, true, true, {}, {}, {11}});
+  c.cuts.push_back({4, false, false, {7, 9}, {3, 3}, {}, 0});
+  c.cuts.push_back({5, true, true, {}, {}, {11}, 0});
+  c.cuts.push_back({0, false, false, {}, {}, {12, 13}, 1});
+  c.cuts.push_back({0, false, false, {}, {}, {12}, 2});
   c.x = {1, 2, 3};
   c.v = {-1, -2, -3.5};
   c.semi.bound = {0.1, 2, 3, 4, 5};
@@ -317,8 +385,17 @@ TEST_CASE("the checkpoint format: every field comes back, and every shorter file
   c.implicit.warm_start = {0.5, 0.25, 0.125};
   c.implicit.steps = 12;
   c.implicit.watchdog = {true, true, 13, 14, 15, 16};
+  c.implicit.solver = {{1.5, -2.5, 3.5}, true};
   c.midpoint = {34, {true, true, 35, 36, 37, 38}};
   c.ledger = {17, 18, 19, 20, 21, 22};
+  sewn::physics::rods::Rods::RodHistory rod;
+  rod.rod.theta = {0.1, 0.2};
+  rod.rod.tangent = {{1, 0, 0}, {0, 1, 0}};
+  rod.rod.director = {{0, 0, 1}, {0, 0, -1}};
+  rod.rod.reference_twist = {0.3};
+  rod.solved_at = {0, 0, 0, 1, 0, 0, 1, 1, 0};
+  c.rods = {rod, {}};
+  c.refinement = {39, 40, 0.75, {0, 3, 1}};
   c.frame_times = {0, 0.5};
   c.csv_columns = 2;
   c.csv_rows = {0, 0, 1, 0.5};
@@ -337,9 +414,21 @@ TEST_CASE("the checkpoint format: every field comes back, and every shorter file
   const std::string bytes = sewn::app::encode_checkpoint(c);
   const sewn::app::Checkpoint d = sewn::app::decode_checkpoint(bytes, "f");
   CHECK(sewn::app::encode_checkpoint(d) == bytes);
-  CHECK(d.cuts.size() == 2);
+  REQUIRE(d.cuts.size() == 4);
   CHECK(d.cuts[1].elements == std::vector<std::uint32_t>{11});
+  CHECK(d.cuts[2].refinement == 1);
+  CHECK(d.cuts[3].refinement == 2);
+  CHECK(d.refinement.calm == c.refinement.calm);
+  CHECK(d.refinement.dissipated == 0.75);
   CHECK(d.implicit.warm_start == c.implicit.warm_start);
+  CHECK(d.implicit.solver.factored == c.implicit.solver.factored);
+  CHECK(d.implicit.solver.refresh_due);
+  REQUIRE(d.rods.size() == 2);
+  CHECK(d.rods[0].rod.theta == rod.rod.theta);
+  CHECK(d.rods[0].rod.director[1] == rod.rod.director[1]);
+  CHECK(d.rods[0].rod.reference_twist == rod.rod.reference_twist);
+  CHECK(d.rods[0].solved_at == rod.solved_at);
+  CHECK(d.rods[1].rod.theta.empty());
   CHECK(d.semi.watchdog.internal0 == 8);
   CHECK(d.midpoint.steps == 34);
   CHECK(d.midpoint.watchdog.peak_speed == 38);

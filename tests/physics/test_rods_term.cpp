@@ -302,3 +302,56 @@ TEST_CASE("rods term: a seeded random sequence of rigid rotations keeps the ener
   MESSAGE("400 random rigid turns: largest relative energy change " << worst);
   CHECK(worst < 1e-8);
 }
+
+TEST_CASE("rods term: a term built alike and given history() continues bit for bit") {
+  // A helix hanging from its first two vertices, swinging: θ, the time-parallel frames and the
+  // reference twists all move on from step to step.
+  struct Swing {
+    System sys;
+    std::vector<Index> ids;
+    Rods* rods = nullptr;
+    LinearlyImplicitEuler euler;
+    Swing() {
+      rods = &helix_rod(sys, 9, ids);
+      sys.nodes().fix(ids[0]);
+      sys.nodes().fix(ids[1]);
+      sys.add<Gravity>(Vec3(0, 0, -9.81));
+    }
+    void run(int steps) {
+      for (int s = 0; s < steps; ++s) (void)euler.step(sys, 2e-3);
+    }
+  };
+  Swing a;
+  a.run(30);
+  Swing b, c;  // b takes a's whole state; c all but the rods'
+  for (Swing* s : {&b, &c}) {
+    std::copy(a.sys.nodes().x().begin(), a.sys.nodes().x().end(), s->sys.nodes().x().begin());
+    std::copy(a.sys.nodes().v().begin(), a.sys.nodes().v().end(), s->sys.nodes().v().begin());
+    s->euler.restore(s->sys, a.euler.history(a.sys));
+  }
+  const auto history = a.rods->history();
+  REQUIRE(history.size() == 1);
+  CHECK(history[0].rod.theta.size() == 8);
+  CHECK(history[0].rod.reference_twist.size() == 7);
+  b.rods->restore(history);
+  a.run(30);
+  b.run(30);
+  c.run(30);
+  const auto xa = a.sys.nodes().x(), xb = b.sys.nodes().x(), xc = c.sys.nodes().x();
+  CHECK(std::equal(xa.begin(), xa.end(), xb.begin()));
+  CHECK(a.rods->rod(0).theta()[4] == b.rods->rod(0).theta()[4]);
+  CHECK_FALSE(std::equal(xa.begin(), xa.end(), xc.begin()));  // the rods' state matters
+
+  // A history that does not fit is refused, the term unchanged.
+  auto bad = history;
+  bad[0].rod.director.pop_back();
+  CHECK_THROWS_AS(b.rods->restore(bad), InputError);
+  bad = history;
+  bad[0].solved_at.push_back(0.0);
+  CHECK_THROWS_AS(b.rods->restore(bad), InputError);
+  bad = history;
+  bad[0].rod.reference_twist[2] = std::nan("");
+  CHECK_THROWS_AS(b.rods->restore(bad), InputError);
+  CHECK_THROWS_AS(b.rods->restore({}), InputError);
+  CHECK(a.rods->rod(0).theta()[4] == b.rods->rod(0).theta()[4]);
+}

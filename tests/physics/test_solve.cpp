@@ -394,3 +394,48 @@ TEST_CASE("issue 17: one CG iteration limit, large enough for the N = 16 cantile
   CHECK(solve::SolverOptions{}.max_iterations == solve::default_max_iterations);
   CHECK(solve::default_max_iterations >= 2000);
 }
+
+TEST_CASE("cholmod-pcg's state taken up by a fresh solver gives the same iterates, bit for bit") {
+  if (!solve::available(solve::Backend::cholmod_pcg)) return;
+  BlockMatrix A;
+  random_spd(A, 300, 31);
+  const Problem p = random_problem(A, nullptr, 0.1, 32);
+  solve::SolverOptions o;
+  o.absolute_tolerance = 0;
+  o.tolerance = 1e-10;
+  o.refresh_iterations = 3;
+  auto kept = solve::make_solver(solve::Backend::cholmod_pcg, o);
+  std::vector<double> x = p.x0;
+  REQUIRE(kept->solve(A, p.b, x, p.free_dof).factorizations == 1);
+  // the values move on: the kept factor is of an earlier matrix now
+  for (Index i = 0; i < A.size(); ++i) A.block(A.diagonal(i)).diagonal().array() *= 1.5;
+  const solve::SolverState state = kept->state();
+  CHECK_FALSE(state.factored.empty());
+  auto resumed = solve::make_solver(solve::Backend::cholmod_pcg, o);
+  resumed->restore(A, state);
+  auto fresh = solve::make_solver(solve::Backend::cholmod_pcg, o);
+  for (int round = 0; round < 3; ++round) {
+    CAPTURE(round);
+    std::vector<double> y1 = p.x0, y2 = p.x0, y3 = p.x0;
+    const auto r1 = kept->solve(A, p.b, y1, p.free_dof);
+    const auto r2 = resumed->solve(A, p.b, y2, p.free_dof);
+    CHECK(r1.iterations == r2.iterations);
+    CHECK(r1.factorizations == r2.factorizations);
+    CHECK(y1 == y2);
+    CHECK(kept->state().refresh_due == resumed->state().refresh_due);
+    if (round == 0) {
+      // without the state, the factor is of the present matrix: other iterates
+      CHECK(fresh->solve(A, p.b, y3, p.free_dof).factorizations == 1);
+      CHECK(y1 != y3);
+    }
+    for (Index i = 0; i < A.size(); ++i) A.block(A.diagonal(i)).diagonal().array() *= 1.2;
+  }
+  // a state that does not fit the pattern, or given to a backend that keeps none, is refused
+  BlockMatrix B;
+  random_spd(B, 100, 33);
+  CHECK_THROWS_AS(resumed->restore(B, state), InputError);
+  auto jacobi = solve::make_solver(solve::Backend::jacobi, o);
+  CHECK_THROWS_AS(jacobi->restore(A, state), InputError);
+  jacobi->restore(A, {});
+  CHECK(jacobi->state().factored.empty());
+}

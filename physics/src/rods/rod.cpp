@@ -311,6 +311,33 @@ void Rod::update_frames(const Points& x) {
   }
 }
 
+Rod::State Rod::state() const {
+  State s{theta_, tangent_, director_, {}};
+  for (const Stencil& st : stencils_) s.reference_twist.push_back(st.frames.reference_twist);
+  return s;
+}
+
+void Rod::restore(const State& s) {
+  const std::size_t m = theta_.size();
+  if (s.theta.size() != m || s.tangent.size() != m || s.director.size() != m || s.reference_twist.size() != stencils_.size())
+    throw InputError("rods::Rod::restore: a state of " + std::to_string(s.theta.size()) + " angles, " + std::to_string(s.tangent.size()) +
+                     " tangents, " + std::to_string(s.director.size()) + " directors and " + std::to_string(s.reference_twist.size()) +
+                     " reference twists, for a rod of " + std::to_string(m) + " edges and " + std::to_string(stencils_.size()) + " stencils");
+  for (std::size_t k = 0; k < m; ++k)
+    if (!std::isfinite(s.theta[k]) || !s.tangent[k].allFinite() || !s.director[k].allFinite())
+      throw InputError("rods::Rod::restore: edge " + std::to_string(k) + "'s angle or frame is not finite");
+  for (std::size_t k = 0; k < stencils_.size(); ++k)
+    if (!std::isfinite(s.reference_twist[k]))
+      throw InputError("rods::Rod::restore: stencil " + std::to_string(k) + "'s reference twist is not finite");
+  theta_ = s.theta;
+  tangent_ = s.tangent;
+  director_ = s.director;
+  for (int k = 0; k < num_stencils(); ++k) {
+    refresh_stencil_frames(k);
+    stencils_[static_cast<std::size_t>(k)].frames.reference_twist = s.reference_twist[static_cast<std::size_t>(k)];
+  }
+}
+
 Vec3 Rod::reference_director(const Points& x, int edge) const {
   const std::size_t k = static_cast<std::size_t>(edge);
   const Vec3 t = (x.col((edge + 1) % num_vertices()) - x.col(edge)).normalized();

@@ -337,6 +337,33 @@ void Rods::step_accepted(const StateView& s) {
   }
 }
 
+std::vector<Rods::RodHistory> Rods::history() const {
+  std::vector<RodHistory> h;
+  for (const Entry& e : rods_) h.push_back({e.rod.state(), std::vector<double>(e.solved_at.data(), e.solved_at.data() + e.solved_at.size())});
+  return h;
+}
+
+void Rods::restore(std::span<const RodHistory> h) {
+  if (h.size() != rods_.size())
+    throw InputError("rods::Rods::restore: a history of " + std::to_string(h.size()) + " rods for a term of " + std::to_string(rods_.size()));
+  for (std::size_t r = 0; r < h.size(); ++r) {
+    const std::size_t n = 3 * static_cast<std::size_t>(rods_[r].rod.num_vertices());
+    if (!h[r].solved_at.empty() && h[r].solved_at.size() != n)
+      throw InputError("rods::Rods::restore: rod " + std::to_string(r) + " was solved at " + std::to_string(h[r].solved_at.size()) +
+                       " coordinates, for " + std::to_string(n / 3) + " vertices");
+    Rod check = rods_[r].rod;  // all or nothing: a bad rod further on leaves the earlier ones as they were
+    check.restore(h[r].rod);
+  }
+  for (std::size_t r = 0; r < h.size(); ++r) {
+    Entry& e = rods_[r];
+    e.rod.restore(h[r].rod);
+    if (h[r].solved_at.empty())
+      e.solved_at.resize(3, 0);
+    else
+      e.solved_at = Eigen::Map<const Points>(h[r].solved_at.data(), 3, e.rod.num_vertices());
+  }
+}
+
 void Rods::check_nodes(const NodeTable& nodes) const {
   for (Index r = 0; r < num_rods(); ++r)
     for (Index v : rods_[r].nodes)

@@ -140,6 +140,21 @@ class Factorization {
     valid_ = true;
   }
 
+  /// K's values when last factored (kept if factorize() was asked to). O(1).
+  [[nodiscard]] const std::vector<double>& factored_values() const { return factored_; }
+
+  /// Factors `values` as K's on A's pattern: how a kept factorization is taken up again.
+  /// Throws InputError if their count is not the pattern's. O(one factorization).
+  void factor_values(const BlockMatrix& A, std::span<const double> values, const char* who) {
+    sync_pattern(A);
+    if (values.size() != src_.size())
+      throw InputError(std::string(who) + ": " + std::to_string(values.size()) + " factored values for a pattern of " +
+                       std::to_string(src_.size()) + " entries");
+    if (!analysed()) analyse();
+    std::copy(values.begin(), values.end(), static_cast<double*>(K_->x));
+    factorize(who, true);
+  }
+
   [[nodiscard]] bool valid() const { return valid_; }
   /// True once analyse() ran on the current pattern (sync_pattern() drops it).
   [[nodiscard]] bool analysed() const { return L_ != nullptr; }
@@ -283,6 +298,17 @@ class CholmodPcg final : public LinearSolver {
     f_.forget();
     stale_ = false;
   }
+  [[nodiscard]] SolverState state() const override {
+    SolverState s;
+    if (f_.valid()) s.factored = f_.factored_values();
+    s.refresh_due = stale_;
+    return s;
+  }
+  void restore(const BlockMatrix& A, const SolverState& s) override {
+    f_.forget();
+    if (!s.factored.empty()) f_.factor_values(A, s.factored, "cholmod-pcg restore");
+    stale_ = s.refresh_due;
+  }
 
   SolveReport solve(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
                     std::span<const double> mass_scale) override {
@@ -323,7 +349,7 @@ class CholmodPcg final : public LinearSolver {
       t = Clock::now();
     }
     f_.fill_values(A, free_dof);
-    f_.factorize("cholmod-pcg solve", false);
+    f_.factorize("cholmod-pcg solve", true);  // the values are kept for state()
     ++rep.factorizations;
     rep.factor_ms += ms_since(t);
     stale_ = false;

@@ -79,6 +79,12 @@ std::unique_ptr<LinearSolver> make_solver(Backend b, SolverOptions options, std:
   }
 }
 
+void LinearSolver::restore(const BlockMatrix& /*A*/, const SolverState& s) {
+  if (!s.factored.empty())
+    throw InputError("LinearSolver::restore: the " + std::string(to_string(backend())) + " backend keeps no factorization, and the state holds " +
+                     std::to_string(s.factored.size()) + " factored values");
+}
+
 namespace detail {
 
 void check_sizes(const char* who, const BlockMatrix& A, std::span<const double> b, std::span<const double> x,

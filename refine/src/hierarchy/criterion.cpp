@@ -40,7 +40,7 @@ bool DiagonalStrain<D>::allows_coarsening(const MssModel<D>& m, Index e) const {
 }
 
 template <int D>
-RefineReport adapt(MssModel<D>& m, const Criterion<D>& criterion, const RefineOptions& options) {
+RefineReport adapt(MssModel<D>& m, const Criterion<D>& criterion, const RefineOptions& options, std::vector<Index>* chosen_out) {
   const physics::ElementKind regular = D == 2 ? physics::ElementKind::quad : physics::ElementKind::hexahedron;
   std::vector<Index> chosen;
   for (Index e = 0; e < m.elements().size(); ++e) {
@@ -52,13 +52,15 @@ RefineReport adapt(MssModel<D>& m, const Criterion<D>& criterion, const RefineOp
   if (after > options.max_elements)
     throw physics::InputError("adaptive refinement: refining the " + std::to_string(chosen.size()) + " elements the criterion picks would leave " +
                               std::to_string(after) + " live elements, more than the limit of " + std::to_string(options.max_elements));
-  return refine_elements(m, std::span<const Index>(chosen), options);
+  const RefineReport report = refine_elements(m, std::span<const Index>(chosen), options);
+  if (chosen_out) *chosen_out = std::move(chosen);
+  return report;
 }
 
 template <int D>
 typename Adapter<D>::Report Adapter<D>::update(MssModel<D>& m) {
   Report r;
-  r.refined = adapt(m, criterion_, options_.refine);
+  r.refined = adapt(m, criterion_, options_.refine, &r.refined_elements);
   if (!options_.coarsen) return r;
   calm_.resize(m.elements().size(), 0);
   for (Index e = 0; e < m.elements().size(); ++e) {
@@ -74,6 +76,7 @@ typename Adapter<D>::Report Adapter<D>::update(MssModel<D>& m) {
     if (!calm) continue;
     r.dissipated_energy += coarsen(m, p).dissipated_energy;
     ++r.coarsened;
+    r.coarsened_parents.push_back(p);
     calm_[p] = 0;
   }
   return r;
@@ -83,7 +86,7 @@ template class Adapter<2>;
 template class Adapter<3>;
 template class DiagonalStrain<2>;
 template class DiagonalStrain<3>;
-template RefineReport adapt(MssModel<2>&, const Criterion<2>&, const RefineOptions&);
-template RefineReport adapt(MssModel<3>&, const Criterion<3>&, const RefineOptions&);
+template RefineReport adapt(MssModel<2>&, const Criterion<2>&, const RefineOptions&, std::vector<Index>*);
+template RefineReport adapt(MssModel<3>&, const Criterion<3>&, const RefineOptions&, std::vector<Index>*);
 
 }  // namespace sewn::refine

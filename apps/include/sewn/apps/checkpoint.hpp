@@ -5,20 +5,27 @@
 //
 // What is stored, and why that is the whole state of a run (docs/checkpoints.md):
 //   - positions and velocities of every particle;
-//   - the topology edits applied so far, resolved (the facets each cut unsewed, by dart, and
-//     the elements each piercing took): the map, its attributes and the node, spring and
-//     element tables are rebuilt from the scene and these edits, and a hash of the rebuilt
+//   - the topology edits applied so far, resolved (the facets each cut unsewed, by dart, the
+//     elements each piercing took, each adaptive refinement refined and each coarsening
+//     merged): the map, its attributes, the refinement hierarchy with its T-junctions and the
+//     node, spring and element tables are rebuilt from the scene and these edits, done again
+//     in their order, and a hash of the rebuilt
 //     tables (the map's dart count, masses, fixed axes, spring ends, stiffnesses, rest lengths,
 //     viscosities, live elements) must equal the stored one;
 //   - the integrator's history (symplectic Euler's cached stable step; linearly implicit
-//     Euler's warm start; the step counters and energy watchdogs of these two and of the
-//     implicit midpoint rule; Newton's backward Euler keeps none) and the energy ledger;
+//     Euler's warm start and, with cholmod-pcg, the matrix its kept factorization was made
+//     of; the step counters and energy watchdogs of these two and of the implicit midpoint
+//     rule; Newton's backward Euler keeps none) and the energy ledger;
+//   - the rods' own state: material angles θ, time-parallel reference frames, tracked
+//     reference twists, and the positions θ was last solved at;
+//   - the refinement's counters and the adapter's per-element hysteresis (calm) counters;
 //   - the time line: steps and frames done, the next scheduled cut, the frames listed in the
 //     .pvd and the rows of frames.csv, and the run summary's running figures.
 // Everything else a run holds is rebuilt from the scene or recomputed from the above at the
 // next step: obstacles are fixed, and friction's lagged normal forces are k·depth at the last
 // accepted positions, which are the stored ones; the solver's matrix pattern, the inversion
-// monitor's corner lists and the spring runs follow from the topology.
+// monitor's corner lists and the spring runs follow from the topology, and the tetrahedra
+// are moved onto the particles the recorded cuts duplicated, as the run moved them.
 //
 // File layout (little-endian): "SEWNCKPT", u32 format version, u32 0, u64 payload size,
 // u64 FNV-1a-64 checksum of the payload, payload. Every length in the payload is checked
@@ -34,6 +41,8 @@
 #include "sewn/physics/integrate/energy_ledger.hpp"
 #include "sewn/physics/integrate/implicit_midpoint.hpp"
 #include "sewn/physics/integrators.hpp"
+#include "sewn/physics/rods/rods_term.hpp"
+#include "sewn/apps/refine_keys.hpp"
 
 namespace sewn::app {
 
@@ -50,18 +59,20 @@ class CheckpointError : public std::runtime_error {
   std::string file_, reason_;
 };
 
-/// One scheduled cut as it was applied: the facets it unsewed (dart and β index) or the
-/// elements it pierced.
+/// One topology edit as it was applied: a scheduled cut (the facets it unsewed, by dart and β
+/// index) or piercing (the elements it took), or an adaptive refinement (the elements it
+/// refined) or coarsening (the parents whose families it merged).
 struct AppliedCut {
-  std::uint32_t spec = 0;  ///< index in the scene's cuts
+  std::uint32_t spec = 0;  ///< cut, pierce: index in the scene's cuts
   bool pierce = false, remove = false;
   std::vector<std::uint32_t> darts;  ///< cut: a dart of each facet
   std::vector<std::uint8_t> betas;   ///< cut: the β joining each facet's two sides (2 or 3)
-  std::vector<std::uint32_t> elements;  ///< pierce: the elements
+  std::vector<std::uint32_t> elements;  ///< pierce, refinement, coarsening: the elements
+  std::uint8_t refinement = 0;          ///< 0: a scheduled cut or piercing; 1: a refinement; 2: a coarsening
 };
 
 struct Checkpoint {
-  static constexpr std::uint32_t format_version = 1;
+  static constexpr std::uint32_t format_version = 2;
 
   std::uint64_t run_hash = 0;    ///< the scene's text, its built model, steps and frames
   std::uint64_t model_hash = 0;  ///< the model's tables after the cuts below
@@ -70,13 +81,15 @@ struct Checkpoint {
 
   std::uint64_t step = 0;   ///< steps done
   std::uint32_t frame = 0;  ///< frames written
-  std::vector<AppliedCut> cuts;  ///< in the order applied
+  std::vector<AppliedCut> cuts;  ///< every topology edit, in the order applied
 
   std::vector<double> x, v;  ///< 3 per particle
   physics::SymplecticEuler::History semi;
   physics::LinearlyImplicitEuler::History implicit;
   physics::ImplicitMidpoint::History midpoint;
   physics::EnergyLedger::State ledger;
+  std::vector<physics::rods::Rods::RodHistory> rods;  ///< per rod of the scene, in build order
+  RefinementRun::State refinement;  ///< the refinement's counters and hysteresis counters
 
   std::vector<double> frame_times;  ///< of the frames listed in the .pvd
   std::uint32_t csv_columns = 0;

@@ -5,7 +5,9 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -41,11 +43,31 @@ class RefinementRun {
   [[nodiscard]] std::uint64_t coarsened() const { return coarsened_; }
   [[nodiscard]] double dissipated() const { return dissipated_; }  ///< J, by the coarsenings
 
+  /// What the last after_step() changed, in order: the elements it refined, then the parents
+  /// whose families it coarsened (both empty if nothing).
+  [[nodiscard]] const std::vector<physics::Index>& last_refined() const { return last_refined_; }
+  [[nodiscard]] const std::vector<physics::Index>& last_coarsened() const { return last_coarsened_; }
+  /// Repeats one such change on the model as it was before it: refines `elements`, or coarsens
+  /// each of their families, with the run's options. Throws physics::InputError if one does not
+  /// fit the model. How a checkpoint rebuilds a refined model; the counters are not touched.
+  void redo(physics::MssModel<3>& model, bool coarsening, std::span<const physics::Index> elements) const;
+
+  /// Everything the run carries from one step to the next beside the model: its counters and
+  /// the adapter's hysteresis counters (refine::Adapter::calm_counts).
+  struct State {
+    std::uint64_t refined = 0, coarsened = 0;
+    double dissipated = 0;
+    std::vector<std::int32_t> calm;
+  };
+  [[nodiscard]] State state() const;
+  void restore(const State& s);
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::uint64_t refined_ = 0, coarsened_ = 0;
   double dissipated_ = 0;
+  std::vector<physics::Index> last_refined_, last_coarsened_;
 };
 
 }  // namespace sewn::app

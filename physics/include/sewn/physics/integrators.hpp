@@ -111,23 +111,33 @@ class LinearlyImplicitEuler {
   /// Forgets the warm start, the solver's factorizations and the energy baseline.
   void reset();
 
-  /// What a step reads from earlier steps with the jacobi backend: the warm start (the last
-  /// ΔV), the step counter and the watchdog. The CHOLMOD backends also keep a factorization,
-  /// which this does not hold: history() throws InputError for them.
+  /// What a step reads from earlier steps: the warm start (the last ΔV), the step counter,
+  /// the watchdog, and what the solver keeps that changes results (cholmod-pcg's factorization
+  /// of an earlier matrix: solve::SolverState).
   struct History {
     std::vector<double> warm_start;  ///< empty before the first step
     std::uint64_t steps = 0;
     EnergyWatchdog::State watchdog;
+    solve::SolverState solver;
   };
+  /// The solver's state is left out (empty) when the topology changed since the last solve:
+  /// the next solve starts afresh on the new pattern anyway.
   [[nodiscard]] History history(const System& sys) const;
-  /// Throws InputError if the warm start does not have 3 values per node of sys.
-  void restore(const System& sys, const History& h);
+  /// Takes up a history of a run of the same system (its topology rebuilt as it was): builds
+  /// the matrix pattern if the solver state needs it and hands that to the solver. A warm
+  /// start of another size than sys's (taken before a topology change) is dropped by the next
+  /// step, as the integrator it came from would have dropped it. Throws InputError if the warm
+  /// start is not 3 values per node or the solver state does not fit the pattern, SolverError
+  /// if its matrix cannot be factored.
+  void restore(System& sys, const History& h);
 
  private:
   ImplicitEulerOptions opt_;
   AlignedVector<double> b_, dv_, kv_, free_, mass3_;
   std::unique_ptr<solve::LinearSolver> solver_;
   solve::Backend solver_asked_ = solve::Backend::automatic;
+  std::uint64_t solved_topology_ = ~std::uint64_t{0};  // sys.topology_key() at the last solve
+  void make_solver(Index nodes);  // solver_ of the backend asked for, if not made yet
   std::uint64_t steps_ = 0;
   EnergyWatchdog watchdog_;
 };

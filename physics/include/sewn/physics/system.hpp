@@ -76,6 +76,9 @@ class System {
   /// every element's node references (InputError naming it) and marks the Jacobian pattern
   /// stale. Returns true if the topology changed. O(terms) when nothing changed, else O(elements).
   bool refresh();
+  /// A value that changes whenever nodes or any term change topology (what refresh() watches),
+  /// and only then. O(terms).
+  [[nodiscard]] std::uint64_t topology_key() const;
   /// The Jacobian pattern and value storage, (re)built first if the topology changed: only
   /// integrators that assemble Jacobians pay for it. Block rows: the nodes, then the angles'
   /// (AngleLayout). O(elements·log) after a change, else O(terms).

@@ -5,6 +5,7 @@
 // others (strain energy, distance to a tool, a user region) implement Criterion.
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "sewn/physics/mss_model.hpp"
@@ -45,8 +46,11 @@ class DiagonalStrain : public Criterion<D> {
 /// skipping those whose children would pass options.max_level. Throws physics::InputError, the
 /// model unchanged, if the pass would leave more than options.max_elements live elements.
 /// O(elements · criterion) plus the refinements.
+/// `chosen`, if given, receives the elements refined, in the order refined: refine_elements()
+/// of that list on the model as it was repeats the pass exactly.
 template <int D>
-RefineReport adapt(MssModel<D>& m, const Criterion<D>& criterion, const RefineOptions& options = {});
+RefineReport adapt(MssModel<D>& m, const Criterion<D>& criterion, const RefineOptions& options = {},
+                   std::vector<Index>* chosen = nullptr);
 
 /// Refinement and coarsening driven step by step (PHYSICS_NOTES §2.7-2.8): call update() after
 /// each accepted step. It refines what the criterion wants (adapt()), then counts, per live leaf,
@@ -65,9 +69,16 @@ class Adapter {
     RefineReport refined;
     std::uint32_t coarsened = 0;
     double dissipated_energy = 0;  ///< J, by the coarsenings
+    /// What the update did, in order: refine_elements() of the first, then coarsen() of each
+    /// of the second, on the model as it was, repeat it (how a checkpoint rebuilds the model).
+    std::vector<Index> refined_elements, coarsened_parents;
   };
   Adapter(const Criterion<D>& criterion, Options options) : criterion_(criterion), options_(options) {}
   Report update(MssModel<D>& m);
+  /// The hysteresis counters (per element, the consecutive updates it was calm), the adapter's
+  /// only state beside the model: with the model rebuilt, restoring them continues exactly.
+  [[nodiscard]] const std::vector<int>& calm_counts() const { return calm_; }
+  void restore_calm_counts(std::vector<int> calm) { calm_ = std::move(calm); }
 
  private:
   const Criterion<D>& criterion_;

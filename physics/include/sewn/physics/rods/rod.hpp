@@ -84,6 +84,20 @@ class Rod {
   /// Tracked reference twist of stencil s at x (unwrapped against the last update). O(1).
   [[nodiscard]] double reference_twist(const Points& x, int s) const;
 
+  /// What the rod carries from one accepted step to the next beside the positions: θ, the
+  /// reference frames (t̄, ā1 per edge) and the tracked reference twist of each stencil at the
+  /// last frame update. Everything else follows from the rest shape. A rod built from the same
+  /// rest shape and given this back continues bit for bit (checkpoints).
+  struct State {
+    std::vector<double> theta;          ///< per edge
+    std::vector<Vec3> tangent, director;  ///< per edge
+    std::vector<double> reference_twist;  ///< per stencil
+  };
+  [[nodiscard]] State state() const;
+  /// Takes up a state from state(). Throws InputError (the rod unchanged) if a size does not
+  /// match this rod or a value is not finite. O(n).
+  void restore(const State& s);
+
  private:
   struct Stencil {
     BendTwistRest rest;

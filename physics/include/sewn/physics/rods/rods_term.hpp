@@ -70,6 +70,19 @@ class Rods final : public ForceTerm {
   /// Whether add_jacobians projects each stencil's position Hessian to PSD (default true).
   void set_project_hessians(bool on) { project_ = on; }
 
+  /// What each rod carries from one step to the next (checkpoints): the rod's own state, and
+  /// the positions θ was last solved at (3 per vertex; empty: none since θ last changed). With
+  /// the latter a restored term solves θ again exactly when the running one would, so the
+  /// quasi-static θ keeps its bits.
+  struct RodHistory {
+    Rod::State rod;
+    std::vector<double> solved_at;
+  };
+  [[nodiscard]] std::vector<RodHistory> history() const;
+  /// Takes up history() of a term built the same way. Throws InputError (nothing changed) if
+  /// the number of rods, a rod's sizes or a value does not fit. O(vertices).
+  void restore(std::span<const RodHistory> h);
+
   [[nodiscard]] std::string_view name() const override { return "rods"; }
   /// Solves θ at s (if s changed since the last solve), then adds −∂E/∂x. Throws
   /// rods::SolveError if a twist solve fails. O(vertices · twist Newton iterations).

@@ -80,6 +80,17 @@ struct SolveReport {
   double analyse_ms = 0.0, factor_ms = 0.0, solve_ms = 0.0;
 };
 
+/// What a backend keeps from one solve to the next that changes later results, for a
+/// checkpoint. cholmod-pcg preconditions with a factorization of an earlier matrix, refreshed
+/// when CG slows down: which matrix that was decides every later iterate, so the state holds
+/// its values and whether a refresh is due. jacobi keeps nothing, and cholmod's kept factor
+/// changes no result: it refactors whenever the values differ, and a factorization of equal
+/// values on the analysis of an equal pattern is the same, bit for bit.
+struct SolverState {
+  std::vector<double> factored;  ///< cholmod-pcg: the filtered matrix's stored entries when factored (empty: no factor)
+  bool refresh_due = false;      ///< cholmod-pcg: the last solve needed more than refresh_iterations
+};
+
 class LinearSolver {
  public:
   virtual ~LinearSolver() = default;
@@ -101,6 +112,14 @@ class LinearSolver {
                             std::span<const double> free_dof, std::span<const double> mass_scale = {}) = 0;
   /// Forgets every factorization and analysis (the next solve starts afresh). O(1).
   virtual void reset() {}
+  /// See SolverState. O(entries of the kept factorization).
+  [[nodiscard]] virtual SolverState state() const { return {}; }
+  /// Takes up state() of a solver of this backend, for A's current pattern (the one it was
+  /// taken on, rebuilt): cholmod-pcg factors the stored values again, which gives the factor it
+  /// had. Throws InputError if the values do not fit A's pattern (or are given to a backend
+  /// that keeps none), SolverError if they cannot be factored; the solver then starts afresh
+  /// at its next solve. O(one factorization).
+  virtual void restore(const BlockMatrix& A, const SolverState& s);
 
  protected:
   explicit LinearSolver(SolverOptions o) : opt_(o) {}
