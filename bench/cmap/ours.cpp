@@ -224,7 +224,8 @@ void bench_unsew_plane(benchmark::State& state, std::uint32_t n, const std::stri
 }
 
 // The new vertex gets a node at the face's barycentre, as CGAL's insert_barycenter_in_cell<2>
-// gives it a point.
+// gives it a point: both pass the new vertex's attribute to the insertion (CGAL's
+// insert_cell_0_in_cell_2(d, attribute), ours insert_vertex_in_face(d, value)).
 void bench_vertex_in_faces(benchmark::State& state, std::uint32_t n, const std::string& key) {
   const Proto<3>& p = proto<3>(n);
   auto work = on_fresh_copies<3>(state, p, no_preparation, [&](Ours<3>& w) {
@@ -240,8 +241,7 @@ void bench_vertex_in_faces(benchmark::State& state, std::uint32_t n, const std::
         k += 1;
         x = map.beta<1>(x);
       } while (x != d);
-      const Dart w = map.insert_vertex_in_face(d);
-      map.set_attribute<0>(w, static_cast<std::uint32_t>(pos.size()));
+      map.insert_vertex_in_face(d, static_cast<std::uint32_t>(pos.size()));
       pos.push_back({c[0] / k, c[1] / k, c[2] / k});
     }
   });
