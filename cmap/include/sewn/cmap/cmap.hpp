@@ -773,6 +773,20 @@ class CMap {
 
   // Gives `to` the attributes of `from` for every dimension whose bit is set in dims.
   void inherit_attributes(std::uint32_t from, std::uint32_t to, unsigned dims);
+  // The same for a dart just made (it carries no attribute yet), the dimensions known at
+  // compile time: the per-dart work of the one-pass insertions, which make many darts.
+  template <unsigned Dims>
+  void inherit_new(std::uint32_t from, std::uint32_t to) {
+    for_each_dim([&](auto k) {
+      constexpr int K = k();
+      if constexpr (has_attribute<K> && ((Dims >> K) & 1u) != 0) {
+        auto& st = store<K>();
+        const std::uint32_t a = st.of_dart[from];
+        st.of_dart[to] = a;
+        if (a != detail::null_index) st.values.add_count(a, 1);
+      }
+    });
+  }
   // Gives the new dart `to` a copy of the info of `from` (the insertion rule above).
   void copy_info(std::uint32_t from, std::uint32_t to) {
     if constexpr (has_dart_info) info_.of_dart[to] = info_.of_dart[from];

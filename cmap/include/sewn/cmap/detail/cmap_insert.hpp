@@ -245,8 +245,8 @@ Dart CMap<D, A...>::insert_face_in_hole(std::span<const Dart> path) {
   detail::DartBuffer<32> p;
   new_darts(static_cast<std::uint32_t>(k), p);
   for (std::size_t i = 0; i < k; ++i) {
-    inherit_attributes(path[i].index(), p[i], ~5u);
-    inherit_attributes(path[(i + 1) % k].index(), p[i], 1u);
+    inherit_new<~5u>(path[i].index(), p[i]);
+    inherit_new<1u>(path[(i + 1) % k].index(), p[i]);
     copy_info(path[i].index(), p[i]);
   }
   for (std::size_t i = 0; i < k; ++i) {
@@ -346,9 +346,9 @@ Dart CMap<D, A...>::star_face(Dart d, detail::DartBuffer<32>& centre) {
       // the new dart after c_i starts where the old β1(c_i) starts; the other one at v
       const std::uint32_t after = flip ? y : x, at_centre = flip ? x : y;
       const std::uint32_t old_next = c[flip ? (i + k - 1) % k : (i + 1) % k];
-      inherit_attributes(ci, x, above_faces);
-      inherit_attributes(ci, y, above_faces);
-      inherit_attributes(old_next, after, 1u);
+      inherit_new<above_faces>(ci, x);
+      inherit_new<above_faces>(ci, y);
+      inherit_new<1u>(old_next, after);
       copy_info(c[0], x);
       copy_info(c[0], y);
       raw_link(ci, 1, after);
