@@ -25,7 +25,10 @@
 //                as ours insert_dangling_edge_in_face plus a node at that point (on a 3-sewn
 //                face CGAL 5.5.1 gives the point to a wrong dart: is_valid() fails).
 //   close holes  insert_cell_2_in_cell_3 on the ring of 2-free darts each removed top face
-//                left (the removals untimed), as ours insert_face_in_hole.
+//                left (the removals untimed), as ours insert_face_in_hole; each iteration
+//                reopens the holes on the same maps instead of copying them (closing them takes
+//                microseconds, copying a grid milliseconds), in copies_for_holes(n) copies of
+//                the grid per timing, so that pausing the clock weighs little on either side.
 // Operations that change the map run on a copy of a prototype made before the clock restarts,
 // and the darts they apply to are collected on that copy, also untimed.
 
@@ -301,35 +304,44 @@ void bench_dangling_in_faces(benchmark::State& state, std::uint32_t n, const std
 template <int D>
   requires(D == 3)
 void bench_close_holes(benchmark::State& state, std::uint32_t n, const std::string& key) {
-  const Peer<D>& p = proto<D>(n);
-  std::unique_ptr<Peer<D>> work;
-  std::vector<std::vector<typename Peer<D>::DartHandle>> rings;
-  std::size_t found = 0;
+  // the holes reopened on the same maps each iteration, copies_for_holes(n) of them, as ours
+  using Handle = typename Peer<D>::DartHandle;
+  struct Work {
+    Peer<D> grid;
+    std::vector<Handle> top;
+    std::vector<std::vector<Handle>> rings;
+  };
+  std::vector<std::unique_ptr<Work>> works;
+  for (std::uint32_t c = 0; c < copies_for_holes(n); ++c) {
+    works.push_back(std::make_unique<Work>(Work{proto<D>(n), {}, {}}));
+    works.back()->top = works.back()->grid.faces_in_plane(static_cast<double>(n), true);
+  }
+  const std::size_t found = works.back()->top.size();
   for (auto _ : state) {
     {
       const Untimed untimed(state);
-      work.reset();
-      work = std::make_unique<Peer<D>>(p);
-      rings.clear();
-      const auto top = work->faces_in_plane(static_cast<double>(n), true);
-      found = top.size();
-      for (auto f : top) {
-        std::vector<typename Peer<D>::DartHandle> ring;
-        auto x = f;
-        do {  // the β2 partners, in reverse order, as ours
-          ring.insert(ring.begin(), work->lcc.template beta<2>(x));
-          x = work->lcc.next(x);
-        } while (x != f);
-        work->lcc.template remove_cell<2>(f);
-        rings.push_back(std::move(ring));
+      for (auto& w : works) {
+        w->rings.clear();
+        for (Handle f : w->top) {
+          std::vector<Handle> ring;
+          Handle x = f;
+          do {  // the β2 partners, in reverse order, as ours
+            ring.insert(ring.begin(), w->grid.lcc.template beta<2>(x));
+            x = w->grid.lcc.next(x);
+          } while (x != f);
+          w->grid.lcc.template remove_cell<2>(f);
+          w->rings.push_back(std::move(ring));
+        }
       }
     }
-    for (const auto& ring : rings) work->lcc.insert_cell_2_in_cell_3(ring.begin(), ring.end());
+    for (auto& w : works)
+      for (std::size_t i = 0; i < w->rings.size(); ++i)
+        w->top[i] = w->grid.lcc.insert_cell_2_in_cell_3(w->rings[i].begin(), w->rings[i].end());
   }
   if (found != std::uint64_t{n} * n)
     state.SkipWithError(("found " + std::to_string(found) + " faces in the top plane").c_str());
   else
-    check_once(state, key, *work, hex_counts(n));
+    check_once(state, key, works.back()->grid, hex_counts(n));
 }
 
 template <int D>

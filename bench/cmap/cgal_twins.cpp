@@ -166,6 +166,11 @@ struct Twins {
       }
       case 1: {
         if (!ours.is_insertable_dangling_edge_in_face(d) || ours.num_darts() > 1500) return nullptr;
+        // On a 3-sewn face whose edge at d is a loop (d starts and ends at one vertex), the
+        // libraries place the far side's edge differently: ours after β3(d), which ends at d's
+        // start, as everywhere else; CGAL before or after each dart by whether it starts at d's
+        // vertex, which a loop makes true of both ends. Both maps are valid; they differ.
+        if (ours.beta(d, 3) && ours.same_cell<0>(d, ours.beta(d, 1))) return nullptr;
         auto rule = face_rule(d);
         ours.insert_dangling_edge_in_face(d);
         peer.insert_dangling_cell_1_in_cell_2(h);

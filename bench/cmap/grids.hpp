@@ -3,6 +3,7 @@
 // the indexed meshes both sides build from, and the cell counts every operation must produce,
 // derived from the grid's shape alone so that neither map is checked against itself.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -51,6 +52,10 @@ Counts after_dangling_edge_in_every_boundary_face(std::uint32_t n);
 /// edges and vertices are all doubled; no dart is created.
 Counts after_unsew_middle_plane(std::uint32_t n);
 
+/// How many copies of an n³ grid close_top_holes closes the top holes of per timing: 4096
+/// holes at least (a timing of a few microseconds would be mostly the clock's own cost).
+inline std::uint32_t copies_for_holes(std::uint32_t n) { return std::max<std::uint32_t>(1, 4096 / (n * n)); }
+
 /// The z coordinate of the middle plane of an n³ grid with unit spacing (n ≥ 2); its top is z = n.
 inline double middle_plane_z(std::uint32_t n) { return static_cast<double>(n / 2); }
 
@@ -64,7 +69,7 @@ inline constexpr const char* split_faces = "insert_edge_in_every_face";  // 2D g
 inline constexpr const char* unsew_plane = "unsew3_middle_plane";       // 3D grids only
 inline constexpr const char* vertex_in_faces = "insert_vertex_in_every_face";    // 3D grids only
 inline constexpr const char* dangling_in_faces = "insert_dangling_edge_in_every_boundary_face";  // 3D
-inline constexpr const char* close_holes = "close_top_holes";  // 3D: insert_face_in_hole per top face
+inline constexpr const char* close_holes = "close_top_holes";  // 3D: insert_face_in_hole per top face, copies_for_holes(n) grids
 inline constexpr const char* validate = "validate";
 }  // namespace op
 

@@ -307,3 +307,61 @@ TEST_CASE("open faces and volumes are refused with the dart named") {
   pts.resize(3);
   CHECK_THROWS_WITH_AS(topology(q, {pts}), doctest::Contains("no point"), TopologyError);
 }
+
+namespace test_topology {
+namespace {
+
+// One dart per d-sewn facet of a built grid (D = 2: edges, D = 3: faces) all of whose darts start
+// at points where `keep` holds.
+template <int D, class Keep>
+std::vector<Dart> sewn_facets_where(const Built<D>& b, const IndexedMesh& mesh, Keep keep) {
+  std::vector<Dart> out;
+  for (Dart d : b.map.template cells<D - 1>()) {
+    if (b.map.is_free(d, D)) continue;
+    bool all = true;
+    for (Dart x : b.map.template cell<D - 1>(d)) all = all && keep(mesh.points[b.res.vertex_of_dart[x.index()]]);
+    if (all) out.push_back(d);
+  }
+  return out;
+}
+
+TEST_CASE("a cut through a body adds one to b0; a crack inside it adds a b_{D-1}, so chi changes") {
+  SUBCASE("hexahedra cut along the plane x = 1") {
+    const IndexedMesh mesh = hex_grid(2, 2, 2);
+    Built<3> b(mesh);
+    const auto plane = sewn_facets_where(b, mesh, [](const Point3& p) { return p[0] == 1.0; });
+    REQUIRE(plane.size() == 4);
+    b.map.unsew_all<3>(plane);
+    REQUIRE(b.map.validate().ok());
+    check_betti(b.own(), {2, 0, 0, 0}, 2);
+  }
+  SUBCASE("one inner face of a 3x3x3 block unsewn: its edges and vertices stay shared") {
+    const IndexedMesh mesh = hex_grid(3, 3, 3);
+    Built<3> b(mesh);
+    const auto face = sewn_facets_where(b, mesh, [](const Point3& p) {
+      return p[0] == 1.0 && p[1] >= 1.0 && p[1] <= 2.0 && p[2] >= 1.0 && p[2] <= 2.0;
+    });
+    REQUIRE(face.size() == 1);
+    const auto before = b.map.count_all();
+    CHECK(b.own().total.euler == 1);
+    b.map.unsew<3>(face[0]);
+    CHECK(b.map.count_all() == std::array<std::uint32_t, 4>{before[0], before[1], before[2] + 1, before[3]});
+    const Topology t = b.own();
+    check_betti(t, {1, 0, 1, 0}, 1);  // a flat cavity: a sphere of boundary inside the ball
+    CHECK(t.total.euler == 2);
+    CHECK(t.boundary.size() == 2);
+  }
+  SUBCASE("one inner edge of a 3x3 quad grid unsewn: a slit") {
+    const IndexedMesh mesh = quad_grid(3, 3);
+    Built<2> b(mesh);
+    const auto edge = sewn_facets_where(b, mesh, [](const Point3& p) { return p[0] == 1.0 && p[1] >= 1.0 && p[1] <= 2.0; });
+    REQUIRE(edge.size() == 1);
+    b.map.unsew<2>(edge[0]);
+    const Topology t = b.own();
+    check_betti(t, {1, 1, 0, 0}, 1);
+    CHECK(t.total.euler == 0);
+  }
+}
+
+}  // namespace
+}  // namespace test_topology

@@ -6,7 +6,10 @@
 // elimination over GF(2)); b0 against count_components(), χ against euler_characteristic() and
 // Σ(-1)^i b_i; the orientation found against every sew; and what each operation must do:
 // insertions keep every Betti number, so do removals between two distinct cells and contractions
-// of an edge between two distinct vertices, and a new closed cell adds one component. The map
+// of an edge between two distinct vertices, and a new closed cell adds one component; sewing or
+// unsewing one facet whose boundary cells stay as they were (only the facet count changes) moves
+// exactly one Betti number by one, b_{D-1} or b_D (see Expect::facet_unsewn: χ does not stay,
+// as issue 18 first stated, since a crack inside a body adds a b_{D-1}). The map
 // carries a per-dart tag (DartInfo), unique to each dart, checked after every operation against
 // a model kept here: a surviving dart keeps its tag, an erased dart's tag is gone (a slot reused
 // later starts from 0), a built dart starts from 0, and each dart an insertion makes holds the
@@ -144,7 +147,15 @@ struct Driver {
   // and two cells around it become one (counts[i] and counts[j] one less, the other counts as
   // they were). When the cells around would be pinched (two faces left meeting at a single
   // vertex of a 2-map, say), the map splits them instead: no promise then.
-  enum class Expect { keep, add_component, keep_if_merged, any };
+  //
+  // Unsewing a facet f whose boundary cells are not split (only the facet count grows by one):
+  // the map before is, over Z/2, the map after with one D-cell e attached, ∂e = f1 + f2 (the two
+  // copies of f share their boundary, so f1 + f2 is a cycle, and the pair (e, f1 + f2) collapses
+  // back to f). Attaching a D-cell either fills a (D-1)-cycle (b_{D-1} one less) or closes a
+  // D-cycle (b_D one more), nothing else. So the unsew raises b_{D-1} by one or lowers b_D by
+  // one, and a sew that only merges two facets does the reverse. (A crack inside a ball adds a
+  // b2: χ changes, against issue 18's first statement that unsewing one facet keeps χ.)
+  enum class Expect { keep, add_component, keep_if_merged, facet_unsewn, facet_sewn, any };
   int merged_i = 0, merged_j = 0;
 
   struct Op {
@@ -311,7 +322,7 @@ struct Driver {
                      const Dart d = random_dart_where([&](Dart x) { return !m.is_free(x, D); });
                      if (!d) return skip();
                      m.template unsew<D>(d);
-                     return done(Expect::any);
+                     return done(Expect::facet_unsewn);
                    }});
     ops.push_back({"sew<D>", [=, this] {
                      const Dart a = random_dart_where([&](Dart x) { return m.is_free(x, D); });
@@ -320,7 +331,7 @@ struct Driver {
                        const Dart b = random_dart();
                        if (b != a && m.template is_sewable<D>(a, b)) {
                          m.template sew<D>(a, b);
-                         return done(Expect::any);
+                         return done(Expect::facet_sewn);
                        }
                      }
                      return skip();
@@ -406,7 +417,7 @@ struct Driver {
   }
 
   B cells_before{};
-  std::int64_t pinched = 0, kept = 0;
+  std::int64_t pinched = 0, kept = 0, facet_moves = 0;
   Topology last;  // after the previous step
   void check(unsigned seed, std::int64_t step, const char* op, Expect expect, const B& before, bool with_oracle) {
     const std::string what = std::string(op) + ", Betti before " + str(before);
@@ -431,6 +442,18 @@ struct Driver {
       --merged[static_cast<std::size_t>(merged_j)];
       if (t.total.cells == merged) expect = Expect::keep;
       else ++pinched;
+    }
+    if (expect == Expect::facet_unsewn || expect == Expect::facet_sewn) {
+      const std::int64_t s = expect == Expect::facet_unsewn ? 1 : -1;
+      B only_facet = cells_before;
+      only_facet[D - 1] += s;
+      if (t.total.cells == only_facet) {
+        ++facet_moves;
+        B crack = before, hole = before;  // for an unsew: a (D-1)-cycle more, or a D-cycle less
+        crack[D - 1] += s;
+        hole[D] -= s;
+        CHECK((b == crack || b == hole));
+      }
     }
     if (expect == Expect::keep) {
       ++kept;
@@ -478,7 +501,7 @@ struct Driver {
 }  // namespace
 
 TEST_CASE("random operation sequences keep the invariants they must (2-maps)") {
-  std::int64_t total = 0, kept = 0, pinched = 0, tag_checks = 0;
+  std::int64_t total = 0, kept = 0, pinched = 0, tag_checks = 0, facet_moves = 0;
   for (unsigned seed : {11u, 12u, 13u, 14u, 15u}) {
     Driver<2> d(seed, 200);
     d.run(seed, 18500);
@@ -486,16 +509,18 @@ TEST_CASE("random operation sequences keep the invariants they must (2-maps)") {
     tag_checks += d.tag_checks;
     kept += d.kept;
     pinched += d.pinched;
+    facet_moves += d.facet_moves;
   }
   MESSAGE("2-map operations applied: ", total, ", of which ", kept, " had to keep every Betti number; ", pinched,
-          " removals or contractions pinched");
+          " removals or contractions pinched; ", facet_moves, " sews or unsews of one facet moved one Betti number");
   CHECK(total >= 50000);
   CHECK(tag_checks >= total);  // the per-dart tags were checked after every operation
   CHECK(kept >= total / 4);
+  CHECK(facet_moves > 0);
 }
 
 TEST_CASE("random operation sequences keep the invariants they must (3-maps)") {
-  std::int64_t total = 0, kept = 0, pinched = 0, tag_checks = 0;
+  std::int64_t total = 0, kept = 0, pinched = 0, tag_checks = 0, facet_moves = 0;
   for (unsigned seed : {21u, 22u, 23u, 24u, 25u}) {
     Driver<3> d(seed, 300);
     d.run(seed, 23000);
@@ -503,10 +528,79 @@ TEST_CASE("random operation sequences keep the invariants they must (3-maps)") {
     tag_checks += d.tag_checks;
     kept += d.kept;
     pinched += d.pinched;
+    facet_moves += d.facet_moves;
   }
   MESSAGE("3-map operations applied: ", total, ", of which ", kept, " had to keep every Betti number; ", pinched,
-          " removals or contractions pinched");
+          " removals or contractions pinched; ", facet_moves, " sews or unsews of one facet moved one Betti number");
   CHECK(total >= 50000);
   CHECK(tag_checks >= total);  // the per-dart tags were checked after every operation
   CHECK(kept >= total / 4);
+  CHECK(facet_moves > 0);
 }
+
+namespace test_topology_random {
+namespace {
+
+// Every D-sewn facet of m in turn: unsewn, then sewn back. When the unsew changes no count but
+// the facet count (its boundary cells stay shared), one Betti number moves by one, b_{D-1} up or
+// b_D down (see Driver::Expect); sewing it back restores the counts and the Betti numbers.
+// Returns how many facets were of that kind.
+template <int D>
+int unsew_and_sew_back_every_facet(CMap<D>& m) {
+  std::vector<Dart> facets;
+  for (Dart d : m.template cells<D - 1>())
+    if (!m.is_free(d, D)) facets.push_back(d);
+  const Topology t0 = topology(m, {{}, false});
+  int moved = 0;
+  for (Dart d : facets) {
+    INFO("facet of dart ", d.index());
+    const Dart partner = m.beta(d, D);
+    m.template unsew<D>(d);
+    REQUIRE(m.validate().ok());
+    const Topology t = topology(m, {{}, false});
+    B only_facet = t0.total.cells;
+    ++only_facet[D - 1];
+    if (t.total.cells == only_facet) {
+      ++moved;
+      B crack = t0.total.betti, hole = t0.total.betti;
+      ++crack[D - 1];
+      --hole[D];
+      const std::string got = str(t.total.betti), was = str(t0.total.betti);
+      INFO("Betti numbers ", was, " became ", got);
+      CHECK((t.total.betti == crack || t.total.betti == hole));
+    }
+    REQUIRE(m.template is_sewable<D>(d, partner));
+    m.template sew<D>(d, partner);
+    REQUIRE(m.validate().ok());
+    const Topology back = topology(m, {{}, false});
+    CHECK(back.total.cells == t0.total.cells);
+    CHECK(back.total.betti == t0.total.betti);
+  }
+  return moved;
+}
+
+TEST_CASE("unsewing one facet whose boundary stays shared moves b_{D-1} up or b_D down, not chi") {
+  SUBCASE("quads: a 4 x 4 grid (cracks) and the surface of a cube (a slit opens the sphere)") {
+    CMap<2> grid;
+    build(grid, quad_grid(4, 4));
+    CHECK(unsew_and_sew_back_every_facet(grid) == 12);  // the edges between two of the 3 x 3 inner vertices
+    IndexedMesh cube;
+    cube.points.resize(8);
+    for (auto f : cell_faces(CellType::hexahedron)) cube.add_cell(CellType::quad, {f[0], f[1], f[2], f[3]});
+    CMap<2> sphere;
+    build(sphere, cube);
+    REQUIRE(topology(sphere).total.betti == B{1, 0, 1, 0});
+    CHECK(unsew_and_sew_back_every_facet(sphere) == 12);
+  }
+  SUBCASE("hexahedra and tetrahedra") {
+    CMap<3> hex;
+    build(hex, hex_grid(3, 3, 3));
+    CHECK(unsew_and_sew_back_every_facet(hex) > 0);
+    CMap<3> tet;
+    build(tet, tet_grid(2, 2, 2, TetSplit::kuhn6));
+    CHECK(unsew_and_sew_back_every_facet(tet) > 0);
+  }
+}
+
+}  // namespace
+}  // namespace test_topology_random

@@ -473,11 +473,7 @@ class CMap {
   Dart insert_vertex_in_edge(Dart d, attribute_type<I> v) {
     detail::DartBuffer<32> made;
     const Dart nd = split_edge(d, made);
-    auto& st = store<0>();
-    const std::uint32_t a = st.values.create(std::move(v));
-    for (std::uint32_t x : made) st.of_dart[x] = a;
-    st.values.add_count(a, static_cast<std::int64_t>(made.size()));
-    st.values.set_dart(a, nd.index());
+    give_new_vertex<I>(made, nd, std::move(v));
     return nd;
   }
   /// True if insert_edge_in_face(a, b) may be called: a ≠ b, both live, b on a's closed β1 cycle.
@@ -510,16 +506,30 @@ class CMap {
   /// if not insertable. O(path).
   Dart insert_face_in_hole(std::span<const Dart> path);
   /// True if insert_vertex_in_face(d) may be called: D ≥ 2, d's face a closed β1 cycle of at
-  /// least two darts. O(face).
+  /// least two darts, not βj-sewn (j ≥ 3) to itself (a face folded onto itself). O(face · copies).
   [[nodiscard]] bool is_insertable_vertex_in_face(Dart d) const;
   /// Inserts a vertex inside the face of d joined to each of its k vertices (CGAL's
-  /// insert_cell_0_in_cell_2): the face becomes k triangles, across every βj-sewn copy (j ≥ 3).
-  /// Done as an edge from d's start to the next vertex, split by the new vertex, then an edge
-  /// to each remaining vertex; hooks fire as for those insertions: the triangle holding d keeps
-  /// the face's attribute, the k-1 others get copies (on_split); the new vertex and edges have
-  /// no attribute. Returns the new dart that starts at the new vertex and ends at β1(d)'s start.
-  /// Throws TopologyError if not insertable. O(k · face).
-  Dart insert_vertex_in_face(Dart d);
+  /// insert_cell_0_in_cell_2): the face becomes k triangles, across every βj-sewn copy (j ≥ 3),
+  /// in one pass that makes the 2k new darts of each copy and their links. The triangle holding
+  /// d keeps the face's attribute, the k-1 others get copies (on_split fires for each, once the
+  /// map is whole); the new vertex and edges have no attribute, the new darts keep their copy's
+  /// volume (and higher) attributes. Returns the new dart that starts at the new vertex and ends
+  /// at β1(d)'s start. Throws TopologyError if not insertable. O(k · copies).
+  Dart insert_vertex_in_face(Dart d) {
+    detail::DartBuffer<32> centre;
+    return star_face(d, centre);
+  }
+  /// As insert_vertex_in_face(d) followed by set_attribute<0> on the new vertex with v, without
+  /// walking the vertex: its darts are the ones the insertion made (CGAL's
+  /// insert_cell_0_in_cell_2 with a vertex attribute). O(k · copies).
+  template <int I = 0>
+    requires(I == 0 && has_attribute<0>)
+  Dart insert_vertex_in_face(Dart d, attribute_type<I> v) {
+    detail::DartBuffer<32> centre;
+    const Dart w = star_face(d, centre);
+    give_new_vertex<I>(centre, w, std::move(v));
+    return w;
+  }
 
   /// True if insert_dangling_edge_in_face(d) may be called: D is 2 or 3, d live with a β0. O(1).
   [[nodiscard]] bool is_insertable_dangling_edge_in_face(Dart d) const;
@@ -715,6 +725,21 @@ class CMap {
   void erase_dart_raw(std::uint32_t x);
   // insert_vertex_in_edge; `made` receives the new darts, which are the new vertex's.
   Dart split_edge(Dart d, detail::DartBuffer<32>& made);
+  // A new 0-attribute holding v for the darts of a new vertex (all of them, none carrying one),
+  // `first` among them.
+  template <int I>
+  void give_new_vertex(const detail::DartBuffer<32>& darts, Dart first, attribute_type<I> v) {
+    auto& st = store<I>();
+    const std::uint32_t a = st.values.create(std::move(v));
+    for (std::uint32_t x : darts) st.of_dart[x] = a;
+    st.values.add_count(a, static_cast<std::int64_t>(darts.size()));
+    st.values.set_dart(a, first.index());
+  }
+  // The face of a dart and its copies across βj (j ≥ 3), see cmap_insert.hpp.
+  struct FaceCopies;
+  [[nodiscard]] bool face_copies(std::uint32_t d, FaceCopies& out) const;
+  // insert_vertex_in_face; `centre` receives the new darts that start at the new vertex.
+  Dart star_face(Dart d, detail::DartBuffer<32>& centre);
   // A bit per dimension whose attributes are enabled: work that only serves attributes is
   // skipped at compile time when an operation's dimensions have none.
   static constexpr unsigned attribute_dims = []<int... I>(std::integer_sequence<int, I...>) {
@@ -748,6 +773,20 @@ class CMap {
 
   // Gives `to` the attributes of `from` for every dimension whose bit is set in dims.
   void inherit_attributes(std::uint32_t from, std::uint32_t to, unsigned dims);
+  // The same for a dart just made (it carries no attribute yet), the dimensions known at
+  // compile time: the per-dart work of the one-pass insertions, which make many darts.
+  template <unsigned Dims>
+  void inherit_new(std::uint32_t from, std::uint32_t to) {
+    for_each_dim([&](auto k) {
+      constexpr int K = k();
+      if constexpr (has_attribute<K> && ((Dims >> K) & 1u) != 0) {
+        auto& st = store<K>();
+        const std::uint32_t a = st.of_dart[from];
+        st.of_dart[to] = a;
+        if (a != detail::null_index) st.values.add_count(a, 1);
+      }
+    });
+  }
   // Gives the new dart `to` a copy of the info of `from` (the insertion rule above).
   void copy_info(std::uint32_t from, std::uint32_t to) {
     if constexpr (has_dart_info) info_.of_dart[to] = info_.of_dart[from];

@@ -242,11 +242,11 @@ Dart CMap<D, A...>::insert_face_in_hole(std::span<const Dart> path) {
   // Path dart d_i goes v_i -> v_{i+1}; the new dart p_i goes v_{i+1} -> v_i, β2(d_i) = p_i. It
   // lies on d_i's edge and in its volume and starts at d_{i+1}'s vertex: every cell it joins
   // already exists, so attributes are inherited and nothing merges.
-  std::vector<std::uint32_t> p(k);
+  detail::DartBuffer<32> p;
+  new_darts(static_cast<std::uint32_t>(k), p);
   for (std::size_t i = 0; i < k; ++i) {
-    p[i] = new_dart();
-    inherit_attributes(path[i].index(), p[i], ~5u);
-    inherit_attributes(path[(i + 1) % k].index(), p[i], 1u);
+    inherit_new<~5u>(path[i].index(), p[i]);
+    inherit_new<1u>(path[(i + 1) % k].index(), p[i]);
     copy_info(path[i].index(), p[i]);
   }
   for (std::size_t i = 0; i < k; ++i) {
@@ -256,38 +256,138 @@ Dart CMap<D, A...>::insert_face_in_hole(std::span<const Dart> path) {
   return Dart(p[0]);
 }
 
+// The face of a dart and its copies across βj (j ≥ 3): copy q's darts are darts[q·k + i],
+// aligned so that position i of every copy lies on the edge of the i-th dart of the face's cycle
+// from d. A copy reached by an odd number of βj runs the other way (flipped): its β1 goes from
+// position i to i-1. next[q][j] is the copy that βj takes copy q to, or null.
+template <int D, class... A>
+struct CMap<D, A...>::FaceCopies {
+  std::uint32_t k = 0;
+  boost::container::small_vector<std::uint32_t, 16> darts;
+  boost::container::small_vector<bool, 2> flipped;
+  boost::container::small_vector<std::array<std::uint32_t, D + 1>, 2> next;
+  [[nodiscard]] std::size_t copies() const { return flipped.size(); }
+};
+
+template <int D, class... A>
+bool CMap<D, A...>::face_copies(std::uint32_t d, FaceCopies& out) const {
+  constexpr std::uint32_t null = detail::null_index;
+  if (!is_alive(Dart(d))) return false;
+  const std::uint32_t cap = dart_capacity();
+  std::uint32_t x = d;
+  do {
+    out.darts.push_back(x);
+    x = b(x, 1);
+    if (x == null || out.darts.size() > cap) return false;  // an open face
+  } while (x != d);
+  const auto k = static_cast<std::uint32_t>(out.darts.size());
+  if (k < 2) return false;
+  out.k = k;
+  std::array<std::uint32_t, D + 1> none;
+  none.fill(null);
+  out.flipped.push_back(false);
+  out.next.push_back(none);
+  if constexpr (D >= 3) {
+    // breadth-first over the copies; βj maps whole closed cycles to whole cycles (valid links),
+    // so a copy is new unless its position-0 image is already listed
+    for (std::size_t q = 0; q < out.copies(); ++q)
+      for (int j = 3; j <= D; ++j) {
+        const std::uint32_t img = b(out.darts[q * k], j);
+        if (img == null) continue;
+        const auto at = static_cast<std::size_t>(std::find(out.darts.begin(), out.darts.end(), img) - out.darts.begin());
+        if (at < out.darts.size() && at % k != 0) return false;  // the face is sewn to itself
+        std::size_t r = at / k;
+        if (at == out.darts.size()) {
+          r = out.copies();
+          for (std::uint32_t i = 0; i < k; ++i) {
+            const std::uint32_t y = b(out.darts[q * k + i], j);
+            if (y == null) return false;
+            out.darts.push_back(y);
+          }
+          out.flipped.push_back(!out.flipped[q]);
+          out.next.push_back(none);
+        }
+        out.next[q][static_cast<std::size_t>(j)] = static_cast<std::uint32_t>(r);
+      }
+  }
+  return true;
+}
+
 template <int D, class... A>
 bool CMap<D, A...>::is_insertable_vertex_in_face(Dart d) const {
   if constexpr (D < 2) return false;
-  if (!is_alive(d)) return false;
-  const std::uint32_t n = b(d.index(), 1);
-  return n != detail::null_index && n != d.index() && is_insertable_edge_in_face(d, Dart(n));
+  FaceCopies fc;
+  return face_copies(d.index(), fc);
 }
 
 template <int D, class... A>
-Dart CMap<D, A...>::insert_vertex_in_face(Dart d) {
-  if (!is_insertable_vertex_in_face(d))
+Dart CMap<D, A...>::star_face(Dart d, detail::DartBuffer<32>& centre) {
+  FaceCopies fc;
+  if (D < 2 || !face_copies(d.index(), fc))
     throw TopologyError("cmap::insert_vertex_in_face: the face of dart " + std::to_string(d.index()) +
-                        " is not a closed cycle of at least two darts");
-  // 1) the face's vertices, in order from d
-  std::vector<Dart> c;
-  for (Dart x = d;;) {
-    c.push_back(x);
-    x = Dart(b(x.index(), 1));
-    if (x == d) break;
+                        " is not a closed cycle of at least two darts, or is sewn to itself");
+  const std::uint32_t k = fc.k;
+  const std::size_t copies = fc.copies();
+  // Dart c_i of a copy runs V_i -> V_{i+1} (flipped: V_{i+1} -> V_i) and becomes triangle i with
+  // the centre v: x_i on the edge {V_{i+1}, v}, y_i on {V_i, v}. Unflipped, c_i -> x_i -> y_i
+  // (x_i leaves V_{i+1}, y_i leaves v); flipped, c_i -> y_i -> x_i (y_i leaves V_i, x_i leaves
+  // v). Either way β2(x_i) = y_{i+1} inside a copy, and βj pairs x with x and y with y at the
+  // same position across copies.
+  detail::DartBuffer<64> made;
+  new_darts(static_cast<std::uint32_t>(2 * k * copies), made);
+  auto X = [&](std::size_t q, std::uint32_t i) { return made[2 * (q * k + i)]; };
+  auto Y = [&](std::size_t q, std::uint32_t i) { return made[2 * (q * k + i) + 1]; };
+  constexpr unsigned above_faces = ~7u;  // volumes and higher: each new dart's copy's own
+  for (std::size_t q = 0; q < copies; ++q) {
+    const bool flip = fc.flipped[q];
+    const std::uint32_t* c = &fc.darts[q * k];
+    for (std::uint32_t i = 0; i < k; ++i) {
+      const std::uint32_t x = X(q, i), y = Y(q, i), ci = c[i];
+      // the new dart after c_i starts where the old β1(c_i) starts; the other one at v
+      const std::uint32_t after = flip ? y : x, at_centre = flip ? x : y;
+      const std::uint32_t old_next = c[flip ? (i + k - 1) % k : (i + 1) % k];
+      inherit_new<above_faces>(ci, x);
+      inherit_new<above_faces>(ci, y);
+      inherit_new<1u>(old_next, after);
+      copy_info(c[0], x);
+      copy_info(c[0], y);
+      raw_link(ci, 1, after);
+      raw_link(after, 1, at_centre);
+      raw_link(at_centre, 1, ci);
+      raw_link(x, 2, Y(q, (i + 1) % k));
+      centre.push_back(at_centre);
+      for (int j = 3; j <= D; ++j)
+        if (const std::uint32_t r = fc.next[q][static_cast<std::size_t>(j)]; r != detail::null_index) {
+          raw_link(x, j, X(r, i));
+          raw_link(y, j, Y(r, i));
+        }
+    }
   }
-  // 2) an edge from c0's start to c1's start (beside c0), split by the new vertex v
-  const Dart h = insert_edge_in_face(c[0], c[1]);  // c0's start -> c1's start, in c1's face
-  const Dart w = insert_vertex_in_edge(h);         // v -> c1's start
-  //    (per-dart info: each insertion copies its first argument's, which is d's or, for the
-  //    darts the split made, h's, itself a copy of d's; so every new dart copies d, as stated)
-  // 3) an edge from v to each remaining vertex; each returned dart starts at v and lies in the
-  //    face that holds the next vertex
-  Dart a = w;
-  for (std::size_t j = 2; j < c.size(); ++j) a = insert_edge_in_face(a, c[j]);
-  return w;
+  // The face splits into k triangles: triangle 0 (holding d) keeps the attribute, each other
+  // one gets a copy of it on all its darts, in every copy of the face; the hooks run last.
+  if constexpr (has_attribute<2>) {
+    auto& st = store<2>();
+    const std::uint32_t orig = st.of_dart[d.index()];
+    if (orig != detail::null_index) {
+      boost::container::small_vector<std::uint32_t, 8> split;
+      for (std::uint32_t i = 0; i < k; ++i) {
+        const std::uint32_t a = i == 0 ? orig : copy_attribute<2>(orig);
+        for (std::size_t q = 0; q < copies; ++q) {
+          st.of_dart[fc.darts[q * k + i]] = a;
+          st.of_dart[X(q, i)] = a;
+          st.of_dart[Y(q, i)] = a;
+        }
+        st.values.add_count(a, static_cast<std::int64_t>(i == 0 ? 2 * copies : 3 * copies));
+        st.values.set_dart(a, fc.darts[i]);
+        if (i != 0) split.push_back(a);
+      }
+      st.values.add_count(orig, -static_cast<std::int64_t>((k - 1) * copies));
+      if (hooks_on_ && st.on_split)
+        for (std::uint32_t a : split) st.on_split(AttrId<2>(orig), AttrId<2>(a));
+    }
+  }
+  return Dart(Y(0, 1));
 }
-
 
 template <int D, class... A>
 bool CMap<D, A...>::is_insertable_dangling_edge_in_face(Dart d) const {
