@@ -159,6 +159,7 @@ std::string encode_payload(const Checkpoint& c) {
   const auto& l = c.ledger;
   for (double x : {l.total0, l.external0, l.last_total, l.last_moving, l.last_external}) e.put(x);
   e.put(l.rises);
+  e.put(l.peak_ratio);
   e.put(c.frame_times);
   e.put(c.csv_columns);
   e.put(c.csv_rows);
@@ -218,6 +219,7 @@ Checkpoint decode_payload(Decoder& d) {
   auto& l = c.ledger;
   for (double* x : {&l.total0, &l.external0, &l.last_total, &l.last_moving, &l.last_external}) *x = d.get<double>("energy ledger");
   l.rises = d.get<std::uint64_t>("energy rises");
+  l.peak_ratio = d.get<double>("energy peak ratio");
   d.get(c.frame_times, "frame times");
   c.csv_columns = d.get<std::uint32_t>("csv columns");
   d.get(c.csv_rows, "csv rows");

@@ -227,8 +227,8 @@ TEST_CASE("a checkpoint that is not this run's, or not whole, is refused with ex
   }
   SUBCASE("another format version") {
     std::string bad = bytes;
-    bad[8] = 2;
-    check_refused(saved, put("v2.checkpoint", bad), "format version 2, but this sewn reads version 1 only");
+    bad[8] = 3;
+    check_refused(saved, put("v3.checkpoint", bad), "format version 3, but this sewn reads version 2 only");
   }
   SUBCASE("not a checkpoint") { check_refused(saved, saved.scene, "not a Sewn checkpoint"); }
   SUBCASE("missing") { check_refused(saved, scratch("nowhere.checkpoint"), "cannot be opened: No such file or directory"); }
@@ -318,7 +318,7 @@ TEST_CASE("the checkpoint format: every field comes back, and every shorter file
   c.implicit.steps = 12;
   c.implicit.watchdog = {true, true, 13, 14, 15, 16};
   c.midpoint = {34, {true, true, 35, 36, 37, 38}};
-  c.ledger = {17, 18, 19, 20, 21, 22};
+  c.ledger = {17, 18, 19, 20, 21, 22, 39};
   c.frame_times = {0, 0.5};
   c.csv_columns = 2;
   c.csv_rows = {0, 0, 1, 0.5};
@@ -345,6 +345,7 @@ TEST_CASE("the checkpoint format: every field comes back, and every shorter file
   CHECK(d.midpoint.watchdog.peak_speed == 38);
   CHECK(d.first_energy_rise == "step 2");
   CHECK(d.wall == 32);
+  CHECK(d.ledger.peak_ratio == 39);
   for (std::size_t n = 0; n < bytes.size(); ++n) CHECK_THROWS_AS((void)sewn::app::decode_checkpoint(bytes.substr(0, n), "f"), sewn::app::CheckpointError);
   // a checksum made to match does not let a bad length through
   std::string forged = bytes;
