@@ -438,10 +438,13 @@ void dynamic_run(benchmark::State& st, Run run) {
     st.SkipWithError((spec.name + ": " + e.what()).c_str());
     return;
   }
-  if (!r.at_rest) {
+  // The midpoint rule does not damp fast modes (only the drag does, and hardly at hω ≫ 1): not
+  // coming to rest is its measured result, reported with the state it reached, not an error.
+  if (!r.at_rest && run.integrator != Integrator::midpoint) {
     st.SkipWithError((spec.name + " " + run.name() + ": not at rest after " + std::to_string(max_simulated_time) + " s").c_str());
     return;
   }
+  st.counters["_at_rest"] = r.at_rest ? 1.0 : 0.0;
   st.counters["_n"] = run.n;
   st.counters["_h"] = h;
   st.counters["_steps"] = static_cast<double>(r.steps);
@@ -497,22 +500,25 @@ void register_cantilever_integrators(Scale scale) {
   // both families, whose three finest give each its own extrapolated reference.
   std::vector<std::uint32_t> statics = {2, 4, 8};
   std::vector<Run> runs;
-  auto add = [&](std::uint32_t n, std::initializer_list<double> steps) {
-    for (bool volume : {false, true})
-      for (Integrator i : {Integrator::implicit, Integrator::midpoint})
-        for (double h : steps) runs.push_back({n, i, h, volume});
+  auto add = [&](std::uint32_t n, std::initializer_list<double> implicit_steps, std::initializer_list<double> midpoint_steps) {
+    for (bool volume : {false, true}) {
+      for (double h : implicit_steps) runs.push_back({n, Integrator::implicit, h, volume});
+      for (double h : midpoint_steps) runs.push_back({n, Integrator::midpoint, h, volume});
+    }
   };
+  // The midpoint rule runs to the time limit (it does not come to rest, see dynamic_run): only at
+  // 10 ms and on the coarser meshes.
   if (scale == Scale::full) {
     statics.push_back(16);
-    add(2, {1e-2, 1e-3});
-    add(4, {1e-2, 1e-3});
-    add(8, {1e-2});
+    add(2, {1e-2, 1e-3}, {1e-2});
+    add(4, {1e-2, 1e-3}, {1e-2});
+    add(8, {1e-2}, {});
   } else if (scale == Scale::small) {
-    add(2, {1e-2});
-    add(4, {1e-2});
+    add(2, {1e-2}, {1e-2});
+    add(4, {1e-2}, {});
   } else {
     statics = {2};
-    runs = {{2, Integrator::midpoint, 1e-2, false}, {2, Integrator::midpoint, 1e-2, true}};
+    runs = {{2, Integrator::implicit, 1e-2, false}, {2, Integrator::implicit, 1e-2, true}};
   }
   register_family("hard", statics, true, runs);
 }
