@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "sewn/apps/runner.hpp"
 #include "sewn/io/errors.hpp"
 #include "sewn/io/geometry.hpp"
@@ -319,10 +321,26 @@ TEST_CASE("a spinning cube: the linearly implicit step's energy rise is reported
   CHECK(fast.first_energy_rise.find("step 1 ") != std::string::npos);
   CHECK(column(header, rows.back(), "energy_rises") == static_cast<double>(fast.energy_rises));
   CHECK(column(header, rows[1], "dissipated") < 0);  // frame 1, after step 1: energy was created
+  // the ratio column saw it at the step: kinetic + elastic far above what the start supplied
+  CHECK(column(header, rows.back(), "energy_ratio_max") > 2.0);
+  const auto angular = [&](const std::vector<double>& r) {
+    return Eigen::Vector3d(column(header, r, "angular_momentum_x"), column(header, r, "angular_momentum_y"),
+                           column(header, r, "angular_momentum_z"));
+  };
+  const auto linear = [&](const std::vector<double>& r) {
+    return Eigen::Vector3d(column(header, r, "momentum_x"), column(header, r, "momentum_y"), column(header, r, "momentum_z"));
+  };
+  // ½ Σ m ω² r² = 9.375 J at 100 rad/s: L = 2 E / ω about the spin axis, and the implicit step loses it
+  CHECK(angular(rows.front()).z() == doctest::Approx(2 * column(header, rows.front(), "kinetic_energy") / 100).epsilon(1e-9));
+  CHECK(angular(rows.back()).z() < 0.9 * angular(rows.front()).z());
   const std::string spin10 = R"([{"where": {"type": "all"}, "angular": [0, 0, 10]}])";
   const RunSummary calm = run_text(spin_scene("midpoint", 0.01, 0.2, spin10), "spin10", header, rows);
   CHECK(calm.energy_rises == 0);
   CHECK(calm.substepped == 0);
+  // the midpoint rule keeps both momenta, and the energy it was given
+  CHECK((angular(rows.back()) - angular(rows.front())).norm() <= 1e-10 * angular(rows.front()).norm());
+  CHECK(linear(rows.back()).norm() <= 1e-12);
+  CHECK(column(header, rows.back(), "energy_ratio_max") == doctest::Approx(1.0).epsilon(1e-9));
   // a radian per step: the midpoint rule's Newton needs sub-steps, the summary counts them, no energy is made
   const RunSummary sub = run_text(spin_scene("midpoint", 0.01, 0.05, spin100), "spin100_midpoint", header, rows);
   CHECK(sub.substepped > 0);
