@@ -202,6 +202,7 @@ std::string encode_payload(const Checkpoint& c) {
   const auto& l = c.ledger;
   for (double x : {l.total0, l.external0, l.last_total, l.last_moving, l.last_external}) e.put(x);
   e.put(l.rises);
+  e.put(l.peak_ratio);
   put_rods(e, c.rods);
   e.put(c.refinement.refined);
   e.put(c.refinement.coarsened);
@@ -271,6 +272,7 @@ Checkpoint decode_payload(Decoder& d) {
   auto& l = c.ledger;
   for (double* x : {&l.total0, &l.external0, &l.last_total, &l.last_moving, &l.last_external}) *x = d.get<double>("energy ledger");
   l.rises = d.get<std::uint64_t>("energy rises");
+  l.peak_ratio = d.get<double>("energy peak ratio");
   c.rods = get_rods(d);
   c.refinement.refined = d.get<std::uint64_t>("refinements");
   c.refinement.coarsened = d.get<std::uint64_t>("coarsenings");

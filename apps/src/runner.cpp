@@ -396,15 +396,17 @@ Assembly assemble(const Scene& scene) {
 
 namespace {
 
-// The volume-preserving term of the materials that ask for it. Its stencils are read from the
-// model as built, so a scene that cuts is refused rather than given stale stencils.
+// The volume-preserving term of the materials that ask for it. Its stencils follow cuts (each
+// takes its element's corner particles after the cut) but not refinement, whose new elements
+// would have none: a scene that refines is refused rather than given a term with holes.
 void add_volume_term(const Scene& scene, const std::vector<std::string>& material_names, physics::MssModel<3>& model) {
   std::vector<double> kappa;
   for (const auto& name : material_names) {
     kappa.push_back(scene.materials.at(name).volume_stiffness);
-    if (kappa.back() > 0 && !scene.cuts.empty())
+    if (kappa.back() > 0 && scene.refinement.enabled)
       throw SceneError(scene.file, "materials." + name + ".volume_stiffness",
-                       "the volume term is not supported with cuts yet (its stencils would keep the nodes of before a cut)");
+                       "the volume term is not supported with refinement yet (the elements refinement creates would have no "
+                       "volume stencils)");
   }
   // Materials past the scene's own are copies apply_rod_sections made for rod cells, which have
   // no volume to keep.
@@ -544,8 +546,9 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   if (scene.write_csv) {
     sum.csv = sum.out / "frames.csv";
     const std::vector<std::string> columns{"frame", "time", "kinetic_energy", "elastic_energy", "gravity_energy",
-                                           "total_energy", "external_work", "dissipated", "energy_rises", "inverted",
-                                           "particles", "springs", "elements", "steps", "ms_per_step",
+                                           "total_energy", "external_work", "dissipated", "energy_ratio_max",
+                                           "energy_rises", "inverted", "momentum_x", "momentum_y", "momentum_z",
+                                           "angular_momentum_x", "angular_momentum_y", "angular_momentum_z", "particles", "springs", "elements", "steps", "ms_per_step",
                                            "cg_iterations_mean", "cg_iterations_max", "cuts", "faces_cut", "refined", "coarsened"};
     if (resuming && ck.csv_columns != columns.size())
       throw CheckpointError(options.resume.string(), "its frames.csv rows have " + std::to_string(ck.csv_columns) + " columns, not " +
@@ -617,8 +620,11 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     if (csv) {
       const auto elements = std::count_if(model->elements().begin(), model->elements().end(), [](const auto& e) { return e.alive; });
       const physics::EnergyBalance e = ledger.balance(sys);
+      ledger.observe(e);
+      const physics::Momenta p = physics::momenta(model->nodes());
       const double row[] = {static_cast<double>(frame), t, e.kinetic, e.elastic, e.external_potential, e.total, e.external_work,
-                            e.dissipated, static_cast<double>(ledger.rises()), static_cast<double>(inverted_now),
+                            e.dissipated, ledger.peak_ratio(), static_cast<double>(ledger.rises()), static_cast<double>(inverted_now),
+                            p.linear.x(), p.linear.y(), p.linear.z(), p.angular.x(), p.angular.y(), p.angular.z(),
                             static_cast<double>(model->nodes().num_alive()),
                             static_cast<double>(model->springs().num_alive()), static_cast<double>(elements),
                             static_cast<double>(frame_steps), frame_steps ? frame_ms / static_cast<double>(frame_steps) : 0.0,

@@ -58,7 +58,7 @@ Field build_schema() {
       field("thickness", Kind::number).unit("m").fallback(1.0).above(0).doc("Thickness of 2D cells (membranes): scales their mass and stiffness."),
       field("area", Kind::number).unit("m²").fallback(1e-4).above(0).doc("Cross-section of 1D cells (polylines): axial spring k = E·area/length."),
       field("volume_stiffness", Kind::number).unit("Pa").fallback(0.0).at_least(0).at_most(1e13)
-          .doc("Bulk stiffness κ of a volume-preserving term (Teschner et al. 2004): each tetrahedron, and each corner of a hexahedron with an eighth of its volume, stores ½ κ V̄ (V/V̄ - 1)². Springs see lengths, not orientation: a region much softer than its load (a 1 kPa region under a 1 GPa block) turns inside out, and κ well above the pressure it carries (e.g. 100× E for a soft, nearly incompressible solid) keeps it from inverting. 0: no term. Not available with `cuts`."),
+          .doc("Bulk stiffness κ of a volume-preserving term (Teschner et al. 2004): each tetrahedron, and each corner of a hexahedron with an eighth of its volume, stores ½ κ V̄ (V/V̄ - 1)². Springs see lengths, not orientation: a region much softer than its load (a 1 kPa region under a 1 GPa block) turns inside out, and κ well above the pressure it carries (e.g. 100× E for a soft, nearly incompressible solid) keeps it from inverting. 0: no term. Follows cuts (each element keeps its own particles after one); not available with `refinement`."),
       field("elongated", Kind::string).one_of({"refuse", "clamp", "split"}).fallback("refuse")
           .doc("Baudet's edge stiffness turns negative for boxes longer than ~1.5× their width. `refuse`: such an element is refused, naming it. `split`: each such hexahedron is cut into near-cubes (pieces of aspect at most √2) before the model is built, and so are the hexahedra sharing its split edges, so that the mesh stays conforming; on the 1 m cantilever at E = 100 MPa (4 cells through its thickness) the static tip is the cube-meshed beam's at 10:1 and 5:1 boxes (the pieces are its cubes) and 3.1 % softer at 2.5:1 (pieces of 0.83:1), at the cost of the cube mesh's particles. Cells of other types on a split edge are refused. Mesh cell numbers in later messages are those of the split mesh. `clamp`: the negative edge stiffnesses are set to 0 and the diagonals carry the load along the long axis, which makes the body far too stiff in bending (on that cantilever: 4.8× at 2.5:1, 66× at 5:1, 860× at 10:1). Both `split` and `clamp` print a warning with the number of cells they changed."),
   });
@@ -170,8 +170,13 @@ Field build_schema() {
              "gravity has done since the start (its potential then minus now) and `dissipated` the energy lost since "
              "the start (total then minus now: damping plus the integrator's numerical dissipation; negative when the "
              "scheme created energy), so that kinetic + elastic = their start value + `external_work` − `dissipated`. "
+             "`energy_ratio_max` is the largest (kinetic + elastic) / (their start value + `external_work`) seen so far, "
+             "at every step of the implicit schemes and at every frame of the semi-implicit one: at most 1 when the "
+             "integrator created no energy, 1.43 if it once held 43 % more than it was given (0 until anything was given). "
              "`energy_rises` counts the implicit steps so far that created energy (see `integrator.energy_rise_tolerance`), "
              "`inverted` the hexahedra and tetrahedra inverted in the frame (see `integrator.stop_on_inversion`). "
+             "`momentum_x` … `_z` (kg·m/s) and `angular_momentum_x` … `_z` (kg·m²/s, about the centre of mass) of all "
+             "particles: constant on a free body (no fixed particle, no gravity) with an integrator that keeps them. "
              "Then: `particles`, `springs`, `elements` alive; `steps` in the frame, `ms_per_step` (stepping only), "
              "`cg_iterations_mean` and `_max` per step (implicit), `cuts` applied and `faces_cut` so far, elements `refined` (pre-refinement included) and families `coarsened` so far (`refinement`).")
       .fallback(nlohmann::json::object())

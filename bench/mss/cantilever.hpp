@@ -8,11 +8,17 @@
 //                                            the run, per step, per simulated second, tip
 // The derive script (bench/mss/derive) turns the tips into errors against the extrapolated
 // reference and draws the Pareto plot.
+//
+// The hard suite (issue 17) registers the same family extended with the implicit midpoint
+// integrator and the volume term (κ = E on every hexahedron corner), under its own name:
+//   hard/cantilever/static{,_volume}/N<n>/ours
+//   hard/cantilever/N<n>/{implicit,midpoint}_h1e<k>{,_volume}/ours
 
 #include "sewn_bench.hpp"
 
 namespace sewn::bench::mss {
 
 void register_cantilever(Scale scale);
+void register_cantilever_integrators(Scale scale);
 
 }  // namespace sewn::bench::mss

@@ -48,6 +48,7 @@ Ours::Ours(const ModelSpec& spec) : impl_(std::make_unique<Impl>(spec)) { save()
 Ours::~Ours() = default;
 
 const physics::MssModel<3>& Ours::model() const { return *impl_->model; }
+physics::MssModel<3>& Ours::model() { return *impl_->model; }
 
 physics::System& Ours::system() { return impl_->sys; }
 Index Ours::node(std::uint32_t p) const { return impl_->node_of_point[p]; }

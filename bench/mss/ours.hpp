@@ -25,6 +25,7 @@ class Ours {
   [[nodiscard]] physics::System& system();
   /// The model on the map behind the system.
   [[nodiscard]] const physics::MssModel<3>& model() const;
+  [[nodiscard]] physics::MssModel<3>& model();
   /// The node of mesh point p.
   [[nodiscard]] physics::Index node(std::uint32_t p) const;
   [[nodiscard]] Counts counts() const;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <numeric>
 #include <unordered_map>
@@ -153,6 +154,7 @@ BoxSplit split_boxes(const IndexedMesh& mesh, std::span<const std::uint8_t> want
       for (std::size_t k = 1; k < 4; ++k)
         sheets.unite(sheets.id(v[edges[4 * a][0]], v[edges[4 * a][1]]), sheets.id(v[edges[4 * a + k][0]], v[edges[4 * a + k][1]]));
   }
+  std::unordered_map<std::uint32_t, std::uint32_t> asked_by;  // sheet root -> the hexahedron that set its count
   for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
     if (c >= wanted.size() || wanted[c] == 0 || mesh.types[c] != CellType::hexahedron) continue;
     ++out.asked;
@@ -164,7 +166,9 @@ BoxSplit split_boxes(const IndexedMesh& mesh, std::span<const std::uint8_t> want
       if (n > 4096)
         throw InputError(cell_name(c) + ": splitting it into near-cubes would take " + std::to_string(n) +
                          " pieces along one axis (at most 4096)");
-      std::uint32_t& count = sheets.count(sheets.id(v[edges[4 * a][0]], v[edges[4 * a][1]]));
+      const std::uint32_t sheet = sheets.id(v[edges[4 * a][0]], v[edges[4 * a][1]]);
+      std::uint32_t& count = sheets.count(sheet);
+      if (n > count) asked_by[sheets.root(sheet)] = c;
       count = std::max(count, n);
     }
   }
@@ -174,10 +178,19 @@ BoxSplit split_boxes(const IndexedMesh& mesh, std::span<const std::uint8_t> want
     const auto v = mesh.cell(c);
     for (std::size_t i = 0; i < v.size(); ++i)
       for (std::size_t j = i + 1; j < v.size(); ++j)
-        if (const std::uint32_t* e = sheets.find_edge(v[i], v[j]); e != nullptr && sheets.count(*e) > 1)
-          throw InputError(cell_name(c) + " shares the edge (" + std::to_string(v[i]) + ", " + std::to_string(v[j]) +
-                           ") with hexahedra split into near-cubes, which only hexahedra can follow; mesh the elongated "
-                           "region finer instead");
+        if (const std::uint32_t* e = sheets.find_edge(v[i], v[j]); e != nullptr && sheets.count(*e) > 1) {
+          const std::uint32_t by = asked_by.at(sheets.root(*e));
+          const std::array<double, 3> len = box_axis_lengths(mesh, by);
+          const double aspect = *std::max_element(len.begin(), len.end()) / *std::min_element(len.begin(), len.end());
+          char ratio[32];
+          std::snprintf(ratio, sizeof ratio, "%.3g:1", aspect);
+          throw InputError(cell_name(c) + " shares the edge (points " + std::to_string(v[i]) + ", " + std::to_string(v[j]) +
+                           ") with hexahedra split into near-cubes (its edge would be cut into " + std::to_string(sheets.count(*e)) +
+                           " pieces because hexahedron " + std::to_string(by) + ", " + ratio +
+                           ", is too elongated for Baudet's stiffness), and only hexahedra can follow such a split: a " +
+                           to_string(mesh.types[c]) + " would be left with a hanging point on its edge; mesh the "
+                           "elongated region finer, or use elongated = \"clamp\" there");
+        }
   }
 
   out.mesh.points = mesh.points;

@@ -304,7 +304,7 @@ TEST_CASE("a checkpoint that is not this run's, or not whole, is refused with ex
   }
   SUBCASE("another format version") {
     std::string bad = bytes;
-    bad[8] = 1;  // the format before rods and solver state
+    bad[8] = 1;  // the format before rods, solver state and the energy-ratio peak
     check_refused(saved, put("v1.checkpoint", bad), "format version 1, but this sewn reads version 2 only");
     bad[8] = 3;
     check_refused(saved, put("v3.checkpoint", bad), "format version 3, but this sewn reads version 2 only");
@@ -387,7 +387,7 @@ TEST_CASE("the checkpoint format: every field comes back, and every shorter file
   c.implicit.watchdog = {true, true, 13, 14, 15, 16};
   c.implicit.solver = {{1.5, -2.5, 3.5}, true};
   c.midpoint = {34, {true, true, 35, 36, 37, 38}};
-  c.ledger = {17, 18, 19, 20, 21, 22};
+  c.ledger = {17, 18, 19, 20, 21, 22, 41};
   sewn::physics::rods::Rods::RodHistory rod;
   rod.rod.theta = {0.1, 0.2};
   rod.rod.tangent = {{1, 0, 0}, {0, 1, 0}};
@@ -434,6 +434,7 @@ TEST_CASE("the checkpoint format: every field comes back, and every shorter file
   CHECK(d.midpoint.watchdog.peak_speed == 38);
   CHECK(d.first_energy_rise == "step 2");
   CHECK(d.wall == 32);
+  CHECK(d.ledger.peak_ratio == 39);
   for (std::size_t n = 0; n < bytes.size(); ++n) CHECK_THROWS_AS((void)sewn::app::decode_checkpoint(bytes.substr(0, n), "f"), sewn::app::CheckpointError);
   // a checksum made to match does not let a bad length through
   std::string forged = bytes;

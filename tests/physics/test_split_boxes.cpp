@@ -111,6 +111,9 @@ TEST_CASE("split boxes: a 2.5:1 block and its neighbour across a shared face spl
   mixed.add_cell(CellType::tetrahedron, {0, 1, 8, 3});
   CHECK_THROWS_WITH_AS((void)split_boxes(mixed, std::vector<std::uint8_t>{1, 0}, "mixed.msh"),
                        doctest::Contains("mixed.msh: cell 1 (tetrahedron)"), InputError);
+  // and why: which hexahedron asked, how elongated it is, how the edge would be cut
+  CHECK_THROWS_WITH_AS((void)split_boxes(mixed, std::vector<std::uint8_t>{1, 0}, "mixed.msh"),
+                       doctest::Contains("cut into 10 pieces because hexahedron 0, 10:1, is too elongated"), InputError);
 }
 
 TEST_CASE("split boxes: the cantilever's static tip at 10:1, 5:1 and 2.5:1 boxes is the cube-meshed beam's to within 10 %") {

@@ -5,6 +5,9 @@
 // 10⁶ times softer than its load inverts without the term and not with it.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -131,4 +134,94 @@ TEST_CASE("the soft/stiff column: inverted without the volume term, none with it
   CHECK(without.most_inverted > 0);
   CHECK(with.most_inverted == 0);
   CHECK(with.least_corner_ratio > 0.0);
+}
+
+namespace volume_term_test {
+
+// A 4x2x2 beam of 5 cm cubes with the volume term on, cut through at x = 0.1 (every face there
+// unsewn, so the beam falls apart in two), as the scene tool's plane cut does.
+struct CutBeam {
+  std::unique_ptr<MssModel<3>> model;
+  solids::VolumePreservation* term = nullptr;
+  Index nodes_before = 0;
+};
+
+CutBeam cut_beam() {
+  MssOptions o;
+  o.damping = DampingModel::none;
+  o.gravity = Vector3d::Zero();
+  CutBeam b;
+  b.model = std::make_unique<MssModel<3>>(hex_grid(4, 2, 2, {{0.05, 0.05, 0.05}, {}}), std::vector<MaterialParams>{{1e6, 0.3, 1000}},
+                                          std::vector<std::uint32_t>{}, o);
+  MssModel<3>& m = *b.model;
+  b.term = solids::add_volume_preservation(m, std::vector<double>{3e6});
+  b.nodes_before = m.nodes().num_alive();
+  const auto at_cut = [&](Dart d) { return std::abs(m.rest_position(m.node_of(d)).x() - 0.1) < 1e-12; };
+  m.edit([&](auto& map) {
+    for (Dart d : map.darts())
+      if (map.beta(d, 3) && at_cut(d) && at_cut(map.beta(d, 1)) && at_cut(map.beta(d, 1, 1))) map.template unsew<3>(d);
+  });
+  return b;
+}
+
+// The model elements on the side x > 0.1 of the cut.
+bool right_side(const MssModel<3>& m, Index element) { return m.element_centroid(element).x() > 0.1; }
+
+}  // namespace volume_term_test
+
+TEST_CASE("the volume term follows a cut: each stencil on its element's particles, energy and derivatives exact after it") {
+  volume_term_test::CutBeam b = volume_term_test::cut_beam();
+  MssModel<3>& m = *b.model;
+  const solids::VolumePreservation& term = *b.term;
+  // the 3x3 points of the cut plane were duplicated
+  REQUIRE(m.nodes().num_alive() == b.nodes_before + 9);
+  // no stencil refers to a node its element no longer has: each is its element's corners now,
+  // and the two pieces share no node
+  std::vector<int> side_of_node(m.nodes().size(), -1);
+  for (Index e = 0; e < term.size(); ++e) {
+    const auto& src = term.source(e);
+    REQUIRE(src.element != invalid_index);
+    const std::vector<Index> corners = m.element_nodes(src.element);
+    const int side = volume_term_test::right_side(m, src.element) ? 1 : 0;
+    for (int k = 0; k < 4; ++k) {
+      const Index n = term.element_nodes(e)[static_cast<std::size_t>(k)];
+      CHECK(n == corners[src.corners[static_cast<std::size_t>(k)]]);
+      CHECK(m.nodes().is_alive(n));
+      CHECK((side_of_node[n] == -1 || side_of_node[n] == side));
+      side_of_node[n] = side;
+    }
+  }
+  // pull the right piece 3 cm away, rigidly: no volume changed, so no energy and no force (a
+  // stencil left on the other piece's particles would be stretched across the gap)
+  for (Index i = 0; i < m.nodes().size(); ++i)
+    if (side_of_node[i] == 1) m.nodes().set_position(i, m.nodes().position(i) + Vector3d(0.03, 0, 0));
+  const StateView apart = m.nodes().state();
+  CHECK(term.potential_energy(apart) < 1e-20);
+  std::vector<double> f(3 * std::size_t{m.nodes().size()}, 0.0);
+  term.add_forces(apart, f);
+  CHECK(*std::max_element(f.begin(), f.end(), [](double p, double q) { return std::abs(p) < std::abs(q); }) == doctest::Approx(0.0));
+  // jiggled: the forces are minus the energy's gradient, the assembled Jacobian the forces'
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-0.004, 0.004);
+  for (Index i = 0; i < m.nodes().size(); ++i) m.nodes().set_position(i, m.nodes().position(i) + Vector3d(u(rng), u(rng), u(rng)));
+  std::fill(f.begin(), f.end(), 0.0);
+  term.add_forces(m.nodes().state(), f);
+  auto x = m.nodes().x();
+  double worst = 0, largest = 0;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    const double keep = x[k], d = 1e-7;
+    x[k] = keep + d;
+    const double ep = term.potential_energy(m.nodes().state());
+    x[k] = keep - d;
+    const double em = term.potential_energy(m.nodes().state());
+    x[k] = keep;
+    worst = std::max(worst, std::abs(-(ep - em) / (2 * d) - f[k]));
+    largest = std::max(largest, std::abs(f[k]));
+  }
+  CHECK(largest > 0);
+  CHECK(worst < 1e-6 * largest);
+  const JacobianOptions exact{false, false, false};
+  const Eigen::MatrixXd K = test::assembled(m.system(), 1.0, 0.0, exact);
+  const Eigen::MatrixXd K_fd = test::finite_difference(m.system(), false, 1e-7);
+  CHECK(test::max_abs(K - K_fd) < 1e-5 * test::max_abs(K_fd));
 }

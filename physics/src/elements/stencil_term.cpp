@@ -29,6 +29,7 @@ template <int N>
 Index StencilTerm<N>::push_element(const Nodes& nodes) {
   check_distinct(size(), nodes);
   nodes_.push_back(nodes);
+  alive_.push_back(1);
   touch_topology();
   return size() - 1;
 }
@@ -43,8 +44,17 @@ void StencilTerm<N>::set_element_nodes(Index e, const Nodes& nodes) {
 }
 
 template <int N>
+void StencilTerm<N>::retire_element(Index e) {
+  if (e >= size()) throw InputError(element_name(e) + ": no such element (" + std::to_string(size()) + " elements)");
+  if (alive_[e] == 0) return;
+  alive_[e] = 0;
+  touch_topology();
+}
+
+template <int N>
 void StencilTerm<N>::add_forces(const StateView& s, std::span<double> f) const {
   for (Index e = 0; e < size(); ++e) {
+    if (alive_[e] == 0) continue;
     const Gradient g = element_gradient(e, gather(s, e));
     for (int a = 0; a < N; ++a)
       for (int c = 0; c < 3; ++c) f[3 * std::size_t{nodes_[e][a]} + c] -= g[3 * a + c];
@@ -54,22 +64,23 @@ void StencilTerm<N>::add_forces(const StateView& s, std::span<double> f) const {
 template <int N>
 double StencilTerm<N>::potential_energy(const StateView& s) const {
   double sum = 0.0;
-  for (Index e = 0; e < size(); ++e) sum += element_energy(e, gather(s, e));
+  for (Index e = 0; e < size(); ++e)
+    if (alive_[e] != 0) sum += element_energy(e, gather(s, e));
   return sum;
 }
 
 template <int N>
 void StencilTerm<N>::collect_pairs(std::vector<NodePair>& out) const {
-  for (const Nodes& n : nodes_)
-    for (int a = 0; a < N; ++a)
-      for (int b = a + 1; b < N; ++b) out.push_back({n[a], n[b]});
+  for (Index e = 0; e < size(); ++e)
+    for (int a = 0; a < N && alive_[e] != 0; ++a)
+      for (int b = a + 1; b < N; ++b) out.push_back({nodes_[e][a], nodes_[e][b]});
 }
 
 template <int N>
 void StencilTerm<N>::bind_pattern(const BlockMatrix& pattern) {
-  slots_.resize(std::size_t{N} * N * nodes_.size());
+  slots_.assign(std::size_t{N} * N * nodes_.size(), invalid_index);
   for (Index e = 0; e < size(); ++e)
-    for (int a = 0; a < N; ++a)
+    for (int a = 0; a < N && alive_[e] != 0; ++a)
       for (int b = 0; b < N; ++b) slots_[(std::size_t{e} * N + a) * N + b] = pattern.find(nodes_[e][a], nodes_[e][b]);
   bound_pattern_ = pattern.pattern_version();
   bound_topology_ = topology_version();
@@ -83,6 +94,7 @@ void StencilTerm<N>::add_jacobians(const StateView& s, const JacobianRequest& re
   const bool product = !req.product_in.empty();
   if (req.cx == 0.0 && !product) return;
   for (Index e = 0; e < size(); ++e) {
+    if (alive_[e] == 0) continue;
     Hessian H = element_hessian(e, gather(s, e));
     if (req.options.project_element_hessians) project_psd(H);
     const Nodes& n = nodes_[e];
@@ -104,6 +116,7 @@ void StencilTerm<N>::add_jacobians(const StateView& s, const JacobianRequest& re
 template <int N>
 void StencilTerm<N>::add_stability_rows(const StateView& s, StabilityRows& rows) const {
   for (Index e = 0; e < size(); ++e) {
+    if (alive_[e] == 0) continue;
     Hessian H = element_hessian(e, gather(s, e));
     project_psd(H);
     const Nodes& n = nodes_[e];
@@ -119,6 +132,7 @@ template <int N>
 void StencilTerm<N>::check_nodes(const NodeTable& nodes) const {
   for (Index e = 0; e < size(); ++e)
     for (Index i : nodes_[e]) {
+      if (alive_[e] == 0) break;
       if (i >= nodes.size())
         throw InputError(element_name(e) + " refers to node " + std::to_string(i) + " but there are " +
                          std::to_string(nodes.size()) + " nodes");
@@ -128,8 +142,9 @@ void StencilTerm<N>::check_nodes(const NodeTable& nodes) const {
 
 template <int N>
 void StencilTerm<N>::remap_nodes(std::span<const Index> old_to_new) {
-  for (Nodes& n : nodes_)
-    for (Index& i : n) i = old_to_new[i];
+  // a retired element's nodes may be gone: it keeps no node at all
+  for (Index e = 0; e < size(); ++e)
+    for (Index& i : nodes_[e]) i = alive_[e] != 0 ? old_to_new[i] : invalid_index;
   touch_topology();
 }
 

@@ -1,16 +1,46 @@
 #include "sewn/physics/integrate/energy_ledger.hpp"
 
+#include <algorithm>
 #include <cmath>
+
+#include <Eigen/Geometry>
 
 namespace sewn::physics {
 
 EnergyLedger::EnergyLedger(double rise_tolerance) : tolerance_(rise_tolerance) {}
+
+Momenta momenta(const NodeTable& nodes) {
+  double mass = 0;
+  Eigen::Vector3d first = Eigen::Vector3d::Zero(), centre = Eigen::Vector3d::Zero();
+  Momenta m;
+  for (Index i = 0; i < nodes.size(); ++i) {
+    if (!nodes.is_alive(i)) continue;
+    mass += nodes.mass(i);
+    centre += nodes.mass(i) * nodes.position(i);
+    m.linear += nodes.mass(i) * nodes.velocity(i);
+    first += nodes.mass(i) * nodes.position(i).cross(nodes.velocity(i));
+  }
+  if (!(mass > 0)) return m;
+  centre /= mass;
+  // Σ m (x − c) × v = Σ m x × v − c × Σ m v
+  m.angular = first - centre.cross(m.linear);
+  return m;
+}
+
+void EnergyLedger::observe(double moving, double external) {
+  // what the start and the fields supplied: total at the start minus the external potential now
+  const double supplied = total0_ - external;
+  if (supplied > 0) peak_ratio_ = std::max(peak_ratio_, moving / supplied);
+}
+
+void EnergyLedger::observe(const EnergyBalance& b) { observe(b.kinetic + b.elastic, b.external_potential); }
 
 void EnergyLedger::start(const System& sys) {
   rebase(sys);
   total0_ = last_total_;
   external0_ = last_external_;
   rises_ = 0;
+  peak_ratio_ = 0;
 }
 
 void EnergyLedger::restore(const State& s) {
@@ -20,6 +50,7 @@ void EnergyLedger::restore(const State& s) {
   last_moving_ = s.last_moving;
   last_external_ = s.last_external;
   rises_ = s.rises;
+  peak_ratio_ = s.peak_ratio;
 }
 
 void EnergyLedger::rebase(const System& sys) {
@@ -36,6 +67,7 @@ std::optional<EnergyRise> EnergyLedger::after_step(const System& sys, std::uint6
   last_total_ = total;
   last_moving_ = moving;
   last_external_ = external;
+  observe(moving, external);
   // `!(a <= b)`: a NaN energy is a rise too
   if (!(r.after - r.before <= tolerance_ * r.moved + 1e-12 * sys.energy_scale())) {
     ++rises_;

@@ -20,9 +20,31 @@ double norm2(std::span<const double> a) {
   return std::sqrt(s);
 }
 
+// Calls f(springs, s, 3·node_i, 3·node_j) for every live spring of every springs term of sys.
+template <class F>
+void for_each_spring(const System& sys, F&& f) {
+  for (const auto& t : sys.terms()) {
+    const auto* springs = dynamic_cast<const Springs*>(t.get());
+    if (!springs) continue;
+    for (Index s = 0; s < springs->size(); ++s)
+      if (springs->is_alive(s)) f(*springs, s, 3 * std::size_t{springs->node_i(s)}, 3 * std::size_t{springs->node_j(s)});
+  }
+}
+
 }  // namespace
 
 ImplicitMidpoint::ImplicitMidpoint(ImplicitMidpointOptions options) : opt_(options) {}
+
+double ImplicitMidpoint::roundoff_estimate(const System& sys, std::span<const double> x, double h) {
+  double sum = 0;
+  for_each_spring(sys, [&](const Springs& springs, Index s, std::size_t i, std::size_t j) {
+    const double xi = std::max({std::abs(x[i]), std::abs(x[i + 1]), std::abs(x[i + 2])});
+    const double xj = std::max({std::abs(x[j]), std::abs(x[j + 1]), std::abs(x[j + 2])});
+    const double e = springs.stiffness(s) * (xi + xj);
+    sum += e * e;
+  });
+  return h * std::numeric_limits<double>::epsilon() * std::sqrt(sum);
+}
 
 CgResult ImplicitMidpoint::solve(const BlockMatrix& A, std::span<const double> b, std::span<double> x) {
   block_jacobi_inverse(A, free_, precond_);
@@ -33,32 +55,26 @@ void ImplicitMidpoint::discrete_gradient(System& sys, double h) const {
   NodeTable& nodes = sys.nodes();
   const auto xm = nodes.x();  // the midpoint state
   const auto f = nodes.f();
-  for (const auto& t : sys.terms()) {
-    const auto* springs = dynamic_cast<const Springs*>(t.get());
-    if (!springs) continue;
-    for (Index s = 0; s < springs->size(); ++s) {
-      if (!springs->is_alive(s)) continue;
-      const std::size_t i = 3 * std::size_t{springs->node_i(s)}, j = 3 * std::size_t{springs->node_j(s)};
-      const double k = springs->stiffness(s), l = springs->rest_length(s);
-      double dm2 = 0, d02 = 0, d12 = 0, e[3];
-      for (int a = 0; a < 3; ++a) {
-        e[a] = xm[j + a] - xm[i + a];
-        const double e0 = x0_[j + a] - x0_[i + a];
-        const double e1 = e0 + h * (v0_[j + a] - v0_[i + a] + 0.5 * (dv_[j + a] - dv_[i + a]));
-        dm2 += e[a] * e[a];
-        d02 += e0 * e0;
-        d12 += e1 * e1;
-      }
-      const double dm = std::sqrt(dm2), d0 = std::sqrt(d02), d1 = std::sqrt(d12);
-      if (!(dm > 0 && d0 + d1 > 0)) continue;  // a spring of zero length has no direction either way
-      // (ψ(d₁) − ψ(d₀)) / ((d₁² − d₀²)/2) for ψ = ½k(d − l)², minus the midpoint's own k(1 − l/d̄)
-      const double c = k * (1 - 2 * l / (d0 + d1)) - k * (1 - l / dm);
-      for (int a = 0; a < 3; ++a) {
-        f[i + a] += c * e[a];
-        f[j + a] -= c * e[a];
-      }
+  for_each_spring(sys, [&](const Springs& springs, Index s, std::size_t i, std::size_t j) {
+    const double k = springs.stiffness(s), l = springs.rest_length(s);
+    double dm2 = 0, d02 = 0, d12 = 0, e[3];
+    for (std::size_t a = 0; a < 3; ++a) {
+      e[a] = xm[j + a] - xm[i + a];
+      const double e0 = x0_[j + a] - x0_[i + a];
+      const double e1 = e0 + h * (v0_[j + a] - v0_[i + a] + 0.5 * (dv_[j + a] - dv_[i + a]));
+      dm2 += e[a] * e[a];
+      d02 += e0 * e0;
+      d12 += e1 * e1;
     }
-  }
+    const double dm = std::sqrt(dm2), d0 = std::sqrt(d02), d1 = std::sqrt(d12);
+    if (!(dm > 0 && d0 + d1 > 0)) return;  // a spring of zero length has no direction either way
+    // (ψ(d₁) − ψ(d₀)) / ((d₁² − d₀²)/2) for ψ = ½k(d − l)², minus the midpoint's own k(1 − l/d̄)
+    const double c = k * (1 - 2 * l / (d0 + d1)) - k * (1 - l / dm);
+    for (std::size_t a = 0; a < 3; ++a) {
+      f[i + a] += c * e[a];
+      f[j + a] -= c * e[a];
+    }
+  });
 }
 
 void ImplicitMidpoint::restore(NodeTable& nodes) const {
@@ -69,8 +85,9 @@ void ImplicitMidpoint::restore(NodeTable& nodes) const {
 StepReport ImplicitMidpoint::step(System& sys, double h) {
   if (!(std::isfinite(h) && h > 0)) throw InputError("ImplicitMidpoint::step: time step must be finite and > 0, got " + detail::format_number(h));
   if (!(opt_.newton_tolerance > 0 && opt_.cg_tolerance > 0 && opt_.max_newton_iterations >= 1 && opt_.cg_max_iterations >= 1 &&
-        opt_.max_step_halvings >= 0 && opt_.max_step_halvings <= 20))
-    throw InputError("ImplicitMidpoint::step: tolerances must be > 0, iteration limits >= 1 and max_step_halvings in [0, 20]");
+        opt_.max_step_halvings >= 0 && opt_.max_step_halvings <= 20 && opt_.roundoff_factor >= 0 && std::isfinite(opt_.roundoff_factor)))
+    throw InputError("ImplicitMidpoint::step: tolerances must be > 0, iteration limits >= 1, max_step_halvings in [0, 20] and "
+                     "roundoff_factor finite and >= 0");
   detail::require_symmetric_jacobians(sys, opt_.jacobian, "ImplicitMidpoint::step");
   sys.require_no_angles("ImplicitMidpoint::step");
   StepReport rep;
@@ -87,6 +104,7 @@ StepReport ImplicitMidpoint::step(System& sys, double h) {
   substeps_ = 0;
   finest_ = 0;
   newton_iterations_ = 0;
+  residual_over_roundoff_ = 0;
   if (!advance(sys, h, 0, rep)) {
     std::copy(x_start_.begin(), x_start_.end(), nodes.x().begin());
     std::copy(v_start_.begin(), v_start_.end(), nodes.v().begin());
@@ -129,6 +147,8 @@ bool ImplicitMidpoint::attempt(System& sys, double h, StepReport& rep) {
   for (std::size_t k = 0; k < n3; ++k) momentum += (mass[k / 3] * v0_[k]) * (mass[k / 3] * v0_[k]);
   momentum = std::sqrt(momentum);
   std::fill(dv_.begin(), dv_.end(), 0.0);
+  // the positions move little within a step: the estimate at its start stands for all of it
+  const double roundoff = roundoff_estimate(sys, x0_, h);
 
   int iterations = 0;
   double residual = 0, scale = 0;
@@ -164,13 +184,17 @@ bool ImplicitMidpoint::attempt(System& sys, double h, StepReport& rep) {
     scale = momentum + std::sqrt(mdv) + std::sqrt(hf);
     if (residual <= opt_.newton_tolerance * scale) break;
     // Round-off floor: the residual sums forces that each carry their own rounding, so below
-    // some level a Newton step no longer shrinks it. Accept that level if it is small.
-    if (iterations > 0 && residual > 0.5 * previous && residual <= opt_.stagnation_tolerance * scale) break;
+    // some level a Newton step no longer shrinks it. Accept that level if it is small against
+    // the momentum in play or near what round-off allows (a stiff body near rest).
+    if (iterations > 0 && residual > 0.5 * previous &&
+        residual <= std::max(opt_.stagnation_tolerance * scale, opt_.roundoff_factor * roundoff))
+      break;
     if (iterations == opt_.max_newton_iterations) {
       restore(nodes);
       failure_ = "Newton stopped after " + std::to_string(iterations) + " iterations at residual " + detail::format_number(residual) +
                  " (" + detail::format_number(residual / scale) + " of the momentum and impulse in play, tolerance " +
-                 detail::format_number(opt_.newton_tolerance) + ")";
+                 detail::format_number(opt_.newton_tolerance) + "; " + detail::format_number(residual / roundoff) +
+                 " times the springs' round-off estimate)";
       failure_residual_ = residual / scale;
       return false;
     }
@@ -216,6 +240,7 @@ bool ImplicitMidpoint::attempt(System& sys, double h, StepReport& rep) {
   }
   if (finite) nodes.mark_state_finite();
   rep.cg_converged = true;
+  if (roundoff > 0) residual_over_roundoff_ = std::max(residual_over_roundoff_, residual / roundoff);
   ++steps_;
   if (watch && finite)
     if (auto blowup = watchdog_.after_step(sys, opt_.health, steps_, max_speed)) {

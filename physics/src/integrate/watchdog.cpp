@@ -18,6 +18,7 @@ bool EnergyWatchdog::baseline_if_needed(const System& sys) {
   if (has_baseline_ && v == version_) return false;
   internal0_ = sys.kinetic_energy() + sys.potential_energy(EnergyKind::internal);
   external0_ = sys.potential_energy(EnergyKind::external);
+  scale_ = sys.energy_scale();
   speed_at_check_ = max_abs_component(sys.nodes().v());
   peak_speed_ = 0;
   version_ = v;
@@ -33,6 +34,7 @@ void EnergyWatchdog::restore(const System& sys, const State& s) {
   has_baseline_ = s.has_baseline;
   // a stale baseline must be retaken at the next step, as it would have been
   version_ = s.baseline_current ? sys.version() : sys.version() + 1;
+  scale_ = sys.energy_scale();
   internal0_ = s.internal0;
   external0_ = s.external0;
   speed_at_check_ = s.speed_at_check;
@@ -59,7 +61,8 @@ std::optional<EnergyBlowup> EnergyWatchdog::check(const System& sys, const Healt
   const double internal = sys.kinetic_energy() + sys.potential_energy(EnergyKind::internal);
   const double work = external0_ - sys.potential_energy(EnergyKind::external);
   const double budget = internal0_ + std::max(0.0, work);
-  const double floor = opt.energy_floor_fraction * sys.energy_scale();
+  // the scale is the baseline's unless the system changed since (a check without a baseline step)
+  const double floor = opt.energy_floor_fraction * (version_ == sys.version() ? scale_ : sys.energy_scale());
   if (internal <= opt.energy_growth_factor * budget + floor) return std::nullopt;
   const NodeTable& nodes = sys.nodes();
   Index fastest = invalid_index;

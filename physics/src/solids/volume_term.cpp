@@ -89,7 +89,29 @@ Index VolumePreservation::add(const std::array<Index, 4>& nodes, const CornerPos
                      physics::detail::format_number(longest) + " m)");
   const Index e_index = push_element(nodes);
   rest_.push_back({det, kappa * weight});
+  source_.emplace_back();
   return e_index;
+}
+
+void VolumePreservation::follow(const MssModel<3>& model) {
+  Index last = invalid_index;
+  std::vector<Index> corners;
+  for (Index e = 0; e < size(); ++e) {
+    const Source& src = source_[e];
+    if (src.element == invalid_index || !is_alive(e)) continue;
+    if (src.element >= model.elements().size())
+      throw InputError(std::string(name()) + " element " + std::to_string(e) + ": its model element " + std::to_string(src.element) +
+                       " does not exist (" + std::to_string(model.elements().size()) + " elements)");
+    if (!model.elements()[src.element].alive) {
+      retire_element(e);  // the material is gone (pierced away): nothing left to keep
+      continue;
+    }
+    if (src.element != last) {  // a hexahedron's 8 stencils are consecutive: one read for them
+      corners = model.element_nodes(src.element);
+      last = src.element;
+    }
+    set_element_nodes(e, {corners[src.corners[0]], corners[src.corners[1]], corners[src.corners[2]], corners[src.corners[3]]});
+  }
 }
 
 VolumePreservation* add_volume_preservation(MssModel<3>& model, std::span<const double> kappa_of_material) {
@@ -105,25 +127,29 @@ VolumePreservation* add_volume_preservation(MssModel<3>& model, std::span<const 
   }
   if (!any) return nullptr;
   auto& term = model.system().add<VolumePreservation>();
-  const auto add_corner = [&](const std::vector<Index>& v, std::size_t o, std::size_t a, std::size_t b, std::size_t c,
+  Index element = 0;
+  const auto add_corner = [&](const std::vector<Index>& v, std::uint8_t o, std::uint8_t a, std::uint8_t b, std::uint8_t c,
                               double kappa, double weight) {
     CornerPositions X;
     const std::array<Index, 4> nodes{v[o], v[a], v[b], v[c]};
     for (int k = 0; k < 4; ++k) X.col(k) = model.rest_position(nodes[k]);
-    term.add(nodes, X, kappa, weight);
+    term.set_source(term.add(nodes, X, kappa, weight), {element, {o, a, b, c}});
   };
   for (Index e = 0; e < model.elements().size(); ++e) {
     const Element& el = model.elements()[e];
     const double kappa = kappa_of_material[el.material];
     if (!el.alive || kappa == 0.0) continue;
+    element = e;
     if (el.kind == ElementKind::tetrahedron) {
       add_corner(model.element_nodes(e), 0, 1, 2, 3, kappa, el.measure);
     } else if (el.kind == ElementKind::hexahedron) {
       const std::vector<Index> v = model.element_nodes(e);
-      for (std::size_t c = 0; c < 8; ++c)
+      for (std::uint8_t c = 0; c < 8; ++c)
         add_corner(v, c, detail::hex_corners[c][0], detail::hex_corners[c][1], detail::hex_corners[c][2], kappa, el.measure / 8);
     }
   }
+  // a cut duplicates particles: each stencil then takes its element's copies
+  model.after_edits([&model, &term] { term.follow(model); });
   return &term;
 }
 

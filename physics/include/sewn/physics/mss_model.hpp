@@ -152,18 +152,27 @@ class MssModel {
       if constexpr (std::is_void_v<std::invoke_result_t<F, Map&>>) {
         f(map_);
         resync();
+        notify_edited();
       } else {
         decltype(auto) result = f(map_);
         resync();
+        notify_edited();
         return result;
       }
     } catch (...) {
       // a failed map operation leaves the map unchanged, but earlier ones in f may have fired
       // hooks: bring the physics in line with whatever the map now is
       resync();
+      notify_edited();
       throw;
     }
   }
+
+  /// Registers f, called after every edit() once the springs and masses are in line again:
+  /// terms built over the elements (the volume term) re-read their corner particles there, so
+  /// that a cut which duplicated a particle hands each element its own copy. f must outlive
+  /// the model's edits (terms of the model's own System do). O(1).
+  void after_edits(std::function<void()> f) { edit_listeners_.push_back(std::move(f)); }
 
   /// The node of mesh point p, as built (before any cut): invalid_index for unused points.
   [[nodiscard]] Index node_of_point(std::uint32_t p) const { return p < node_of_point_.size() ? node_of_point_[p] : invalid_index; }
@@ -254,6 +263,10 @@ class MssModel {
   std::vector<std::uint32_t> seen_edge_, seen_element_, seen_node_, seen_spring_;
   std::string unsupported_;  // an edit the model cannot follow (element merge), reported by resync
   bool refining_ = false;    // element splits and merges are refinement and coarsening, which set up the elements
+  std::vector<std::function<void()>> edit_listeners_;  // see after_edits()
+  void notify_edited() {
+    for (const auto& f : edit_listeners_) f();
+  }
 
   friend struct refine::detail::ModelAccess<D>;
 };

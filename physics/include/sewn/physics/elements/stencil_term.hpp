@@ -41,6 +41,11 @@ class StencilTerm : public ForceTerm {
   /// particle hands the element its copy. Throws InputError (naming the element, unchanged) if
   /// e is out of range or a node repeats. O(1); the Jacobian pattern is rebuilt when next needed.
   void set_element_nodes(Index e, const Nodes& nodes);
+  /// Takes element e out of the term for good (the model element it stood for was removed):
+  /// no energy, force or Jacobian, and its nodes may be removed. O(1).
+  void retire_element(Index e);
+  /// False once retire_element(e) was called.
+  [[nodiscard]] bool is_alive(Index e) const { return alive_[e] != 0; }
 
   void add_forces(const StateView& s, std::span<double> f) const override;
   [[nodiscard]] double potential_energy(const StateView& s) const override;
@@ -66,6 +71,7 @@ class StencilTerm : public ForceTerm {
   void check_distinct(Index e, const Nodes& nodes) const;
 
   std::vector<Nodes> nodes_;
+  std::vector<std::uint8_t> alive_;  // per element: 0 once retired
   std::vector<Index> slots_;  // N² per element, row-major (a, b)
   std::uint64_t bound_pattern_ = ~std::uint64_t{0};
   std::uint64_t bound_topology_ = ~std::uint64_t{0};

@@ -25,6 +25,13 @@ struct EnergyBalance {
   double external_work = 0, dissipated = 0;
 };
 
+/// Linear momentum Σ m v and angular momentum Σ m (x − c) × v about the centre of mass c of the
+/// live nodes: both are constant on a free body under central forces. O(n).
+struct Momenta {
+  Eigen::Vector3d linear = Eigen::Vector3d::Zero(), angular = Eigen::Vector3d::Zero();
+};
+[[nodiscard]] Momenta momenta(const NodeTable& nodes);
+
 /// One step that created energy.
 struct EnergyRise {
   std::uint64_t step = 0;
@@ -49,13 +56,23 @@ class EnergyLedger {
   [[nodiscard]] EnergyBalance balance(const System& sys) const;
   /// Number of steps reported so far.
   [[nodiscard]] std::uint64_t rises() const { return rises_; }
+  /// Takes the balance now into peak_ratio() (after_step does at every step it sees). O(1).
+  void observe(const EnergyBalance& b);
+  /// The largest ratio seen so far of kinetic + elastic energy to what the start and the external
+  /// fields supplied (kinetic + elastic at the start + external work): at most 1 for a scheme
+  /// that creates no energy (damping lowers it), above 1 by what the integrator created. 0 until
+  /// anything was supplied.
+  [[nodiscard]] double peak_ratio() const { return peak_ratio_; }
 
   /// Everything the ledger holds, for a checkpoint (restore continues from it exactly).
   struct State {
     double total0 = 0, external0 = 0, last_total = 0, last_moving = 0, last_external = 0;
     std::uint64_t rises = 0;
+    double peak_ratio = 0;
   };
-  [[nodiscard]] State state() const { return {total0_, external0_, last_total_, last_moving_, last_external_, rises_}; }
+  [[nodiscard]] State state() const {
+    return {total0_, external0_, last_total_, last_moving_, last_external_, rises_, peak_ratio_};
+  }
   void restore(const State& s);
 
  private:
@@ -63,6 +80,9 @@ class EnergyLedger {
   double total0_ = 0, external0_ = 0;
   double last_total_ = 0, last_moving_ = 0, last_external_ = 0;
   std::uint64_t rises_ = 0;
+  double peak_ratio_ = 0;
+  // kinetic + elastic over (their start value + external work), with the external potential now
+  void observe(double moving, double external);
 };
 
 }  // namespace sewn::physics

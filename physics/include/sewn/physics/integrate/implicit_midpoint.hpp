@@ -22,6 +22,7 @@
 // (ImplicitMidpointOptions::max_step_halvings). Fixed axes keep their velocity.
 
 #include <cstdint>
+#include <span>
 #include <string>
 
 #include "sewn/physics/aligned.hpp"
@@ -37,8 +38,16 @@ struct ImplicitMidpointOptions {
   /// changes per step are then below this fraction of the momentum and impulses in play.
   double newton_tolerance = 1e-13;
   /// Newton also stops when a step no longer halves the residual (round-off) and it is below
-  /// stagnation_tolerance · that scale; above it that is a SolverError.
+  /// stagnation_tolerance · that scale or roundoff_factor · the residual's round-off estimate
+  /// (see roundoff_estimate()); above both that is a failed attempt.
   double stagnation_tolerance = 1e-10;
+  /// How far above the springs' round-off estimate a stagnating residual is still accepted. The
+  /// scale above is momentum and impulse, which a stiff body near rest barely has, while the
+  /// round-off of its forces grows with E: on the 20×2×2 cantilever at E ≥ 1 GPa the residual
+  /// stagnated at 2e-10 … 4e-8 of that scale and every step was refused. Measured there (E = 1 to
+  /// 100 GPa, h = 1 and 10 ms, tests/physics/test_spin.cpp): Newton's last residual is 0.02 to
+  /// 0.06 of the estimate, which is a bound more than an expectation; 1 leaves 16× of margin.
+  double roundoff_factor = 1.0;
   int max_newton_iterations = 30;
   /// When Newton (or a CG solve in it) fails, the step is retried as two half steps, each of
   /// which may be halved again, up to this many times (2^max_step_halvings sub-steps). Each
@@ -79,6 +88,14 @@ class ImplicitMidpoint {
   /// finest sub-step was halved.
   [[nodiscard]] int last_substeps() const { return substeps_; }
   [[nodiscard]] int last_halvings() const { return finest_; }
+  /// The largest ratio, over the last step's sub-steps, of Newton's final residual to the
+  /// round-off estimate (how close to round-off Newton went).
+  [[nodiscard]] double last_residual_over_roundoff() const { return residual_over_roundoff_; }
+  /// What round-off alone leaves in the residual h F(x̄) − M Δv at positions x, for step h:
+  /// h ε √(Σ_springs (k (‖x_i‖∞ + ‖x_j‖∞))²), each spring's force k(1 − l/d)(x_j − x_i) carrying
+  /// an error of about k ε ‖x‖ from the rounding of the positions it subtracts (it grows with the
+  /// coordinates, not with the spring's length or stretch). Springs only. O(springs).
+  [[nodiscard]] static double roundoff_estimate(const System& sys, std::span<const double> x, double h);
   [[nodiscard]] ImplicitMidpointOptions& options() { return opt_; }
   /// Forgets the energy baseline.
   void reset() { watchdog_.reset(); }
@@ -115,6 +132,7 @@ class ImplicitMidpoint {
   int substeps_ = 0, finest_ = 0;
   std::string failure_;  // why the last failed attempt failed
   double failure_residual_ = 0.0;
+  double residual_over_roundoff_ = 0.0;
   EnergyWatchdog watchdog_;
 };
 

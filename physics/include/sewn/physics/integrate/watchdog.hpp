@@ -69,6 +69,7 @@ class EnergyWatchdog {
  private:
   bool has_baseline_ = false;
   double internal0_ = 0, external0_ = 0;
+  double scale_ = 0;  // System::energy_scale() at the baseline: it changes only with the version
   double speed_at_check_ = 0;  // the largest speed up to the last check
   double peak_speed_ = 0;      // the largest speed since
   std::uint64_t version_ = 0;

@@ -17,6 +17,7 @@
 // Cost: energy ~30 flops, gradient ~50, Hessian ~400 per stencil; a hexahedron is 8 stencils.
 
 #include <array>
+#include <cstdint>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -53,20 +54,35 @@ class VolumePreservation final : public elements::StencilTerm<4> {
   Index add(const std::array<Index, 4>& nodes, const CornerPositions& X, double kappa, double weight);
   [[nodiscard]] const VolumeStencil& stencil(Index e) const { return rest_[e]; }
 
+  /// Where stencil e's nodes come from: a model element and the local corners (VTK order) of
+  /// its o, a, b, c. Set by add_volume_preservation; stencils added by hand have none.
+  struct Source {
+    Index element = invalid_index;
+    std::array<std::uint8_t, 4> corners{};
+  };
+  void set_source(Index e, const Source& s) { source_[e] = s; }
+  [[nodiscard]] const Source& source(Index e) const { return source_[e]; }
+  /// Re-reads every sourced stencil's nodes from the model's element corners, as they are after
+  /// an edit (a cut hands an element the copy of a duplicated particle), and retires the
+  /// stencils of removed elements. Elements added later (refinement's children) get none.
+  /// O(elements).
+  void follow(const MssModel<3>& model);
+
   [[nodiscard]] double element_energy(Index e, const Positions& x) const override { return volume_energy(x, rest_[e]); }
   [[nodiscard]] Gradient element_gradient(Index e, const Positions& x) const override { return volume_gradient(x, rest_[e]); }
   [[nodiscard]] Hessian element_hessian(Index e, const Positions& x) const override { return volume_hessian(x, rest_[e]); }
 
  private:
   std::vector<VolumeStencil> rest_;
+  std::vector<Source> source_;
 };
 
 /// Adds a VolumePreservation term over the live hexahedra and tetrahedra of `model`, each with
 /// its material's bulk stiffness kappa_of_material[m] (0: that material gets none). Returns the
 /// term, or nullptr when no element has a stiffness. Throws InputError on a negative or
 /// non-finite stiffness (naming the material) or a size that does not match the materials.
-/// The term follows the model as built: after a cut its stencils refer to the nodes of before.
-/// O(elements).
+/// The term follows the model's edits (MssModel::after_edits calls follow()): after a cut each
+/// stencil uses its element's corner particles as they are then. O(elements).
 VolumePreservation* add_volume_preservation(MssModel<3>& model, std::span<const double> kappa_of_material);
 
 }  // namespace sewn::physics::solids
