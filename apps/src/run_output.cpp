@@ -1,0 +1,93 @@
+#include "run_output.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
+#include "sewn/refine/hierarchy.hpp"
+
+namespace sewn::app::detail {
+
+namespace {
+
+using physics::ElementKind;
+using physics::Index;
+using Vec3d = Eigen::Vector3d;
+
+CellType cell_type(ElementKind k) {
+  switch (k) {
+    case ElementKind::hexahedron: return CellType::hexahedron;
+    case ElementKind::tetrahedron: return CellType::tetrahedron;
+    case ElementKind::quad: return CellType::quad;
+    case ElementKind::triangle: return CellType::triangle;
+    case ElementKind::segment: return CellType::segment;
+  }
+  return CellType::segment;
+}
+
+}  // namespace
+
+void Snapshot::take(const physics::MssModel<3>& m) {
+  *this = Snapshot{};
+  const auto& n = m.nodes();
+  for (Index i = 0; i < n.size(); ++i) {
+    // a slot a coarsening emptied keeps its place (cells index points by slot), inert at rest
+    const bool alive = n.is_alive(i);
+    const Vec3d x = alive ? n.position(i) : m.rest_position(i), v = alive ? n.velocity(i) : Vec3d::Zero(),
+                f = alive ? n.force(i) : Vec3d::Zero(), u = x - m.rest_position(i);
+    points.push_back({x.x(), x.y(), x.z()});
+    velocity.push_back({v.x(), v.y(), v.z()});
+    force.push_back({f.x(), f.y(), f.z()});
+    displacement.push_back({u.x(), u.y(), u.z()});
+    speed.push_back(v.norm());
+    force_norm.push_back(f.norm());
+    displacement_norm.push_back(u.norm());
+    fixed.push_back(alive ? n.fixed(i) : physics::no_axes);
+    fixed_scalar.push_back(alive && n.fixed(i) ? 1.0 : 0.0);
+    material_scalar.push_back(0.0);
+    level_scalar.push_back(1.0);  // a root's level index; points of no live element keep it
+  }
+  for (Index e = 0; e < m.elements().size(); ++e) {
+    const auto& el = m.elements()[e];
+    if (!el.alive) continue;
+    types.push_back(cell_type(el.kind));
+    const int index = refine::level_index(el.level);
+    for (Index q : m.element_nodes(e)) {
+      conn.push_back(q);
+      material_scalar[q] = el.material;
+      level_scalar[q] = std::max(level_scalar[q], static_cast<double>(index));
+    }
+    offsets.push_back(static_cast<std::uint32_t>(conn.size()));
+    material.push_back(static_cast<std::int32_t>(el.material));
+    level.push_back(index);
+    mesh_cell.push_back(static_cast<std::int32_t>(el.mesh_cell));
+    element.push_back(e);
+  }
+}
+
+void prepare_output(const std::filesystem::path& dir) {
+  for (const auto& part : dir)
+    if (part.native().size() > 255)
+      throw OutputPathError(dir, "a folder name of " + std::to_string(part.native().size()) +
+                                     " bytes is longer than file systems allow (255)");
+  std::error_code ec;
+  const auto status = std::filesystem::status(dir, ec);
+  if (std::filesystem::exists(status) && !std::filesystem::is_directory(status))
+    throw OutputPathError(dir, "exists and is not a folder");
+  std::filesystem::create_directories(dir, ec);
+  if (ec == std::errc::not_a_directory || ec == std::errc::file_exists || ec == std::errc::filename_too_long)
+    throw OutputPathError(dir, "cannot be created: " + ec.message());
+  if (ec) throw OutputError(dir, "cannot be created: " + ec.message());
+  if (::access(dir.c_str(), W_OK | X_OK) != 0) throw OutputError(dir, std::string("cannot be written: ") + std::strerror(errno));
+}
+
+std::string frame_file(std::uint32_t frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%05u.vtu", frame);
+  return name;
+}
+
+}  // namespace sewn::app::detail

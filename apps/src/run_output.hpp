@@ -1,0 +1,49 @@
+#pragma once
+// The runner's output side: the model's state as a mesh of its live elements, the output folder
+// checked before any work, and the frame files' names.
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "sewn/apps/runner.hpp"
+#include "sewn/io/write.hpp"
+#include "sewn/physics/mss_model.hpp"
+
+namespace sewn::app::detail {
+
+// The current state as a mesh of the live elements, for writing and drawing.
+struct Snapshot {
+  std::vector<Point3> points, velocity, force, displacement;
+  std::vector<double> speed, force_norm, displacement_norm, fixed_scalar, material_scalar, level_scalar;
+  std::vector<std::uint8_t> fixed;
+  std::vector<CellType> types;
+  std::vector<std::uint32_t> offsets{0}, conn;
+  std::vector<std::int32_t> material, level, mesh_cell;
+  std::vector<physics::Index> element;  // per output cell, its element
+
+  /// Fills every field from the model's live nodes and elements. O(nodes + elements).
+  void take(const physics::MssModel<3>& m);
+  [[nodiscard]] io::CellsView cells() const { return {types, offsets, conn}; }
+};
+
+// Makes `dir` the output folder, refusing what cannot be one (OutputPathError, bad input) and
+// what cannot be written (OutputError), before any work is done.
+void prepare_output(const std::filesystem::path& dir);
+
+// Runs one write, turning a file error into the run's OutputError (exit 1) rather than the
+// bad-input error a mesh file's FileError means.
+template <class F>
+void writing(F&& write) {
+  try {
+    write();
+  } catch (const io::FileError& e) {
+    throw OutputError(e.file(), e.reason());
+  }
+}
+
+/// frame_00042.vtu for frame 42.
+std::string frame_file(std::uint32_t frame);
+
+}  // namespace sewn::app::detail
