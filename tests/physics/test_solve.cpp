@@ -126,6 +126,29 @@ void random_spd(BlockMatrix& A, Index n, unsigned seed, double diagonal_shift = 
   }
 }
 
+// cholmod-pcg told to refresh its factor once CG needs more than 3 iterations, on a random SPD
+// matrix of 300 blocks (seed, seed + 1 for the problem): the setting of the refresh tests.
+struct RefreshingPcg {
+  BlockMatrix A;
+  Problem p;
+  solve::SolverOptions options;
+
+  RefreshingPcg(unsigned seed, double fixed_fraction) {
+    random_spd(A, 300, seed);
+    p = random_problem(A, nullptr, fixed_fraction, seed + 1);
+    options.absolute_tolerance = 0;
+    options.tolerance = 1e-10;
+    options.refresh_iterations = 3;
+  }
+  // A solver that has solved the system once, factoring A (checked).
+  auto solved_once() const {
+    auto s = solve::make_solver(solve::Backend::cholmod_pcg, options);
+    std::vector<double> x = p.x0;
+    REQUIRE(s->solve(A, p.b, x, p.free_dof).factorizations == 1);
+    return s;
+  }
+};
+
 // The SOFA comparison's beam (891 particles), clamped at its base.
 std::unique_ptr<MssModel<3>> beam_8x8x10() {
   const double a = 0.0125;
@@ -272,16 +295,11 @@ TEST_CASE("a reused factorization is refreshed when the matrix changes, and the 
 
 TEST_CASE("cholmod-pcg refreshes its factorization once the iteration count grows") {
   if (!solve::available(solve::Backend::cholmod_pcg)) return;
-  BlockMatrix A;
-  random_spd(A, 300, 21);
-  const Problem p = random_problem(A, nullptr, 0.0, 22);
-  solve::SolverOptions o;
-  o.absolute_tolerance = 0;
-  o.tolerance = 1e-10;
-  o.refresh_iterations = 3;
-  auto s = solve::make_solver(solve::Backend::cholmod_pcg, o);
-  std::vector<double> x = p.x0;
-  CHECK(s->solve(A, p.b, x, p.free_dof).factorizations == 1);
+  RefreshingPcg f(21, 0.0);
+  BlockMatrix& A = f.A;
+  const Problem& p = f.p;
+  const solve::SolverOptions& o = f.options;
+  auto s = f.solved_once();
   // Change A's values in place (same pattern): the kept factor now preconditions a matrix far
   // from the one it factored, so CG needs more than 3 iterations and the factor goes stale.
   for (Index i = 0; i < A.size(); ++i) A.block(A.diagonal(i)).diagonal().array() *= 30.0;
@@ -397,16 +415,11 @@ TEST_CASE("issue 17: one CG iteration limit, large enough for the N = 16 cantile
 
 TEST_CASE("cholmod-pcg's state taken up by a fresh solver gives the same iterates, bit for bit") {
   if (!solve::available(solve::Backend::cholmod_pcg)) return;
-  BlockMatrix A;
-  random_spd(A, 300, 31);
-  const Problem p = random_problem(A, nullptr, 0.1, 32);
-  solve::SolverOptions o;
-  o.absolute_tolerance = 0;
-  o.tolerance = 1e-10;
-  o.refresh_iterations = 3;
-  auto kept = solve::make_solver(solve::Backend::cholmod_pcg, o);
-  std::vector<double> x = p.x0;
-  REQUIRE(kept->solve(A, p.b, x, p.free_dof).factorizations == 1);
+  RefreshingPcg f(31, 0.1);
+  BlockMatrix& A = f.A;
+  const Problem& p = f.p;
+  const solve::SolverOptions& o = f.options;
+  auto kept = f.solved_once();
   // the values move on: the kept factor is of an earlier matrix now
   for (Index i = 0; i < A.size(); ++i) A.block(A.diagonal(i)).diagonal().array() *= 1.5;
   const solve::SolverState state = kept->state();
