@@ -471,10 +471,7 @@ class CMap {
   template <int I = 0>
     requires(I == 0 && has_attribute<0>)
   Dart insert_vertex_in_edge(Dart d, attribute_type<I> v) {
-    detail::DartBuffer<32> made;
-    const Dart nd = split_edge(d, made);
-    give_new_vertex<I>(made, nd, std::move(v));
-    return nd;
+    return with_new_vertex<I>(&CMap::split_edge, d, std::move(v));
   }
   /// True if insert_edge_in_face(a, b) may be called: a ≠ b, both live, b on a's closed β1 cycle.
   [[nodiscard]] bool is_insertable_edge_in_face(Dart a, Dart b) const;
@@ -525,10 +522,7 @@ class CMap {
   template <int I = 0>
     requires(I == 0 && has_attribute<0>)
   Dart insert_vertex_in_face(Dart d, attribute_type<I> v) {
-    detail::DartBuffer<32> centre;
-    const Dart w = star_face(d, centre);
-    give_new_vertex<I>(centre, w, std::move(v));
-    return w;
+    return with_new_vertex<I>(&CMap::star_face, d, std::move(v));
   }
 
   /// True if insert_dangling_edge_in_face(d) may be called: D is 2 or 3, d live with a β0. O(1).
@@ -734,6 +728,15 @@ class CMap {
     for (std::uint32_t x : darts) st.of_dart[x] = a;
     st.values.add_count(a, static_cast<std::int64_t>(darts.size()));
     st.values.set_dart(a, first.index());
+  }
+  // An insertion that makes a vertex (split_edge, star_face: they return a dart of the new
+  // vertex and fill `made` with all of them), followed by the vertex's attribute holding v.
+  template <int I>
+  Dart with_new_vertex(Dart (CMap::*insert)(Dart, detail::DartBuffer<32>&), Dart d, attribute_type<I> v) {
+    detail::DartBuffer<32> made;
+    const Dart nd = (this->*insert)(d, made);
+    give_new_vertex<I>(made, nd, std::move(v));
+    return nd;
   }
   // The face of a dart and its copies across βj (j ≥ 3), see cmap_insert.hpp.
   struct FaceCopies;
