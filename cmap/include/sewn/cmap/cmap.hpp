@@ -48,6 +48,8 @@
 #include "sewn/cmap/detail/dart_buffer.hpp"
 #include "sewn/cmap/detail/pod_array.hpp"
 #include "sewn/cmap/dart.hpp"
+#include "sewn/cmap/dart_info.hpp"
+#include "sewn/cmap/detail/cmap_params.hpp"
 #include "sewn/cmap/errors.hpp"
 #include "sewn/cmap/marks.hpp"
 #include "sewn/cmap/validation.hpp"
@@ -56,91 +58,6 @@ namespace sewn {
 
 /// Darts of an orbit or cell, in breadth-first order from the dart asked for (which comes first).
 using DartList = boost::container::small_vector<Dart, 32>;
-
-/// CMap<D, DartInfo<T>, A0, A1, ...> gives every dart a value of type T (CGAL's Dart_info), read
-/// and written with info(d). Without it a map stores nothing per dart beyond its links and
-/// attribute indices. T must be default-constructible and copyable.
-template <class T>
-struct DartInfo {
-  static_assert(!std::is_void_v<T> && std::is_default_constructible_v<T> && std::is_copy_assignable_v<T>,
-                "DartInfo<T>: T must be a default-constructible, copyable type");
-  using type = T;
-};
-
-namespace detail {
-
-template <int I, class... A>
-struct nth_or_void {
-  using type = void;
-};
-template <class H, class... T>
-struct nth_or_void<0, H, T...> {
-  using type = H;
-};
-template <int I, class H, class... T>
-  requires(I > 0)
-struct nth_or_void<I, H, T...> {
-  using type = typename nth_or_void<I - 1, T...>::type;
-};
-
-template <int I, class T>
-struct AttrStore {
-  PodArray<std::uint32_t> of_dart;  // attribute index of each dart's I-cell
-  AttributeContainer<T> values;
-  std::function<void(AttrId<I>, AttrId<I>)> on_split, on_merge;
-  std::function<void(AttrId<I>)> on_erase;
-};
-template <int I>
-struct AttrStore<I, void> {};
-
-template <class Seq, class... A>
-struct StoreTuple;
-template <int... I, class... A>
-struct StoreTuple<std::integer_sequence<int, I...>, A...> {
-  using type = std::tuple<AttrStore<I, typename nth_or_void<I, A...>::type>...>;
-};
-
-// CMap's type parameters: an optional DartInfo<T> first, then the cell attribute types.
-template <class T>
-struct is_dart_info : std::false_type {};
-template <class T>
-struct is_dart_info<DartInfo<T>> : std::true_type {};
-template <class... A>
-struct MapParams {
-  using info = void;
-  template <int I>
-  using attr = typename nth_or_void<I, A...>::type;
-  template <class Seq>
-  using stores = typename StoreTuple<Seq, A...>::type;
-  static constexpr std::size_t num_attrs = sizeof...(A);
-  static constexpr bool info_only_first = (!is_dart_info<A>::value && ...);
-};
-template <class T, class... A>
-struct MapParams<DartInfo<T>, A...> : MapParams<A...> {
-  using info = T;
-};
-
-// The per-dart values of a map with DartInfo<T>; nothing at all without.
-template <class T>
-struct InfoStore {
-  std::conditional_t<std::is_trivially_copyable_v<T>, PodArray<T>, std::vector<T>> of_dart;
-};
-template <>
-struct InfoStore<void> {};
-
-inline constexpr std::uint32_t null_index = Dart::null_index;
-inline constexpr std::uint32_t dead_marker = Dart::null_index - 1;  // β0 of a free-listed dart
-
-// For builders in sibling headers that link with link_beta and complete every orbit they
-// touch: they read whether the links were sound before and say so again when done.
-struct LinkSoundness {
-  template <class Map>
-  static bool get(const Map& m) { return m.links_sound_; }
-  template <class Map>
-  static void restore(const Map& m, bool sound) { m.links_sound_ = sound; }
-};
-
-}  // namespace detail
 
 /// A face table checked once and ready to instantiate: each half-edge (a dart-to-be, in table
 /// order) with its local start and end vertex and the index of its opposite half-edge.
@@ -827,65 +744,9 @@ class CMap {
   std::vector<std::pair<int, std::uint32_t>> pending_erase_;  // (dimension, attribute) to free
 };
 
-/// Pauses a map's hooks for the lifetime of the guard (attributes stay consistent).
-template <class Map>
-class HooksPaused {
- public:
-  explicit HooksPaused(Map& m) : map_(m), was_(m.hooks_enabled()) { map_.set_hooks_enabled(false); }
-  ~HooksPaused() { map_.set_hooks_enabled(was_); }
-  HooksPaused(const HooksPaused&) = delete;
-  HooksPaused& operator=(const HooksPaused&) = delete;
-
- private:
-  Map& map_;
-  bool was_;
-};
-
-/// A reserved mark freed (and cleared) on destruction. Clearing is O(1) when no or all live
-/// darts are marked, O(n/64) otherwise: for marking a few darts of a big map use ScopedMarker.
-template <class Map>
-class ScopedMark {
- public:
-  explicit ScopedMark(const Map& m) : map_(m), mark_(m.reserve_mark()) {}
-  ~ScopedMark() { map_.free_mark(mark_); }
-  ScopedMark(const ScopedMark&) = delete;
-  ScopedMark& operator=(const ScopedMark&) = delete;
-  [[nodiscard]] Mark get() const { return mark_; }
-  operator Mark() const { return mark_; }  // NOLINT(google-explicit-constructor)
-
- private:
-  const Map& map_;
-  Mark mark_;
-};
-
-/// A reserved mark that remembers what it marked and unmarks only that on destruction: O(k).
-template <class Map>
-class ScopedMarker {
- public:
-  explicit ScopedMarker(const Map& m) : map_(m), mark_(m.reserve_mark()) {}
-  ~ScopedMarker() {
-    for (Dart d : marked_) map_.unmark(d, mark_);
-    map_.free_mark(mark_);
-  }
-  ScopedMarker(const ScopedMarker&) = delete;
-  ScopedMarker& operator=(const ScopedMarker&) = delete;
-  /// Marks d; returns false if it was already marked.
-  bool mark(Dart d) {
-    if (!map_.mark(d, mark_)) return false;
-    marked_.push_back(d);
-    return true;
-  }
-  [[nodiscard]] bool is_marked(Dart d) const { return map_.is_marked(d, mark_); }
-  [[nodiscard]] Mark get() const { return mark_; }
-
- private:
-  const Map& map_;
-  Mark mark_;
-  std::vector<Dart> marked_;
-};
-
 }  // namespace sewn
 
+#include "sewn/cmap/guards.hpp"
 #include "sewn/cmap/detail/cmap_core.hpp"
 #include "sewn/cmap/detail/cmap_traversal.hpp"
 #include "sewn/cmap/detail/cmap_attributes.hpp"
