@@ -372,4 +372,18 @@ void PointConnection::accept(const Eigen::VectorXd& q, TwistUpdate update) {
   advance(n_, q.tail(dofs_n_));
 }
 
+void PointConnection::remap_nodes(std::span<const Index> old_to_new) {
+  auto map = [&](Index& i) { i = old_to_new[i]; };
+  map(joint_);
+  for (Index& i : nodes_) map(i);
+  for (Side* s : {&m_, &n_}) {
+    if (auto* r = std::get_if<RodEdgeSide>(s)) {
+      map(r->from);
+      map(r->to);
+    } else {
+      for (Index& i : std::get<TriangleSide>(*s).nodes) map(i);
+    }
+  }
+}
+
 }  // namespace sewn::connect

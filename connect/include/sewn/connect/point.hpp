@@ -27,6 +27,7 @@
 
 #include <array>
 #include <optional>
+#include <span>
 #include <string>
 #include <variant>
 #include <vector>
@@ -140,6 +141,8 @@ class PointConnection {
   /// and each rod side's frame history is transported to its current tangent (what
   /// Rod::update_frames does to the rod's own). O(1).
   void accept(const Eigen::VectorXd& q, TwistUpdate update);
+  /// Renames every node id (sides, joint, layout; old → new) after the node table was compacted.
+  void remap_nodes(std::span<const Index> old_to_new);
 
  private:
   std::string name_;

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "sewn/connect/point.hpp"
+#include "sewn/connect/stencil_dofs.hpp"
 #include "sewn/physics/force_term.hpp"
 #include "sewn/physics/rods/rods_term.hpp"
 
@@ -36,6 +37,16 @@ struct RodEdgeRef {
   int edge = 0;
 };
 using SideRef = std::variant<RodEdgeRef, TriangleSide>;
+
+/// A rod edge of the Rods term as a side at state s (its nodes, its current reference frame) and
+/// the System angle holding its θ. Throws physics::InputError naming `owner`: no rods, rods
+/// without angle DOFs, a rod or edge out of range. O(1).
+struct RodEdgeBinding {
+  RodEdgeSide side;
+  Index angle = 0;
+};
+[[nodiscard]] RodEdgeBinding bind_rod_edge(const physics::rods::Rods* rods, const RodEdgeRef& r, const physics::StateView& s,
+                                           const std::string& owner);
 
 /// Largest change of the twist δ within one step before a state counts as singular (rad).
 inline constexpr double max_twist_increment = 2.8;
@@ -73,23 +84,11 @@ class PointConnections final : public physics::ForceTerm {
   void remap_nodes(std::span<const Index> old_to_new) override;
 
  private:
-  // One stencil DOF: a node's axis or a System angle.
-  struct Dof {
-    bool angle = false;
-    Index id = 0;   // node or angle
-    int axis = 0;   // for a node
-  };
   struct Item {
     PointConnection connection;
-    std::vector<Dof> dofs;           // stencil order
-    std::vector<Index> blocks;       // distinct block rows of the stencil (set in collect_pairs)
-    std::vector<int> block_of;       // per DOF: its index in blocks
-    std::vector<Index> slots;        // blocks × blocks
+    StencilDofs dofs;  // stencil order
+    [[nodiscard]] std::string owner() const { return "point connection '" + connection.name() + "'"; }
   };
-  [[nodiscard]] static Eigen::VectorXd gather(const std::vector<Dof>& dofs, const physics::StateView& s, const std::string& name);
-  // Block row and component of a DOF in the Jacobian (angles by the System's AngleLayout).
-  [[nodiscard]] Index block_row(const Dof& d) const;
-  [[nodiscard]] int component(const Dof& d) const;
   // Energy, or +inf at a singular configuration (see the header comment).
   [[nodiscard]] double guarded_energy(const Item& it, const PointEval& e) const;
 
