@@ -9,7 +9,10 @@ namespace sewn::connect {
 
 namespace {
 
+using detail::signed_angle;
+using detail::transport;
 using detail::V3;
+using detail::vec_at;
 using physics::InputError;
 
 constexpr int max_dofs = 18;  // edge (6) + two hinges (6 + 6)
@@ -35,19 +38,6 @@ std::string describe(const EdgeSide& s) {
   if (const auto* f = std::get_if<FaceSide>(&s)) return "face with apex " + std::to_string(f->apex);
   const auto& h = std::get<HingeSide>(s);
   return "hinge with apices " + std::to_string(h.left) + ", " + std::to_string(h.right);
-}
-
-// The 3-vector at stencil offset `at` (positions follow a rod's θ unaligned, so by offset).
-template <class T, class Q>
-V3<T> vec_at(const Q& q, int at) {
-  return {q[at], q[at + 1], q[at + 2]};
-}
-
-template <class T>
-V3<T> transport(const V3<T>& a, const V3<T>& b, const V3<T>& u) {  // P_a^b(u), exact form
-  const T c = detail::dot(a, b);
-  const V3<T> w = detail::cross(a, b);
-  return c * u + detail::cross(w, u) + (detail::dot(w, u) / (T(1.0) + c)) * w;
 }
 
 template <class T>
@@ -90,12 +80,6 @@ SideFrame<T> side_frame(const EdgeSide& side, Index a, const Q& q, int at, const
   if (!(detail::value_of(dot(s, s)) > hinge_margin * hinge_margin)) f.degenerate = true;
   f.m1 = detail::normalized(s);
   return f;
-}
-
-template <class T>
-T signed_angle(const V3<T>& from, const V3<T>& to, const V3<T>& axis) {
-  using std::atan2;
-  return atan2(detail::dot(to, detail::cross(axis, from)), detail::dot(to, from));
 }
 
 template <class T>

@@ -163,5 +163,24 @@ template <class T>
 V3<T> constant(double x, double y, double z) {
   return {T(x), T(y), T(z)};
 }
+/// P_a^b(u), the exact form c u + w×u + (w·u)/(1+c) w of physics::rods::transport_exact on V3.
+template <class T>
+V3<T> transport(const V3<T>& a, const V3<T>& b, const V3<T>& u) {
+  const T c = dot(a, b);
+  const V3<T> w = cross(a, b);
+  return c * u + cross(w, u) + (dot(w, u) / (T(1.0) + c)) * w;
+}
+/// The signed angle from u to v about axis (|u|, |v| need not be 1; u, v ⟂ axis).
+template <class T>
+T signed_angle(const V3<T>& u, const V3<T>& v, const V3<T>& axis) {
+  using std::atan2;
+  return atan2(dot(cross(u, v), axis), dot(u, v));
+}
+/// The 3-vector at offset `at` of an indexable q (stencils are laid out by offset, a rod's θ
+/// leaving the positions after it unaligned).
+template <class T, class Q>
+V3<T> vec_at(const Q& q, int at) {
+  return {q[at], q[at + 1], q[at + 2]};
+}
 
 }  // namespace sewn::connect::detail

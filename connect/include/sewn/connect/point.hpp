@@ -129,11 +129,10 @@ class PointConnection {
   /// ½k_b|d − d̄|² (equal to ½k_bω² to O(ω⁴), and differentiable there). Near the singular
   /// configurations the values are still returned, flagged; a rod edge of zero length or a
   /// triangle of zero area *now* gives non-finite values (callers check, as for the rods).
-  /// Throws physics::InputError naming the connection if q has the wrong size or is not finite. Cost O(1): measured ~0.7 µs for the
-  /// energy, ~7–15 µs with the gradient (18-wide forward AD; AMD EPYC, shared machine).
+  /// Throws physics::InputError naming the connection if q has the wrong size or is not finite. Cost O(1) (18-wide
+  /// forward AD, connect/src/jet.hpp, for the gradient).
   /// With `hessian`, also d²E/dq² (and the gradient), by `method` (see HessianMethod): exact
-  /// to round-off, symmetric, not projected (indefinite away from rest). Cost: see docs/connect.md
-  /// (nested_ad ~0.65 ms).
+  /// to round-off, symmetric, not projected (indefinite away from rest). Cost: see docs/connect.md.
   [[nodiscard]] PointEval evaluate(const Eigen::VectorXd& q, TwistUpdate update, bool want_gradient,
                                    Eigen::MatrixXd* hessian = nullptr, HessianMethod method = HessianMethod::chained) const;
 
