@@ -15,15 +15,15 @@ using detail::V3;
 using detail::vec_at;
 using physics::InputError;
 
-constexpr int max_dofs = 18;  // edge (6) + two hinges (6 + 6)
-constexpr double two_pi = 2 * std::numbers::pi;
+constexpr int edge_max_dofs = 18;  // edge (6) + two hinges (6 + 6)
+constexpr double full_turn = 2 * std::numbers::pi;
 // A hinge whose two normals nearly cancel (|n_A + n_B| < this: folded to within ~0.01 rad of
 // flat onto itself) has no average normal to speak of.
 constexpr double hinge_margin = 1e-2;
 // A triangle or edge this thin (relative) gives no direction.
 constexpr double thin_margin = 1e-12;
 
-[[noreturn]] void fail(const std::string& name, const std::string& why) {
+[[noreturn]] void fail_edge(const std::string& name, const std::string& why) {
   throw InputError("curve connection '" + name + "': " + why);
 }
 
@@ -103,33 +103,33 @@ std::vector<Index> edge_stencil_nodes(Index a, Index b, const EdgeSide& m, const
 EdgeConnection::EdgeConnection(std::string name, Index a, Index b, EdgeSide m, EdgeSide n, double k_per_length,
                                const Eigen::VectorXd& q_rest)
     : name_(std::move(name)), a_(a), b_(b), m_(std::move(m)), n_(std::move(n)), k_(k_per_length) {
-  if (!std::isfinite(k_) || k_ < 0) fail(name_, "stiffness per length must be finite and >= 0, got " + std::to_string(k_));
-  if (a_ == b_) fail(name_, "the edge's two nodes are both " + std::to_string(a_));
+  if (!std::isfinite(k_) || k_ < 0) fail_edge(name_, "stiffness per length must be finite and >= 0, got " + std::to_string(k_));
+  if (a_ == b_) fail_edge(name_, "the edge's two nodes are both " + std::to_string(a_));
   nodes_ = edge_stencil_nodes(a_, b_, m_, n_);
   for (std::size_t i = 0; i < nodes_.size(); ++i)
     for (std::size_t j = i + 1; j < nodes_.size(); ++j)
       if (nodes_[i] == nodes_[j])
-        fail(name_, "node " + std::to_string(nodes_[i]) + " appears twice in the edge (" + std::to_string(a_) + ", " +
+        fail_edge(name_, "node " + std::to_string(nodes_[i]) + " appears twice in the edge (" + std::to_string(a_) + ", " +
                         std::to_string(b_) + ") and its sides' apices");
   for (const EdgeSide* s : {&m_, &n_})
     if (const auto* r = std::get_if<RodEdgeSide>(s)) {
       if (!((r->from == a_ && r->to == b_) || (r->from == b_ && r->to == a_)))
-        fail(name_, describe(*s) + " is not the shared edge (" + std::to_string(a_) + ", " + std::to_string(b_) + ")");
+        fail_edge(name_, describe(*s) + " is not the shared edge (" + std::to_string(a_) + ", " + std::to_string(b_) + ")");
       if (std::abs(r->tangent.norm() - 1) > 1e-9 || std::abs(r->director.norm() - 1) > 1e-9 ||
           std::abs(r->tangent.dot(r->director)) > 1e-9)
-        fail(name_, describe(*s) + ": its stored tangent and director are not an orthonormal pair");
+        fail_edge(name_, describe(*s) + ": its stored tangent and director are not an orthonormal pair");
     }
   extra_m_ = extra_dofs(m_);
   extra_n_ = extra_dofs(n_);
   if (q_rest.size() != num_dofs())
-    fail(name_, "rest configuration has " + std::to_string(q_rest.size()) + " entries, the stencil " +
+    fail_edge(name_, "rest configuration has " + std::to_string(q_rest.size()) + " entries, the stencil " +
                     std::to_string(num_dofs()));
-  if (!q_rest.allFinite()) fail(name_, "rest configuration is not finite");
+  if (!q_rest.allFinite()) fail_edge(name_, "rest configuration is not finite");
   rest_length_ = (q_rest.segment<3>(3) - q_rest.segment<3>(0)).norm();
-  if (!(rest_length_ > 0)) fail(name_, "the edge has zero length at rest");
+  if (!(rest_length_ > 0)) fail_edge(name_, "the edge has zero length at rest");
   const EdgeEval e = evaluate(q_rest, TwistUpdate::direct, false);
   if (e.degenerate)
-    fail(name_, "no frame can be built at rest (a zero-area triangle, a hinge folded flat onto itself, or a rod "
+    fail_edge(name_, "no frame can be built at rest (a zero-area triangle, a hinge folded flat onto itself, or a rod "
                 "frame turned against its edge) on " + describe(m_) + " or " + describe(n_));
   rest_twist_ = e.twist_raw;
   if (std::abs(rest_twist_) > std::numbers::pi / 2) {  // the orientation rule
@@ -148,8 +148,8 @@ int EdgeConnection::angle_slot(int side) const {
 EdgeEval EdgeConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update, bool want_gradient,
                                   Eigen::MatrixXd* hessian) const {
   if (q.size() != num_dofs())
-    fail(name_, "configuration has " + std::to_string(q.size()) + " entries, the stencil " + std::to_string(num_dofs()));
-  if (!q.allFinite()) fail(name_, "configuration is not finite");
+    fail_edge(name_, "configuration has " + std::to_string(q.size()) + " entries, the stencil " + std::to_string(num_dofs()));
+  if (!q.allFinite()) fail_edge(name_, "configuration is not finite");
   auto run = [&](const auto& qt) {
     using T = std::decay_t<decltype(qt[0])>;
     using std::cos;
@@ -163,7 +163,7 @@ EdgeEval EdgeConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update, 
     Angles<T> out{signed_angle(fm.m1, fn.m1, e), 0.0, fm.degenerate || fn.degenerate || !(dd > 0)};
     out.raw = detail::value_of(out.twist);
     if (update == TwistUpdate::incremental_i) {
-      out.twist = out.twist + T(two_pi * std::round((accepted_twist_ - out.raw) / two_pi));
+      out.twist = out.twist + T(full_turn * std::round((accepted_twist_ - out.raw) / full_turn));
     } else if (update == TwistUpdate::incremental_ii) {
       // Turn m1 by the accepted δ first: what is left is the step's increment (< π).
       const V3<T> m1t = cos(T(accepted_twist_)) * fm.m1 + sin(T(accepted_twist_)) * detail::cross(e, fm.m1);
@@ -184,7 +184,7 @@ EdgeEval EdgeConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update, 
   if (hessian || want_gradient) {
     auto differentiate = [&](auto tag) {
       using J = decltype(tag);
-      std::array<J, max_dofs> qa;
+      std::array<J, edge_max_dofs> qa;
       for (int i = 0; i < n; ++i) qa[static_cast<std::size_t>(i)] = J::variable(q[i], i);
       const auto result = run(qa);
       finish(result);
@@ -197,9 +197,9 @@ EdgeEval EdgeConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update, 
       }
     };
     if (hessian)
-      differentiate(detail::Jet<max_dofs, true>{});
+      differentiate(detail::Jet<edge_max_dofs, true>{});
     else
-      differentiate(detail::Jet<max_dofs, false>{});
+      differentiate(detail::Jet<edge_max_dofs, false>{});
   } else {
     finish(run(q));
   }

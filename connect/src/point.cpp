@@ -1,5 +1,6 @@
 #include "sewn/connect/point.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
@@ -19,15 +20,15 @@ using detail::value_of;
 using detail::vec_at;
 using physics::InputError;
 
-constexpr int max_dofs = 18;  // triangle + triangle
 constexpr double two_pi = 2 * std::numbers::pi;
-// Forward AD over the whole stencil: first order (gradients), second (the reference Hessian).
-using G = detail::Jet<max_dofs, false>;
-using H2 = detail::Jet<max_dofs, true>;
-// The chained Hessian's scalars: a side's frame in ≤ 9 directions, the core in 12.
-constexpr int side_dofs_max = 9;
-using S2 = detail::Jet<side_dofs_max, true>;
+// Forward AD over the whole stencil, in as many directions as it needs: 18 (rod or triangle
+// sides) or 24 (a tet side); first order (gradients), second (the reference Hessian).
+constexpr int max_dofs = 24;  // tet + tet
+// The chained Hessian's scalars: a side's frame in 9 (rod, triangle) or 12 (tet) directions,
+// the core in 12.
+constexpr int side_dofs_max = 12;
 using C2 = detail::Jet<12, true>;
+using Coef = std::array<double, 6>;
 
 [[noreturn]] void fail(const std::string& name, const std::string& why) {
   throw InputError("point connection '" + name + "': " + why);
@@ -35,22 +36,28 @@ using C2 = detail::Jet<12, true>;
 
 std::string describe(const Side& s) {
   std::ostringstream o;
-  if (const auto* r = std::get_if<RodEdgeSide>(&s))
+  if (const auto* r = std::get_if<RodEdgeSide>(&s)) {
     o << "rod edge (" << r->from << ", " << r->to << ")";
-  else {
-    const auto& t = std::get<TriangleSide>(s);
-    o << "triangle (" << t.nodes[0] << ", " << t.nodes[1] << ", " << t.nodes[2] << ")";
+  } else if (const auto* t = std::get_if<TriangleSide>(&s)) {
+    o << "triangle (" << t->nodes[0] << ", " << t->nodes[1] << ", " << t->nodes[2] << ")";
+  } else {
+    const auto& k = std::get<TetSide>(s);
+    o << "tetrahedron (" << k.nodes[0] << ", " << k.nodes[1] << ", " << k.nodes[2] << ", " << k.nodes[3] << ")";
   }
   return o.str();
 }
 
 std::vector<Index> side_nodes(const Side& s) {
   if (const auto* r = std::get_if<RodEdgeSide>(&s)) return {r->from, r->to};
-  const auto& t = std::get<TriangleSide>(s);
-  return {t.nodes.begin(), t.nodes.end()};
+  if (const auto* t = std::get_if<TriangleSide>(&s)) return {t->nodes.begin(), t->nodes.end()};
+  const auto& k = std::get<TetSide>(s);
+  return {k.nodes.begin(), k.nodes.end()};
 }
 
-int side_dofs(const Side& s) { return std::holds_alternative<RodEdgeSide>(s) ? 7 : 9; }
+int side_dofs(const Side& s) {
+  if (std::holds_alternative<RodEdgeSide>(s)) return 7;
+  return std::holds_alternative<TriangleSide>(s) ? 9 : 12;
+}
 
 // The one node both sides hold; rejects sides that are degenerate or share 0 or 2+ nodes.
 Index shared_node(const std::string& name, const Side& m, const Side& n) {
@@ -71,10 +78,22 @@ Index shared_node(const std::string& name, const Side& m, const Side& n) {
   return common[0];
 }
 
-// A triangle side with its nodes rotated to start at the joint (orientation kept).
+// A triangle side with its nodes rotated to start at the joint (orientation kept); a tet's
+// joint moved to the front, the others in order.
 TriangleSide rotated(TriangleSide t, Index joint) {
   while (t.nodes[0] != joint) t.nodes = {t.nodes[1], t.nodes[2], t.nodes[0]};
   return t;
+}
+TetSide rotated(TetSide t, Index joint) {
+  const auto at = std::find(t.nodes.begin(), t.nodes.end(), joint);
+  std::rotate(t.nodes.begin(), at, at + 1);
+  return t;
+}
+// Side s with its nodes starting at the joint.
+Side rotated(const Side& s, Index joint) {
+  if (const auto* t = std::get_if<TriangleSide>(&s)) return rotated(*t, joint);
+  if (const auto* k = std::get_if<TetSide>(&s)) return rotated(*k, joint);
+  return s;
 }
 
 template <class T>
@@ -84,7 +103,7 @@ struct Frame {
 
 // The side's frame from the stencil q, its DOFs from offset `at`, axis sign and triangle coefficients.
 template <class T, class Q>
-Frame<T> build_frame(const Side& side, const Q& q, int at, double sign, const std::array<double, 2>& coef) {
+Frame<T> build_frame(const Side& side, const Q& q, int at, double sign, const Coef& coef) {
   using detail::cross;
   using detail::dot;
   using std::cos;
@@ -99,6 +118,14 @@ Frame<T> build_frame(const Side& side, const Q& q, int at, double sign, const st
     const V3<T> a2 = cross(t, a1);
     f.m1 = cos(q[at + 6]) * a1 + sin(q[at + 6]) * a2;
     f.m3 = T(sign) * t;
+  } else if (std::holds_alternative<TetSide>(side)) {
+    const V3<T> x0 = vec_at<T>(q, at);
+    const V3<T> c1 = vec_at<T>(q, at + 3) - x0, c2 = vec_at<T>(q, at + 6) - x0, c3 = vec_at<T>(q, at + 9) - x0;
+    const V3<T> a = coef[0] * c1 + coef[1] * c2 + coef[2] * c3;  // F m̄3
+    const V3<T> b = coef[3] * c1 + coef[4] * c2 + coef[5] * c3;  // F m̄1
+    const V3<T> m3 = detail::normalized(a);
+    f.m1 = detail::normalized(b - dot(b, m3) * m3);
+    f.m3 = T(sign) * m3;
   } else {
     const V3<T> e1 = vec_at<T>(q, at + 3) - vec_at<T>(q, at);
     const V3<T> e2 = vec_at<T>(q, at + 6) - vec_at<T>(q, at);
@@ -118,21 +145,29 @@ struct SideJet {
   std::array<Eigen::Matrix<double, side_dofs_max, side_dofs_max>, 6> hessian;
 };
 
-SideJet side_jet(const Side& side, const Eigen::VectorXd& q, int at, int dofs, double sign, const std::array<double, 2>& coef) {
-  std::array<S2, side_dofs_max> qa;
+template <int N>
+SideJet side_jet_n(const Side& side, const Eigen::VectorXd& q, int at, int dofs, double sign, const Coef& coef) {
+  using S2 = detail::Jet<N, true>;
+  std::array<S2, side_dofs_max> qa;  // sized for any side, so no path reads past it
   for (int i = 0; i < dofs; ++i) qa[static_cast<std::size_t>(i)] = S2::variable(q[at + i], i);
   const Frame<S2> f = build_frame<S2>(side, qa, 0, sign, coef);
   SideJet jet;
+  jet.jacobian.setZero();
   const std::array<const S2*, 6> out{&f.m1.x, &f.m1.y, &f.m1.z, &f.m3.x, &f.m3.y, &f.m3.z};
   for (int k = 0; k < 6; ++k) {
     const S2& v = *out[static_cast<std::size_t>(k)];
     jet.value[k] = v.v;
-    for (int i = 0; i < side_dofs_max; ++i) {
+    jet.hessian[static_cast<std::size_t>(k)].setZero();
+    for (int i = 0; i < N; ++i) {
       jet.jacobian(k, i) = v.g[static_cast<std::size_t>(i)];
-      for (int j = 0; j < side_dofs_max; ++j) jet.hessian[static_cast<std::size_t>(k)](i, j) = v.hessian(i, j);
+      for (int j = 0; j < N; ++j) jet.hessian[static_cast<std::size_t>(k)](i, j) = v.hessian(i, j);
     }
   }
   return jet;
+}
+// In as few directions as the side needs.
+SideJet side_jet(const Side& side, const Eigen::VectorXd& q, int at, int dofs, double sign, const Coef& coef) {
+  return dofs <= 9 ? side_jet_n<9>(side, q, at, dofs, sign, coef) : side_jet_n<12>(side, q, at, dofs, sign, coef);
 }
 
 template <class T>
@@ -161,13 +196,8 @@ std::vector<Index> stencil_layout(const std::string& name, const Side& m, const 
   const Index joint = shared_node(name, m, n);
   std::vector<Index> out;
   for (const Side* s : {&m, &n}) {
-    if (std::holds_alternative<TriangleSide>(*s)) {
-      const auto t = rotated(std::get<TriangleSide>(*s), joint);
-      out.insert(out.end(), t.nodes.begin(), t.nodes.end());
-    } else {
-      const auto v = side_nodes(*s);
-      out.insert(out.end(), v.begin(), v.end());
-    }
+    const auto v = side_nodes(rotated(*s, joint));
+    out.insert(out.end(), v.begin(), v.end());
   }
   return out;
 }
@@ -186,8 +216,21 @@ PointConnection::PointConnection(std::string name, Side m, Side n, PointStiffnes
                     std::to_string(num_dofs()));
   if (!q_rest.allFinite()) fail(name_, "rest configuration is not finite");
 
-  // Per side: geometry checks, the triangle axis coefficients, the into/out-of-joint sign.
-  auto prepare = [&](Side& s, const Eigen::VectorXd& q, std::array<double, 2>& coef, double into_joint) -> double {
+  // A tet side: checks, and Dm⁻¹m̄3, Dm⁻¹m̄1 (F m̄ = Ds Dm⁻¹ m̄ at any state).
+  auto prepare_tet = [&](const TetSide& k, const Eigen::VectorXd& q, Coef& coef) {
+    if (!k.rest_axis.allFinite() || !(k.rest_axis.norm() > 0)) fail(name_, describe(k) + ": rest axis is zero or not finite");
+    Eigen::Matrix3d Dm;
+    for (int c = 0; c < 3; ++c) Dm.col(c) = q.segment<3>(3 * (c + 1)) - q.segment<3>(0);
+    const double scale = Dm.col(0).norm() * Dm.col(1).norm() * Dm.col(2).norm();
+    if (!(std::abs(Dm.determinant()) > 1e-12 * scale))
+      fail(name_, describe(k) + " has zero volume at rest: no frame can be built on it");
+    const Vec3 m3 = k.rest_axis.normalized(), m1 = physics::rods::any_perpendicular(m3);
+    const Eigen::Matrix3d inv = Dm.inverse();
+    const Vec3 w3 = inv * m3, w1 = inv * m1;
+    coef = {w3[0], w3[1], w3[2], w1[0], w1[1], w1[2]};
+  };
+  // Per side: geometry checks, the frame constants, the into/out-of-joint sign.
+  auto prepare = [&](Side& s, const Eigen::VectorXd& q, Coef& coef, double into_joint) -> double {
     if (auto* r = std::get_if<RodEdgeSide>(&s)) {
       const Vec3 e = q.segment<3>(3) - q.segment<3>(0);
       if (!(e.norm() > 0)) fail(name_, describe(s) + " has zero length at rest");
@@ -196,6 +239,13 @@ PointConnection::PointConnection(std::string name, Side m, Side n, PointStiffnes
         fail(name_, describe(s) + ": its stored tangent and director are not an orthonormal pair");
       const double out_sign = (r->from == joint_) ? 1.0 : -1.0;  // t points out of the joint if it starts there
       return into_joint * out_sign;
+    }
+    if (auto* k = std::get_if<TetSide>(&s)) {
+      *k = rotated(*k, joint_);
+      prepare_tet(*k, q, coef);
+      // The rest axis points out of the solid, so the body lies along −axis (a triangle's lies
+      // along its axis): a rod standing on the surface continues the solid's axis straight.
+      return -into_joint;
     }
     auto& t = std::get<TriangleSide>(s);
     t = rotated(t, joint_);
@@ -281,13 +331,23 @@ PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update
     using T = std::decay_t<decltype(qt[0])>;
     return core(build_frame<T>(m_, qt, 0, sign_m_, coef_m_), build_frame<T>(n_, qt, dofs_m_, sign_n_, coef_n_));
   };
-  // Whole-stencil forward AD of order 1 or 2 (J = G or H2): the energy's jet.
-  auto stencil_jet = [&](auto tag) {
-    using J = decltype(tag);
-    std::array<J, max_dofs> qa;
+  // Whole-stencil forward AD in N directions, second order if H: the gradient (and Hessian) into
+  // out (and *hessian); the values returned.
+  auto whole = [&]<int N, bool H>() {
+    using J = detail::Jet<N, H>;
+    std::array<J, max_dofs> qa;  // sized for any stencil, so no path reads past it
     for (int i = 0; i < num_dofs(); ++i) qa[static_cast<std::size_t>(i)] = J::variable(q[i], i);
-    return run(qa);
+    const auto ca = run(qa);
+    out.gradient.resize(num_dofs());
+    if (H) hessian->resize(num_dofs(), num_dofs());
+    for (int i = 0; i < num_dofs(); ++i) {
+      out.gradient[i] = ca.energy.g[static_cast<std::size_t>(i)];
+      if (H)
+        for (int j = 0; j < num_dofs(); ++j) (*hessian)(i, j) = ca.energy.hessian(i, j);
+    }
+    return Core<double>{value_of(ca.energy), ca.twist, ca.twist_raw, ca.bend, ca.one_plus_c};
   };
+  const bool wide = num_dofs() > 18;  // a tet side
   Core<double> c;
   const Eigen::Index n = q.size();
   if (hessian && method == HessianMethod::chained) {
@@ -324,19 +384,9 @@ PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update
       hessian->bottomRightCorner(dn, dn) += eF[6 + k] * jn.hessian[static_cast<std::size_t>(k)].topLeftCorner(dn, dn);
     }
   } else if (hessian) {
-    const auto ca = stencil_jet(H2{});
-    c = {value_of(ca.energy), ca.twist, ca.twist_raw, ca.bend, ca.one_plus_c};
-    out.gradient.resize(n);
-    hessian->resize(n, n);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      out.gradient[i] = ca.energy.g[static_cast<std::size_t>(i)];
-      for (Eigen::Index j = 0; j < n; ++j) (*hessian)(i, j) = ca.energy.hessian(static_cast<int>(i), static_cast<int>(j));
-    }
+    c = wide ? whole.template operator()<max_dofs, true>() : whole.template operator()<18, true>();
   } else if (want_gradient) {
-    const auto ca = stencil_jet(G{});
-    c = {value_of(ca.energy), ca.twist, ca.twist_raw, ca.bend, ca.one_plus_c};
-    out.gradient.resize(n);
-    for (Eigen::Index i = 0; i < n; ++i) out.gradient[i] = ca.energy.g[static_cast<std::size_t>(i)];
+    c = wide ? whole.template operator()<max_dofs, false>() : whole.template operator()<18, false>();
   } else {
     c = run(q);
   }
@@ -370,8 +420,10 @@ void PointConnection::remap_nodes(std::span<const Index> old_to_new) {
     if (auto* r = std::get_if<RodEdgeSide>(s)) {
       map(r->from);
       map(r->to);
+    } else if (auto* t = std::get_if<TriangleSide>(s)) {
+      for (Index& i : t->nodes) map(i);
     } else {
-      for (Index& i : std::get<TriangleSide>(*s).nodes) map(i);
+      for (Index& i : std::get<TetSide>(*s).nodes) map(i);
     }
   }
 }

@@ -44,6 +44,7 @@ Index PointConnections::add(const std::string& name, const SideRef& m, const Sid
   std::array<Index, 2> angle{physics::invalid_index, physics::invalid_index};
   auto resolve = [&](const SideRef& ref, int which) -> Side {
     if (const auto* t = std::get_if<TriangleSide>(&ref)) return *t;
+    if (const auto* k = std::get_if<TetSide>(&ref)) return *k;
     const RodEdgeBinding bound = bind_rod_edge(rods_, std::get<RodEdgeRef>(ref), s, "point connection '" + name + "'");
     angle[static_cast<std::size_t>(which)] = bound.angle;
     return bound.side;
@@ -53,8 +54,10 @@ Index PointConnections::add(const std::string& name, const SideRef& m, const Sid
   StencilDofs dofs;
   std::size_t p = 0;
   for (int which = 0; which < 2; ++which) {
-    const bool rod = std::holds_alternative<RodEdgeSide>(which == 0 ? sm : sn);
-    for (int v = 0; v < (rod ? 2 : 3); ++v, ++p) dofs.add_node(layout[p]);
+    const Side& side = which == 0 ? sm : sn;
+    const bool rod = std::holds_alternative<RodEdgeSide>(side);
+    const int nodes = rod ? 2 : std::holds_alternative<TriangleSide>(side) ? 3 : 4;
+    for (int v = 0; v < nodes; ++v, ++p) dofs.add_node(layout[p]);
     if (rod) dofs.add_angle(angle[static_cast<std::size_t>(which)]);
   }
   const Eigen::VectorXd q_rest = dofs.gather(s, "point connection '" + name + "'");

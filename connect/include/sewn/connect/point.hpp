@@ -22,6 +22,7 @@
 //   rod edge:  x_from (3), x_to (3), θ (1)   — 7; from/to in the rod's own edge direction
 //   triangle:  x_joint (3), x_next (3), x_prev (3) — 9; the triangle's nodes rotated so that
 //              the joint comes first (orientation, hence the normal's sign, is kept)
+//   tet:       x_joint, then the other three in their order (12); F does not depend on the order
 // The shared node thus has one 3-block per side; an assembler adds both. position_nodes()
 // lists the node of every 3-block in order.
 
@@ -65,7 +66,17 @@ struct TriangleSide {
   std::optional<Vec3> rest_axis;
 };
 
-using Side = std::variant<RodEdgeSide, TriangleSide>;
+/// A solid's tetrahedron as a side (PHYSICS_NOTES §3.5, solid option i): the rest frame — m̄3 =
+/// `rest_axis` (the surface vertex normal at the joint, pointing out of the solid; the tet is
+/// the one the inward normal ray enters), m̄1 any unit vector ⟂ to it — carried by the tet's
+/// deformation gradient F and re-orthonormalised, m3 first: m3 = ±hat(F m̄3),
+/// m1 = hat(F m̄1 − (F m̄1·m3) m3). The joint is one of its nodes.
+struct TetSide {
+  std::array<Index, 4> nodes{};
+  Vec3 rest_axis{0, 0, 1};
+};
+
+using Side = std::variant<RodEdgeSide, TriangleSide, TetSide>;
 
 /// How δ is followed through a motion (PHYSICS_NOTES §3.5). The incremental updates freeze
 /// their history within a step and are advanced by accept(); both need each step's increment
@@ -149,7 +160,9 @@ class PointConnection {
   PointStiffness k_;
   int dofs_m_ = 0, dofs_n_ = 0;
   double sign_m_ = 1, sign_n_ = 1;
-  std::array<double, 2> coef_m_{}, coef_n_{};  // triangle sides: the rest axis in (e1, e2)
+  // Per side, constants of its frame: a triangle's rest axis in (e1, e2) (2); a tet's
+  // Dm⁻¹m̄3 and Dm⁻¹m̄1 (6), so that F m̄ = Ds (Dm⁻¹ m̄).
+  std::array<double, 6> coef_m_{}, coef_n_{};
   Index joint_ = 0;
   std::vector<Index> nodes_;
   double rest_twist_ = 0, accepted_twist_ = 0;
