@@ -196,7 +196,10 @@ EdgeEval EdgeConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update, 
           for (int j = 0; j < n; ++j) (*hessian)(i, j) = result.second.hessian(i, j);
       }
     };
-    if (hessian)
+    // In as few directions as the stencil needs: a rod or face on each side fits in 12.
+    if (hessian && n <= 12)
+      differentiate(detail::Jet<12, true>{});
+    else if (hessian)
       differentiate(detail::Jet<edge_max_dofs, true>{});
     else
       differentiate(detail::Jet<edge_max_dofs, false>{});
