@@ -14,6 +14,7 @@
 
 #include "sewn/connect/curve_term.hpp"
 #include "sewn/physics/basic_terms.hpp"
+#include "sewn/physics/shells/shell_terms.hpp"
 #include "sewn/physics/integrate/newton_euler.hpp"
 #include "sewn/physics/springs.hpp"
 #include "sewn/physics/system.hpp"
@@ -185,6 +186,67 @@ TEST_CASE("curve connections term: guard, renumbering, errors naming the connect
                        doctest::Contains("curve connection 'off'"), physics::InputError);
   CHECK_THROWS_WITH_AS((void)t.curve->add("norod", 0, 1, RodEdgeRef{3, 0}, FaceSide{3}, 1.0, t.sys.state()),
                        doctest::Contains("curve connection 'norod': rod 3 edge 0 is out of range"), physics::InputError);
+}
+
+// A cantilever plate (0.2 × 0.05 m, 8 × 2 cells of two triangles, E = 1 GPa, h = 2 mm, clamped
+// along its first two columns of nodes) settled under gravity: whole (hinges everywhere), or
+// split along x = 0.1 (no hinge across that line: the halves share its nodes only) and rejoined
+// by a curve connection of k per unit length along each of its edges (k = 0: a free hinge).
+// Returns the mean height of the free end.
+double plate_tip(bool split, double k) {
+  constexpr int nx = 8, ny = 2;
+  const double dx = 0.025, E = 1e9, nu = 0.3, h = 2e-3, rho = 1000;
+  physics::System sys;
+  auto id = [](int i, int j) { return static_cast<Index>(i + (nx + 1) * j); };
+  const double node_mass = rho * h * (nx * dx) * (ny * dx) / ((nx + 1) * (ny + 1));
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) (void)sys.nodes().add(Vec3(i * dx, j * dx, 0), Vec3::Zero(), node_mass);
+  for (int j = 0; j <= ny; ++j) {
+    sys.nodes().fix(id(0, j));
+    sys.nodes().fix(id(1, j));
+  }
+  std::vector<std::array<Index, 3>> left, right;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      auto& half = (split && i >= nx / 2) ? right : left;
+      half.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      half.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  auto& membranes = sys.add<physics::shells::Membranes>();
+  const std::vector<double> rest(sys.nodes().x().begin(), sys.nodes().x().end());
+  for (const auto* half : {&left, &right})
+    for (const auto& t : *half) {
+      physics::shells::TriPositions X;
+      for (int c = 0; c < 3; ++c) X.col(c) = sys.nodes().position(t[static_cast<std::size_t>(c)]);
+      (void)membranes.add(t, X, E, nu, h);
+    }
+  auto& hinges = sys.add<physics::shells::Hinges>();
+  const double k_b = physics::shells::hinge_stiffness(E, nu, h);
+  (void)hinges.add_interior_edges(left, rest, k_b);
+  if (split) (void)hinges.add_interior_edges(right, rest, k_b);
+  if (split && k > 0) {
+    auto& curve = sys.add<CurveConnections>(nullptr);
+    for (int j = 0; j < ny; ++j)  // the left triangle (apex behind the line) and the right one (apex ahead)
+      (void)curve.add("split " + std::to_string(j), id(nx / 2, j), id(nx / 2, j + 1), FaceSide{id(nx / 2 - 1, j)},
+                      FaceSide{id(nx / 2 + 1, j + 1)}, k, sys.state());
+  }
+  sys.add<physics::Gravity>(Vec3(0, 0, -9.81));
+  sys.add<physics::MassDamping>(50.0);
+  physics::integrate::NewtonEuler newton;
+  for (int s = 0; s < 300; ++s) (void)newton.step(sys, 0.01);
+  double tip = 0;
+  for (int j = 0; j <= ny; ++j) tip += sys.nodes().position(id(nx, j)).z() / (ny + 1);
+  return tip;
+}
+
+TEST_CASE("curve connections term: a plate split along a line and rejoined by a stiff curve connection bends like the whole plate") {
+  const double D = 1e9 * 8e-9 / (12 * (1 - 0.09));  // E h³ / 12(1 − ν²)
+  const double whole = plate_tip(false, 0), hinged = plate_tip(true, 0), stiff = plate_tip(true, 1e3 * D / 0.025);
+  MESSAGE("plate tip: whole " << whole << " m, split with a free hinge " << hinged << " m, rejoined stiffly " << stiff << " m");
+  CHECK(whole < -1e-3);                                     // a real deflection
+  CHECK(hinged < 5 * whole);                                // the free hinge lets the far half fall
+  CHECK(stiff == doctest::Approx(whole).epsilon(0.1));      // the joint carries the moment
+  CHECK(stiff > whole);                                     // and is stiffer than the plate it replaces
 }
 
 }  // namespace
