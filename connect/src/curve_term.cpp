@@ -1,5 +1,6 @@
 #include "sewn/connect/curve_term.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -90,6 +91,14 @@ void CurveConnections::step_accepted(const StateView& s) {
 
 void CurveConnections::check_nodes(const physics::NodeTable& nodes) const {
   for (const Item& it : items_) it.dofs.check_nodes(nodes, it.owner());
+}
+
+Index CurveConnections::remove_dangling(const physics::NodeTable& nodes) {
+  const auto before = items_.size();
+  std::erase_if(items_, [&](const Item& it) { return it.dofs.touches_removed(nodes); });
+  const auto removed = static_cast<Index>(before - items_.size());
+  if (removed > 0) touch_topology();
+  return removed;
 }
 
 void CurveConnections::remap_nodes(std::span<const Index> old_to_new) {

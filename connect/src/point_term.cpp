@@ -115,6 +115,14 @@ void PointConnections::check_nodes(const physics::NodeTable& nodes) const {
   for (const Item& it : items_) it.dofs.check_nodes(nodes, it.owner());
 }
 
+Index PointConnections::remove_dangling(const physics::NodeTable& nodes) {
+  const auto before = items_.size();
+  std::erase_if(items_, [&](const Item& it) { return it.dofs.touches_removed(nodes); });
+  const auto removed = static_cast<Index>(before - items_.size());
+  if (removed > 0) touch_topology();
+  return removed;
+}
+
 void PointConnections::remap_nodes(std::span<const Index> old_to_new) {
   // Both the DOF table and the connection's own node ids (its sides, joint and layout), so that
   // errors name the current nodes.

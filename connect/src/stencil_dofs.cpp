@@ -90,6 +90,10 @@ void StencilDofs::check_nodes(const physics::NodeTable& nodes, const std::string
                        (d.id < nodes.size() ? ", which was removed" : ", out of range"));
 }
 
+bool StencilDofs::touches_removed(const physics::NodeTable& nodes) const {
+  return std::any_of(dofs_.begin(), dofs_.end(), [&](const Dof& d) { return !d.angle && !nodes.is_alive(d.id); });
+}
+
 void StencilDofs::remap_nodes(std::span<const Index> old_to_new) {
   for (Dof& d : dofs_)
     if (!d.angle) d.id = old_to_new[d.id];

@@ -249,5 +249,50 @@ TEST_CASE("curve connections term: a plate split along a line and rejoined by a 
   CHECK(stiff > whole);                                     // and is stiffer than the plate it replaces
 }
 
+TEST_CASE("curve connections term: removing nodes in random order removes exactly the connections they held") {
+  // A line of 8 edges (nodes 0..8 along x), each with a face above (apex 9 + i) and below
+  // (apex 17 + i): one connection per edge. Nodes removed one by one at random, the rule
+  // applied, the table compacted: what remains is exactly the connections whose four nodes all
+  // survive, renumbered, with finite energy; never one left referring to a removed node.
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    physics::System sys;
+    for (int i = 0; i <= 8; ++i) (void)sys.nodes().add(Vec3(0.1 * i, 0, 0), Vec3::Zero(), 1.0);
+    for (int i = 0; i < 8; ++i) (void)sys.nodes().add(Vec3(0.1 * i + 0.05, 0.05, 0.02), Vec3::Zero(), 1.0);
+    for (int i = 0; i < 8; ++i) (void)sys.nodes().add(Vec3(0.1 * i + 0.05, -0.05, 0.01), Vec3::Zero(), 1.0);
+    auto& curve = sys.add<CurveConnections>(nullptr);
+    for (int i = 0; i < 8; ++i)
+      (void)curve.add("edge " + std::to_string(i), Index(i), Index(i + 1), FaceSide{Index(9 + i)}, FaceSide{Index(17 + i)}, 1.0,
+                      sys.state());
+    std::vector<Index> original(25);  // original id of each current node
+    for (Index k = 0; k < 25; ++k) original[k] = k;
+    std::vector<bool> gone(25, false);
+    std::mt19937 rng(seed);
+    for (int round = 0; round < 6; ++round) {
+      const Index victim = std::uniform_int_distribution<Index>(0, sys.nodes().size() - 1)(rng);
+      gone[original[victim]] = true;
+      sys.nodes().remove(victim);
+      (void)curve.remove_dangling(sys.nodes());
+      const std::vector<Index> map = sys.compact_nodes();
+      std::vector<Index> next(sys.nodes().size());
+      for (Index k = 0; k < map.size(); ++k)
+        if (map[k] != physics::invalid_index) next[map[k]] = original[k];
+      original = next;
+      std::vector<std::string> expected, kept;
+      for (int i = 0; i < 8; ++i)
+        if (!gone[i] && !gone[i + 1] && !gone[9 + i] && !gone[17 + i]) expected.push_back("edge " + std::to_string(i));
+      for (Index c = 0; c < curve.size(); ++c) {
+        kept.push_back(curve.connection(c).name());
+        const int i = std::stoi(curve.connection(c).name().substr(5));
+        const std::vector<Index> want{Index(i), Index(i + 1), Index(9 + i), Index(17 + i)};
+        std::vector<Index> now;
+        for (Index v : curve.connection(c).stencil_nodes()) now.push_back(original[v]);
+        CHECK(now == want);  // renumbered onto the same nodes
+      }
+      CHECK(kept == expected);
+      CHECK(std::isfinite(curve.potential_energy(sys.state())));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace test_curve_term

@@ -252,6 +252,16 @@ TEST_CASE("point connections term: compaction renumbers the connection's own nod
   CHECK((c.position_nodes() == std::vector<Index>{0, 3, 3, 5, 6}));
 }
 
+TEST_CASE("point connections term: a connection whose node is removed goes with it, the table compacts") {
+  RodInShell s(TwistUpdate::incremental_ii);
+  CHECK(s.joint->remove_dangling(s.sys.nodes()) == 0);  // nothing removed: kept
+  s.sys.nodes().remove(3);                               // a corner of the triangle side
+  CHECK_THROWS_WITH_AS(s.joint->check_nodes(s.sys.nodes()), doctest::Contains("point connection 'rod in shell' refers to node 3"),
+                       physics::InputError);  // without the rule, compaction refuses it by name
+  CHECK(s.joint->remove_dangling(s.sys.nodes()) == 1);
+  CHECK(s.joint->size() == 0);
+}
+
 TEST_CASE("point connections term: a rod side needs the rods' twist as angle DOFs") {
   physics::System sys;
   const Index a = sys.nodes().add(Vec3(0, 0, 0), Vec3::Zero(), 1.0);

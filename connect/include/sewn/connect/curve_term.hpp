@@ -32,6 +32,12 @@ class CurveConnections final : public physics::ForceTerm {
   Index add(const std::string& name, Index a, Index b, const EdgeSideRef& m, const EdgeSideRef& n, double k_per_length,
             const physics::StateView& s);
   [[nodiscard]] Index size() const { return static_cast<Index>(items_.size()); }
+  /// The rule when nodes go (a cut or a refinement removing them): a connection with a removed
+  /// node in its stencil is removed with it (one of its sides no longer exists there), every
+  /// other one is kept as it is; so none is left dangling. Call it after removing nodes and before
+  /// System::compact_nodes(), whose node check otherwise refuses the connection by name. Returns
+  /// how many were removed. O(connections).
+  Index remove_dangling(const physics::NodeTable& nodes);
   [[nodiscard]] const EdgeConnection& connection(Index c) const { return items_.at(c).connection; }
   /// Values of connection c at state s. O(1).
   [[nodiscard]] EdgeEval evaluate(Index c, const physics::StateView& s) const;

@@ -69,6 +69,12 @@ class PointConnections final : public physics::ForceTerm {
   /// constructor refuses. Returns the connection's index. O(1).
   Index add(const std::string& name, const SideRef& m, const SideRef& n, PointStiffness k, const physics::StateView& s);
   [[nodiscard]] Index size() const { return static_cast<Index>(items_.size()); }
+  /// The rule when nodes go (a cut or a refinement removing them): a connection with a removed
+  /// node in its stencil is removed with it (one of its sides no longer exists there), every
+  /// other one is kept as it is; so none is left dangling. Call it after removing nodes and before
+  /// System::compact_nodes(), whose node check otherwise refuses the connection by name. Returns
+  /// how many were removed. O(connections).
+  Index remove_dangling(const physics::NodeTable& nodes);
   [[nodiscard]] const PointConnection& connection(Index c) const { return items_.at(c).connection; }
   /// Values of connection c at state s (energy, angles, flags). O(1).
   [[nodiscard]] PointEval evaluate(Index c, const physics::StateView& s) const;

@@ -36,6 +36,8 @@ class StencilDofs {
   /// Throws physics::InputError naming `owner` if a node is removed or out of range.
   void check_nodes(const physics::NodeTable& nodes, const std::string& owner) const;
   void remap_nodes(std::span<const physics::Index> old_to_new);
+  /// True if a node of the stencil is removed (or out of range) in `nodes`.
+  [[nodiscard]] bool touches_removed(const physics::NodeTable& nodes) const;
 
  private:
   struct Dof {
