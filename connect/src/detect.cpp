@@ -162,22 +162,29 @@ FoundConnections detect_connections(const CellList& cells) {
     for (auto i = comps.begin(); i != comps.end(); ++i)
       for (auto j = std::next(i); j != comps.end(); ++j) f(*i, *j);
   };
-  for (const auto& [f, comps] : at_face)
-    for_pairs(comps, [&](std::uint32_t a, std::uint32_t b) {
+  // (no structured bindings below: clang 14 cannot capture them in the lambdas)
+  for (const auto& entry : at_face) {
+    const Face& f = entry.first;
+    for_pairs(entry.second, [&](std::uint32_t a, std::uint32_t b) {
       record(ConnectionKind::surface, {f[0], f[1], f[2]}, a, b);
       for (const Edge& e : edges_of(f)) covered_edges.insert({a, b, e[0], e[1]});
       for (std::uint32_t v : f) covered_points.insert({a, b, v});
     });
-  for (const auto& [e, comps] : at_edge)
-    for_pairs(comps, [&](std::uint32_t a, std::uint32_t b) {
+  }
+  for (const auto& entry : at_edge) {
+    const Edge& e = entry.first;
+    for_pairs(entry.second, [&](std::uint32_t a, std::uint32_t b) {
       if (covered_edges.count({a, b, e[0], e[1]})) return;
       record(ConnectionKind::curve, {e[0], e[1]}, a, b);
       for (std::uint32_t v : e) covered_points.insert({a, b, v});
     });
-  for (const auto& [v, comps] : at_point)
-    for_pairs(comps, [&](std::uint32_t a, std::uint32_t b) {
+  }
+  for (const auto& entry : at_point) {
+    const std::uint32_t v = entry.first;
+    for_pairs(entry.second, [&](std::uint32_t a, std::uint32_t b) {
       if (!covered_points.count({a, b, v})) record(ConnectionKind::point, {v}, a, b);
     });
+  }
   return out;
 }
 

@@ -118,7 +118,8 @@ TEST_CASE("curve connection: gradient and Hessian against central differences, e
   const std::vector<std::pair<Kind, Kind>> pairs{{Kind::rod, Kind::face},  {Kind::face, Kind::rod},   {Kind::face, Kind::face},
                                                  {Kind::hinge, Kind::face}, {Kind::rod, Kind::hinge}, {Kind::hinge, Kind::hinge},
                                                  {Kind::face, Kind::hinge}};
-  for (const auto& [m, n] : pairs)
+  for (const auto& kinds : pairs) {
+    const Kind m = kinds.first, n = kinds.second;  // named: clang 14 cannot capture bindings (INFO)
     for (TwistUpdate u : {TwistUpdate::direct, TwistUpdate::incremental_i, TwistUpdate::incremental_ii}) {
       const Eigen::VectorXd q0 = rest_state(m, n);
       EdgeConnection c("fd", 0, 1, make_side(m, 0), make_side(n, 1), k_line, q0);
@@ -137,10 +138,12 @@ TEST_CASE("curve connection: gradient and Hessian against central differences, e
       CHECK(worst_h < 1e-6);
       CHECK(worst_sym < 1e-12);
     }
+  }
 }
 
 TEST_CASE("curve connection: incremental angles past pi and 3 pi, derivatives exact there; the direct one wraps") {
-  for (const auto& [m, n] : {std::pair{Kind::rod, Kind::face}, std::pair{Kind::hinge, Kind::face}}) {
+  for (const auto& kinds : {std::pair{Kind::rod, Kind::face}, std::pair{Kind::hinge, Kind::face}}) {
+    const Kind m = kinds.first, n = kinds.second;  // named: clang 14 cannot capture bindings (INFO)
     const Eigen::VectorXd q0 = rest_state(m, n);
     EdgeConnection inc_i("i", 0, 1, make_side(m, 0), make_side(n, 1), k_line, q0);
     EdgeConnection inc_ii("ii", 0, 1, make_side(m, 0), make_side(n, 1), k_line, q0);
@@ -208,7 +211,8 @@ TEST_CASE("curve connection: a twisted curve's energy does not depend on how man
 TEST_CASE("curve connection: rigid motions give zero energy and force; translations sum the forces to zero") {
   std::mt19937 rng(3);
   std::normal_distribution<double> noise(0, 0.05);
-  for (const auto& [m, n] : {std::pair{Kind::face, Kind::face}, std::pair{Kind::hinge, Kind::face}, std::pair{Kind::hinge, Kind::hinge}}) {
+  for (const auto& kinds : {std::pair{Kind::face, Kind::face}, std::pair{Kind::hinge, Kind::face}, std::pair{Kind::hinge, Kind::hinge}}) {
+    const Kind m = kinds.first, n = kinds.second;  // named: clang 14 cannot capture bindings (INFO)
     const Eigen::VectorXd q0 = rest_state(m, n);
     const EdgeConnection c("rigid", 0, 1, make_side(m, 0), make_side(n, 1), k_line, q0);
     const Eigen::Matrix3d R = Eigen::AngleAxisd(2.1, Vec3(0.3, -1, 0.5).normalized()).toRotationMatrix();

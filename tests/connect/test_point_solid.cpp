@@ -101,7 +101,8 @@ TEST_CASE("point connection, solid side: rest state, orientation, derivatives ag
   std::uniform_real_distribution<double> noise(-0.08, 0.08);
   const std::vector<std::pair<Kind, Kind>> pairs{
       {Kind::rod, Kind::tet}, {Kind::tet, Kind::rod}, {Kind::triangle, Kind::tet}, {Kind::tet, Kind::upper_tet}};
-  for (const auto& [m, n] : pairs) {
+  for (const auto& kinds : pairs) {
+    const Kind m = kinds.first, n = kinds.second;  // named: clang 14 cannot capture bindings (INFO)
     const Side sm = make_side(m), sn = make_side(n);
     const VectorXd q0 = rest_q(sm, sn);
     const PointConnection c("solid", sm, sn, {2.0, 3.0}, q0);
@@ -134,7 +135,8 @@ TEST_CASE("point connection, solid side: rest state, orientation, derivatives ag
 }
 
 TEST_CASE("point connection, solid side: rigid motions cost nothing, a twist of the rod costs k_t phi^2 / 2") {
-  for (const auto& [m, n] : {std::pair{Kind::tet, Kind::upper_tet}, std::pair{Kind::triangle, Kind::tet}}) {
+  for (const auto& kinds : {std::pair{Kind::tet, Kind::upper_tet}, std::pair{Kind::triangle, Kind::tet}}) {
+    const Kind m = kinds.first, n = kinds.second;  // named: clang 14 cannot capture bindings (INFO)
     const Side sm = make_side(m), sn = make_side(n);
     const VectorXd q0 = rest_q(sm, sn);
     const PointConnection c("rigid", sm, sn, {2.0, 3.0}, q0);
