@@ -129,8 +129,9 @@ EdgeConnection::EdgeConnection(std::string name, Index a, Index b, EdgeSide m, E
   if (!(rest_length_ > 0)) fail_edge(name_, "the edge has zero length at rest");
   const EdgeEval e = evaluate(q_rest, TwistUpdate::direct, false);
   if (e.degenerate)
-    fail_edge(name_, "no frame can be built at rest (a zero-area triangle, a hinge folded flat onto itself, or a rod "
-                "frame turned against its edge) on " + describe(m_) + " or " + describe(n_));
+    fail_edge(name_, "no frame can be built at rest (a zero-area triangle, a hinge folded flat onto itself or whose two "
+                     "triangles are not consistently oriented, or a rod frame turned against its edge) on " +
+                         describe(m_) + " or " + describe(n_));
   rest_twist_ = e.twist_raw;
   if (std::abs(rest_twist_) > std::numbers::pi / 2) {  // the orientation rule
     sign_n_ = -1;
