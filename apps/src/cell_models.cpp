@@ -117,4 +117,34 @@ SimulatedComplex simulated_complex(const IndexedMesh& mesh, const std::vector<Ce
   return out;
 }
 
+MeshConnections mesh_connections(const IndexedMesh& mesh, const std::vector<CellModel>& models) {
+  MeshConnections out;
+  connect::CellList cells;
+  for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
+    if (models[c] == CellModel::label) continue;
+    const CellType t = mesh.types[c];
+    if (t != CellType::segment && t != CellType::triangle && t != CellType::tetrahedron) {
+      out.skipped = "cell " + std::to_string(c) + " is not a segment, triangle or tetrahedron";
+      return out;
+    }
+    cells.add(t == CellType::segment ? connect::Body::rod : t == CellType::triangle ? connect::Body::shell : connect::Body::solid,
+              mesh.cell(c));
+  }
+  out.found = connect::detect_connections(cells);
+  return out;
+}
+
+nlohmann::json connections_json(const MeshConnections& c) {
+  if (!c.skipped.empty()) return {{"skipped", c.skipped}};
+  nlohmann::json j = nlohmann::json::object();
+  for (int k = 0; k < 3; ++k) {
+    nlohmann::json per = nlohmann::json::object();
+    for (int p = 0; p < connect::num_body_pairs; ++p)
+      if (const auto n = c.found.counts[static_cast<std::size_t>(k)][static_cast<std::size_t>(p)]) per[connect::body_pair_name(p)] = n;
+    j[connect::to_string(static_cast<connect::ConnectionKind>(k))] = per;
+  }
+  j["components"] = c.found.component_body.size();
+  return j;
+}
+
 }  // namespace sewn::app

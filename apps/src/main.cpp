@@ -168,6 +168,9 @@ int cmd_run(const std::vector<std::string>& args) {
     if (!s.checkpoint.empty()) std::printf("; checkpoint: %s", s.checkpoint.string().c_str());
     if (s.stopped) std::printf("; stopped after the checkpoint (continue with --resume)");
     std::printf("\n");
+    if (!s.connections.empty())
+      std::printf("connections found between the bodies (positions shared; no rotational energies in the scene yet):\n%s",
+                  s.connections.c_str());
   }
   return ok;
 }
@@ -201,6 +204,16 @@ void print_simulated(const sewn::app::SimulatedComplex& sc, const sewn::io::Mesh
   static const char* kinds[] = {"", "segments", "surface cells", "volumes"};
   for (const auto& l : sc.labels)
     std::fprintf(out, "  tag %d%s: %u %s\n", l.tag, tag_name(file, l.tag, l.dimension).c_str(), l.cells, kinds[l.dimension]);
+}
+
+// Where the bodies meet (connect/detect.hpp), cells taken by dimension as model `mixed` does.
+void print_connections(const sewn::app::MeshConnections& c, std::FILE* out) {
+  if (!c.skipped.empty()) {
+    std::fprintf(out, "connections: not computed: %s\n", c.skipped.c_str());
+    return;
+  }
+  std::fprintf(out, "connections (segments as rods, triangles as shells, tetrahedra as solids; %zu components):\n%s",
+               c.found.component_body.size(), sewn::connect::connections_text(c.found).c_str());
 }
 
 nlohmann::json simulated_json(const sewn::app::SimulatedComplex& sc) {
@@ -237,6 +250,8 @@ int cmd_check(const std::vector<std::string>& args) {
   const auto models = default_models(read);
   const sewn::app::SimulatedComplex simulated = sewn::app::simulated_complex(read, models);
   print_simulated(simulated, file, out);
+  const sewn::app::MeshConnections connections = sewn::app::mesh_connections(read, models);
+  print_connections(connections, out);
   const sewn::IndexedMesh mesh = simulated_cells(read, models);
   bool sound = true;
   const auto issues = sewn::io::find_geometry_issues(mesh, path);
@@ -266,6 +281,7 @@ int cmd_check(const std::vector<std::string>& args) {
   if (json) {
     nlohmann::json j = sewn::app::topology_json(topo);
     j["simulated"] = simulated_json(simulated);
+    j["connections"] = sewn::app::connections_json(connections);
     std::cout << j.dump(1) << "\n";
   }
   return sound ? ok : bad_input;

@@ -249,6 +249,12 @@ void split_elongated(const Scene& scene, Assembly& a) {
   a.split_cells = split.split;
 }
 
+// What the report says of where a mixed model's bodies meet.
+std::string connections_line(const Assembly& a) {
+  const MeshConnections c = mesh_connections(a.mesh, a.model_of_cell);
+  return c.skipped.empty() ? connect::connections_text(c.found) : "  not computed: " + c.skipped + "\n";
+}
+
 }  // namespace
 
 Assembly assemble(const Scene& scene) {
@@ -327,6 +333,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
 
   // 1) the bodies and the model
   Assembly assembly = assemble(scene);
+  if (scene.model == "mixed") sum.connections = connections_line(assembly);
   std::vector<physics::MaterialParams> materials;
   for (const auto& name : assembly.material_names) {
     const MaterialSpec& ms = scene.materials.at(name);

@@ -1,40 +1,34 @@
 #include "sewn/connect/point.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
 #include <sstream>
 
-#include <unsupported/Eigen/AutoDiff>
-
+#include "jet.hpp"
 #include "sewn/physics/rods/stencils.hpp"
 
 namespace sewn::connect {
 
 namespace {
 
+using detail::signed_angle;
+using detail::transport;
+using detail::V3;
+using detail::value_of;
+using detail::vec_at;
 using physics::InputError;
-using physics::rods::transport_exact;
 
-constexpr int max_dofs = 18;  // triangle + triangle
 constexpr double two_pi = 2 * std::numbers::pi;
-using AD = Eigen::AutoDiffScalar<Eigen::Matrix<double, max_dofs, 1>>;
-using AD2 = Eigen::AutoDiffScalar<Eigen::Matrix<AD, max_dofs, 1>>;  // second order: AD of AD
-template <class T>
-using V3 = Eigen::Matrix<T, 3, 1>;
-
-// The chained Hessian's scalars: a side's frame in ≤ 9 directions, the core in 12.
-constexpr int side_dofs_max = 9;
-using S1 = Eigen::AutoDiffScalar<Eigen::Matrix<double, side_dofs_max, 1>>;
-using S2 = Eigen::AutoDiffScalar<Eigen::Matrix<S1, side_dofs_max, 1>>;
-using C1 = Eigen::AutoDiffScalar<Eigen::Matrix<double, 12, 1>>;
-using C2 = Eigen::AutoDiffScalar<Eigen::Matrix<C1, 12, 1>>;
-
-double value_of(double v) { return v; }
-template <class D>
-double value_of(const Eigen::AutoDiffScalar<D>& v) {
-  return value_of(v.value());
-}
+// Forward AD over the whole stencil, in as many directions as it needs: 18 (rod or triangle
+// sides) or 24 (a tet side); first order (gradients), second (the reference Hessian).
+constexpr int max_dofs = 24;  // tet + tet
+// The chained Hessian's scalars: a side's frame in 9 (rod, triangle) or 12 (tet) directions,
+// the core in 12.
+constexpr int side_dofs_max = 12;
+using C2 = detail::Jet<12, true>;
+using Coef = std::array<double, 6>;
 
 [[noreturn]] void fail(const std::string& name, const std::string& why) {
   throw InputError("point connection '" + name + "': " + why);
@@ -42,22 +36,28 @@ double value_of(const Eigen::AutoDiffScalar<D>& v) {
 
 std::string describe(const Side& s) {
   std::ostringstream o;
-  if (const auto* r = std::get_if<RodEdgeSide>(&s))
+  if (const auto* r = std::get_if<RodEdgeSide>(&s)) {
     o << "rod edge (" << r->from << ", " << r->to << ")";
-  else {
-    const auto& t = std::get<TriangleSide>(s);
-    o << "triangle (" << t.nodes[0] << ", " << t.nodes[1] << ", " << t.nodes[2] << ")";
+  } else if (const auto* t = std::get_if<TriangleSide>(&s)) {
+    o << "triangle (" << t->nodes[0] << ", " << t->nodes[1] << ", " << t->nodes[2] << ")";
+  } else {
+    const auto& k = std::get<TetSide>(s);
+    o << "tetrahedron (" << k.nodes[0] << ", " << k.nodes[1] << ", " << k.nodes[2] << ", " << k.nodes[3] << ")";
   }
   return o.str();
 }
 
 std::vector<Index> side_nodes(const Side& s) {
   if (const auto* r = std::get_if<RodEdgeSide>(&s)) return {r->from, r->to};
-  const auto& t = std::get<TriangleSide>(s);
-  return {t.nodes.begin(), t.nodes.end()};
+  if (const auto* t = std::get_if<TriangleSide>(&s)) return {t->nodes.begin(), t->nodes.end()};
+  const auto& k = std::get<TetSide>(s);
+  return {k.nodes.begin(), k.nodes.end()};
 }
 
-int side_dofs(const Side& s) { return std::holds_alternative<RodEdgeSide>(s) ? 7 : 9; }
+int side_dofs(const Side& s) {
+  if (std::holds_alternative<RodEdgeSide>(s)) return 7;
+  return std::holds_alternative<TriangleSide>(s) ? 9 : 12;
+}
 
 // The one node both sides hold; rejects sides that are degenerate or share 0 or 2+ nodes.
 Index shared_node(const std::string& name, const Side& m, const Side& n) {
@@ -78,10 +78,22 @@ Index shared_node(const std::string& name, const Side& m, const Side& n) {
   return common[0];
 }
 
-// A triangle side with its nodes rotated to start at the joint (orientation kept).
+// A triangle side with its nodes rotated to start at the joint (orientation kept); a tet's
+// joint moved to the front, the others in order.
 TriangleSide rotated(TriangleSide t, Index joint) {
   while (t.nodes[0] != joint) t.nodes = {t.nodes[1], t.nodes[2], t.nodes[0]};
   return t;
+}
+TetSide rotated(TetSide t, Index joint) {
+  const auto at = std::find(t.nodes.begin(), t.nodes.end(), joint);
+  std::rotate(t.nodes.begin(), at, at + 1);
+  return t;
+}
+// Side s with its nodes starting at the joint.
+Side rotated(const Side& s, Index joint) {
+  if (const auto* t = std::get_if<TriangleSide>(&s)) return rotated(*t, joint);
+  if (const auto* k = std::get_if<TetSide>(&s)) return rotated(*k, joint);
+  return s;
 }
 
 template <class T>
@@ -89,29 +101,39 @@ struct Frame {
   V3<T> m1, m2, m3;
 };
 
-// The side's frame from its stencil slice q (7 or 9 entries), axis sign and triangle coefficients.
+// The side's frame from the stencil q, its DOFs from offset `at`, axis sign and triangle coefficients.
 template <class T, class Q>
-Frame<T> build_frame(const Side& side, const Q& q, double sign, const std::array<double, 2>& coef) {
+Frame<T> build_frame(const Side& side, const Q& q, int at, double sign, const Coef& coef) {
+  using detail::cross;
+  using detail::dot;
   using std::cos;
   using std::sin;
   using std::sqrt;
   Frame<T> f;
   if (const auto* r = std::get_if<RodEdgeSide>(&side)) {
-    const V3<T> e = q.template segment<3>(3) - q.template segment<3>(0);
-    const V3<T> t = e / sqrt(e.dot(e));
-    const V3<T> a1 = transport_exact<T>(r->tangent.cast<T>(), t, r->director.cast<T>());
-    const V3<T> a2 = t.cross(a1);
-    f.m1 = cos(q[6]) * a1 + sin(q[6]) * a2;
+    const V3<T> t = detail::normalized(vec_at<T>(q, at + 3) - vec_at<T>(q, at));
+    const V3<T> tb = detail::constant<T>(r->tangent.x(), r->tangent.y(), r->tangent.z());
+    const V3<T> db = detail::constant<T>(r->director.x(), r->director.y(), r->director.z());
+    const V3<T> a1 = transport(tb, t, db);
+    const V3<T> a2 = cross(t, a1);
+    f.m1 = cos(q[at + 6]) * a1 + sin(q[at + 6]) * a2;
     f.m3 = T(sign) * t;
+  } else if (std::holds_alternative<TetSide>(side)) {
+    const V3<T> x0 = vec_at<T>(q, at);
+    const V3<T> c1 = vec_at<T>(q, at + 3) - x0, c2 = vec_at<T>(q, at + 6) - x0, c3 = vec_at<T>(q, at + 9) - x0;
+    const V3<T> a = coef[0] * c1 + coef[1] * c2 + coef[2] * c3;  // F m̄3
+    const V3<T> b = coef[3] * c1 + coef[4] * c2 + coef[5] * c3;  // F m̄1
+    const V3<T> m3 = detail::normalized(a);
+    f.m1 = detail::normalized(b - dot(b, m3) * m3);
+    f.m3 = T(sign) * m3;
   } else {
-    const V3<T> e1 = q.template segment<3>(3) - q.template segment<3>(0);
-    const V3<T> e2 = q.template segment<3>(6) - q.template segment<3>(0);
-    const V3<T> nrm = e1.cross(e2);
-    f.m1 = nrm / sqrt(nrm.dot(nrm));
+    const V3<T> e1 = vec_at<T>(q, at + 3) - vec_at<T>(q, at);
+    const V3<T> e2 = vec_at<T>(q, at + 6) - vec_at<T>(q, at);
+    f.m1 = detail::normalized(cross(e1, e2));
     const V3<T> axis = T(coef[0]) * e1 + T(coef[1]) * e2;
-    f.m3 = (T(sign) / sqrt(axis.dot(axis))) * axis;
+    f.m3 = (T(sign) / sqrt(dot(axis, axis))) * axis;
   }
-  f.m2 = f.m3.cross(f.m1);
+  f.m2 = cross(f.m3, f.m1);
   return f;
 }
 
@@ -123,28 +145,29 @@ struct SideJet {
   std::array<Eigen::Matrix<double, side_dofs_max, side_dofs_max>, 6> hessian;
 };
 
-SideJet side_jet(const Side& side, const Eigen::VectorXd& qs, double sign, const std::array<double, 2>& coef) {
-  Eigen::Matrix<S2, side_dofs_max, 1> qa;
-  for (int i = 0; i < side_dofs_max; ++i) {
-    qa[i].value() = S1(i < qs.size() ? qs[i] : 0.0, side_dofs_max, i);
-    qa[i].derivatives() = Eigen::Matrix<S1, side_dofs_max, 1>::Constant(S1(0.0));
-    qa[i].derivatives()[i] = S1(1.0);
-  }
-  const Frame<S2> f = build_frame<S2>(side, qa, sign, coef);
+template <int N>
+SideJet side_jet_n(const Side& side, const Eigen::VectorXd& q, int at, int dofs, double sign, const Coef& coef) {
+  using S2 = detail::Jet<N, true>;
+  std::array<S2, side_dofs_max> qa;  // sized for any side, so no path reads past it
+  for (int i = 0; i < dofs; ++i) qa[static_cast<std::size_t>(i)] = S2::variable(q[at + i], i);
+  const Frame<S2> f = build_frame<S2>(side, qa, 0, sign, coef);
   SideJet jet;
+  jet.jacobian.setZero();
+  const std::array<const S2*, 6> out{&f.m1.x, &f.m1.y, &f.m1.z, &f.m3.x, &f.m3.y, &f.m3.z};
   for (int k = 0; k < 6; ++k) {
-    const S2& v = k < 3 ? f.m1[k] : f.m3[k - 3];
-    jet.value[k] = v.value().value();
-    jet.jacobian.row(k) = v.value().derivatives().transpose();
-    for (int j = 0; j < side_dofs_max; ++j) jet.hessian[static_cast<std::size_t>(k)].row(j) = v.derivatives()[j].derivatives().transpose();
+    const S2& v = *out[static_cast<std::size_t>(k)];
+    jet.value[k] = v.v;
+    jet.hessian[static_cast<std::size_t>(k)].setZero();
+    for (int i = 0; i < N; ++i) {
+      jet.jacobian(k, i) = v.g[static_cast<std::size_t>(i)];
+      for (int j = 0; j < N; ++j) jet.hessian[static_cast<std::size_t>(k)](i, j) = v.hessian(i, j);
+    }
   }
   return jet;
 }
-
-template <class T>
-T signed_angle_t(const V3<T>& u, const V3<T>& v, const V3<T>& axis) {
-  using std::atan2;
-  return atan2(u.cross(v).dot(axis), u.dot(v));
+// In as few directions as the side needs.
+SideJet side_jet(const Side& side, const Eigen::VectorXd& q, int at, int dofs, double sign, const Coef& coef) {
+  return dofs <= 9 ? side_jet_n<9>(side, q, at, dofs, sign, coef) : side_jet_n<12>(side, q, at, dofs, sign, coef);
 }
 
 template <class T>
@@ -173,13 +196,8 @@ std::vector<Index> stencil_layout(const std::string& name, const Side& m, const 
   const Index joint = shared_node(name, m, n);
   std::vector<Index> out;
   for (const Side* s : {&m, &n}) {
-    if (std::holds_alternative<TriangleSide>(*s)) {
-      const auto t = rotated(std::get<TriangleSide>(*s), joint);
-      out.insert(out.end(), t.nodes.begin(), t.nodes.end());
-    } else {
-      const auto v = side_nodes(*s);
-      out.insert(out.end(), v.begin(), v.end());
-    }
+    const auto v = side_nodes(rotated(*s, joint));
+    out.insert(out.end(), v.begin(), v.end());
   }
   return out;
 }
@@ -198,8 +216,21 @@ PointConnection::PointConnection(std::string name, Side m, Side n, PointStiffnes
                     std::to_string(num_dofs()));
   if (!q_rest.allFinite()) fail(name_, "rest configuration is not finite");
 
-  // Per side: geometry checks, the triangle axis coefficients, the into/out-of-joint sign.
-  auto prepare = [&](Side& s, const Eigen::VectorXd& q, std::array<double, 2>& coef, double into_joint) -> double {
+  // A tet side: checks, and Dm⁻¹m̄3, Dm⁻¹m̄1 (F m̄ = Ds Dm⁻¹ m̄ at any state).
+  auto prepare_tet = [&](const TetSide& k, const Eigen::VectorXd& q, Coef& coef) {
+    if (!k.rest_axis.allFinite() || !(k.rest_axis.norm() > 0)) fail(name_, describe(k) + ": rest axis is zero or not finite");
+    Eigen::Matrix3d Dm;
+    for (int c = 0; c < 3; ++c) Dm.col(c) = q.segment<3>(3 * (c + 1)) - q.segment<3>(0);
+    const double scale = Dm.col(0).norm() * Dm.col(1).norm() * Dm.col(2).norm();
+    if (!(std::abs(Dm.determinant()) > 1e-12 * scale))
+      fail(name_, describe(k) + " has zero volume at rest: no frame can be built on it");
+    const Vec3 m3 = k.rest_axis.normalized(), m1 = physics::rods::any_perpendicular(m3);
+    const Eigen::Matrix3d inv = Dm.inverse();
+    const Vec3 w3 = inv * m3, w1 = inv * m1;
+    coef = {w3[0], w3[1], w3[2], w1[0], w1[1], w1[2]};
+  };
+  // Per side: geometry checks, the frame constants, the into/out-of-joint sign.
+  auto prepare = [&](Side& s, const Eigen::VectorXd& q, Coef& coef, double into_joint) -> double {
     if (auto* r = std::get_if<RodEdgeSide>(&s)) {
       const Vec3 e = q.segment<3>(3) - q.segment<3>(0);
       if (!(e.norm() > 0)) fail(name_, describe(s) + " has zero length at rest");
@@ -208,6 +239,13 @@ PointConnection::PointConnection(std::string name, Side m, Side n, PointStiffnes
         fail(name_, describe(s) + ": its stored tangent and director are not an orthonormal pair");
       const double out_sign = (r->from == joint_) ? 1.0 : -1.0;  // t points out of the joint if it starts there
       return into_joint * out_sign;
+    }
+    if (auto* k = std::get_if<TetSide>(&s)) {
+      *k = rotated(*k, joint_);
+      prepare_tet(*k, q, coef);
+      // The rest axis points out of the solid, so the body lies along −axis (a triangle's lies
+      // along its axis): a rod standing on the surface continues the solid's axis straight.
+      return -into_joint;
     }
     auto& t = std::get<TriangleSide>(s);
     t = rotated(t, joint_);
@@ -233,13 +271,12 @@ PointConnection::PointConnection(std::string name, Side m, Side n, PointStiffnes
   const Eigen::VectorXd qm = q_rest.head(dofs_m_), qn = q_rest.tail(dofs_n_);
   sign_m_ = prepare(m_, qm, coef_m_, -1.0);
   sign_n_ = prepare(n_, qn, coef_n_, 1.0);
-  const auto fm = build_frame<double>(m_, qm, sign_m_, coef_m_);
-  const auto fn = build_frame<double>(n_, qn, sign_n_, coef_n_);
-  if (fm.m3.dot(fn.m3) < 0) sign_n_ = -sign_n_;
-  const auto fn2 = build_frame<double>(n_, qn, sign_n_, coef_n_);
-  rest_d_ = Vec3(fn2.m3.dot(fm.m1), fn2.m3.dot(fm.m2), fn2.m3.dot(fm.m3));
-  const Vec3 u = transport_exact<double>(fm.m3, fn2.m3, fm.m1);
-  rest_twist_ = signed_angle_t<double>(u, fn2.m1, fn2.m3);
+  const auto fm = build_frame<double>(m_, qm, 0, sign_m_, coef_m_);
+  const auto fn = build_frame<double>(n_, qn, 0, sign_n_, coef_n_);
+  if (detail::dot(fm.m3, fn.m3) < 0) sign_n_ = -sign_n_;
+  const auto fn2 = build_frame<double>(n_, qn, 0, sign_n_, coef_n_);
+  rest_d_ = Vec3(detail::dot(fn2.m3, fm.m1), detail::dot(fn2.m3, fm.m2), detail::dot(fn2.m3, fm.m3));
+  rest_twist_ = signed_angle(transport(fm.m3, fn2.m3, fm.m1), fn2.m1, fn2.m3);
   accepted_twist_ = rest_twist_;
 }
 
@@ -251,74 +288,92 @@ PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update
   PointEval out;
   // Frames → energy and angles (everything after the frame constructions).
   auto core = [&](const auto& fm, const auto& fn) {
-    using T = std::decay_t<decltype(fm.m1[0])>;
+    using T = std::decay_t<decltype(fm.m1.x)>;
+    using detail::cross;
+    using detail::dot;
     using std::atan2;
     using std::cos;
     using std::sin;
     using std::sqrt;
     Core<T> c;
-    c.one_plus_c = 1 + value_of(fm.m3.dot(fn.m3));
-    const T raw = signed_angle_t<T>(transport_exact<T>(fm.m3, fn.m3, fm.m1), fn.m1, fn.m3);
+    c.one_plus_c = 1 + value_of(dot(fm.m3, fn.m3));
+    const T raw = signed_angle(transport(fm.m3, fn.m3, fm.m1), fn.m1, fn.m3);
     T delta = raw;
     if (update == TwistUpdate::incremental_i) {
       delta = raw + T(two_pi * std::round((accepted_twist_ - value_of(raw)) / two_pi));
     } else if (update == TwistUpdate::incremental_ii) {
       // Turn m1 by the accepted δ first: what is left to measure is the step's increment (< π).
       const V3<T> m1t = cos(T(accepted_twist_)) * fm.m1 + sin(T(accepted_twist_)) * fm.m2;
-      delta = T(accepted_twist_) + signed_angle_t<T>(transport_exact<T>(fm.m3, fn.m3, m1t), fn.m1, fn.m3);
+      delta = T(accepted_twist_) + signed_angle(transport(fm.m3, fn.m3, m1t), fn.m1, fn.m3);
     }
-    const V3<T> d(fn.m3.dot(fm.m1), fn.m3.dot(fm.m2), fn.m3.dot(fm.m3));
-    const V3<T> db = rest_d_.cast<T>();
-    const V3<T> cr = d.cross(db);
-    const T s2 = cr.dot(cr);
+    const V3<T> d{dot(fn.m3, fm.m1), dot(fn.m3, fm.m2), dot(fn.m3, fm.m3)};
+    const V3<T> db = detail::constant<T>(rest_d_.x(), rest_d_.y(), rest_d_.z());
+    const V3<T> cr = cross(d, db);
+    const T s2 = dot(cr, cr);
     T eb;
-    if (value_of(s2) < 1e-16 && value_of(d.dot(db)) > 0) {
+    if (value_of(s2) < 1e-16 && value_of(dot(d, db)) > 0) {
       // ω < 1e-8: |d − d̄|² = 2 − 2cos ω = ω² + O(ω⁴), and smooth where sqrt(s2) is not.
       const V3<T> dd = d - db;
-      eb = T(0.5 * k_.bend) * dd.dot(dd);
+      eb = (0.5 * k_.bend) * dot(dd, dd);
       c.bend = std::sqrt(value_of(s2));
     } else {
-      const T w = atan2(sqrt(s2), d.dot(db));
-      eb = T(0.5 * k_.bend) * w * w;
+      const T w = atan2(sqrt(s2), dot(d, db));
+      eb = (0.5 * k_.bend) * (w * w);
       c.bend = value_of(w);
     }
     const T dt = delta - T(rest_twist_);
-    c.energy = T(0.5 * k_.twist) * dt * dt + eb;
+    c.energy = (0.5 * k_.twist) * (dt * dt) + eb;
     c.twist = value_of(delta);
     c.twist_raw = value_of(raw);
     return c;
   };
   auto run = [&](const auto& qt) {
-    using T = typename std::decay_t<decltype(qt)>::Scalar;
-    return core(build_frame<T>(m_, qt.head(dofs_m_), sign_m_, coef_m_),
-                build_frame<T>(n_, qt.segment(dofs_m_, dofs_n_), sign_n_, coef_n_));
+    using T = std::decay_t<decltype(qt[0])>;
+    return core(build_frame<T>(m_, qt, 0, sign_m_, coef_m_), build_frame<T>(n_, qt, dofs_m_, sign_n_, coef_n_));
   };
+  // Whole-stencil forward AD in N directions, second order if H: the gradient (and Hessian) into
+  // out (and *hessian); the values returned.
+  auto whole = [&]<int N, bool H>() {
+    using J = detail::Jet<N, H>;
+    std::array<J, max_dofs> qa;  // sized for any stencil, so no path reads past it
+    for (int i = 0; i < num_dofs(); ++i) qa[static_cast<std::size_t>(i)] = J::variable(q[i], i);
+    const auto ca = run(qa);
+    out.gradient.resize(num_dofs());
+    if (H) hessian->resize(num_dofs(), num_dofs());
+    for (int i = 0; i < num_dofs(); ++i) {
+      out.gradient[i] = ca.energy.g[static_cast<std::size_t>(i)];
+      if (H)
+        for (int j = 0; j < num_dofs(); ++j) (*hessian)(i, j) = ca.energy.hessian(i, j);
+    }
+    return Core<double>{value_of(ca.energy), ca.twist, ca.twist_raw, ca.bend, ca.one_plus_c};
+  };
+  const bool wide = num_dofs() > 18;  // a tet side
   Core<double> c;
+  const Eigen::Index n = q.size();
   if (hessian && method == HessianMethod::chained) {
     // E(q) = C(F_m(q_m), F_n(q_n)) with F = (m1, m3) per side: ∇²E = Jᵀ C_FF J + Σ_k C_F[k] ∇²F_k,
     // J block-diagonal. Second-order AD of each side's frame (≤ 9 directions) and of the core
     // (12 directions) instead of the whole stencil at once (18).
-    const SideJet jm = side_jet(m_, q.head(dofs_m_), sign_m_, coef_m_);
-    const SideJet jn = side_jet(n_, q.tail(dofs_n_), sign_n_, coef_n_);
-    Eigen::Matrix<C2, 12, 1> F;
-    for (int i = 0; i < 12; ++i) {
-      F[i].value() = C1((i < 6 ? jm : jn).value[i % 6], 12, i);
-      F[i].derivatives() = Eigen::Matrix<C1, 12, 1>::Constant(C1(0.0));
-      F[i].derivatives()[i] = C1(1.0);
-    }
+    const SideJet jm = side_jet(m_, q, 0, dofs_m_, sign_m_, coef_m_);
+    const SideJet jn = side_jet(n_, q, dofs_m_, dofs_n_, sign_n_, coef_n_);
+    std::array<C2, 12> F;
+    for (int i = 0; i < 12; ++i) F[static_cast<std::size_t>(i)] = C2::variable((i < 6 ? jm : jn).value[i % 6], i);
     Frame<C2> fm, fn;
-    fm.m1 = F.segment<3>(0);
-    fm.m3 = F.segment<3>(3);
-    fm.m2 = fm.m3.cross(fm.m1);
-    fn.m1 = F.segment<3>(6);
-    fn.m3 = F.segment<3>(9);
-    fn.m2 = fn.m3.cross(fn.m1);
+    fm.m1 = {F[0], F[1], F[2]};
+    fm.m3 = {F[3], F[4], F[5]};
+    fm.m2 = detail::cross(fm.m3, fm.m1);
+    fn.m1 = {F[6], F[7], F[8]};
+    fn.m3 = {F[9], F[10], F[11]};
+    fn.m2 = detail::cross(fn.m3, fn.m1);
     const auto cc = core(fm, fn);
     c = {value_of(cc.energy), cc.twist, cc.twist_raw, cc.bend, cc.one_plus_c};
-    const Eigen::Matrix<double, 12, 1> eF = cc.energy.value().derivatives();
+    Eigen::Matrix<double, 12, 1> eF;
     Eigen::Matrix<double, 12, 12> eFF;
-    for (int j = 0; j < 12; ++j) eFF.row(j) = cc.energy.derivatives()[j].derivatives().transpose();
-    const Eigen::Index n = q.size(), dm = dofs_m_, dn = dofs_n_;
+    for (int i = 0; i < 12; ++i) {
+      eF[i] = cc.energy.g[static_cast<std::size_t>(i)];
+      for (int j = 0; j < 12; ++j) eFF(i, j) = cc.energy.hessian(i, j);
+    }
+    const Eigen::Index dm = dofs_m_, dn = dofs_n_;
     Eigen::MatrixXd J = Eigen::MatrixXd::Zero(12, n);
     J.topLeftCorner(6, dm) = jm.jacobian.leftCols(dm);
     J.bottomRightCorner(6, dn) = jn.jacobian.leftCols(dn);
@@ -329,24 +384,9 @@ PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update
       hessian->bottomRightCorner(dn, dn) += eF[6 + k] * jn.hessian[static_cast<std::size_t>(k)].topLeftCorner(dn, dn);
     }
   } else if (hessian) {
-    const Eigen::Index n = q.size();
-    Eigen::Matrix<AD2, Eigen::Dynamic, 1> qa(n);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      qa[i].value() = AD(q[i], max_dofs, static_cast<int>(i));
-      qa[i].derivatives() = Eigen::Matrix<AD, max_dofs, 1>::Constant(AD(0.0));
-      qa[i].derivatives()[i] = AD(1.0);
-    }
-    const auto ca = run(qa);
-    c = {value_of(ca.energy), ca.twist, ca.twist_raw, ca.bend, ca.one_plus_c};
-    out.gradient = ca.energy.value().derivatives().head(n);
-    hessian->resize(n, n);
-    for (Eigen::Index j = 0; j < n; ++j) hessian->row(j) = ca.energy.derivatives()[j].derivatives().head(n).transpose();
+    c = wide ? whole.template operator()<max_dofs, true>() : whole.template operator()<18, true>();
   } else if (want_gradient) {
-    Eigen::Matrix<AD, Eigen::Dynamic, 1> qa(q.size());
-    for (Eigen::Index i = 0; i < q.size(); ++i) qa[i] = AD(q[i], max_dofs, static_cast<int>(i));
-    const auto ca = run(qa);
-    c = {value_of(ca.energy), ca.twist, ca.twist_raw, ca.bend, ca.one_plus_c};
-    out.gradient = ca.energy.derivatives().head(q.size());
+    c = wide ? whole.template operator()<max_dofs, false>() : whole.template operator()<18, false>();
   } else {
     c = run(q);
   }
@@ -370,6 +410,22 @@ void PointConnection::accept(const Eigen::VectorXd& q, TwistUpdate update) {
   };
   advance(m_, q.head(dofs_m_));
   advance(n_, q.tail(dofs_n_));
+}
+
+void PointConnection::remap_nodes(std::span<const Index> old_to_new) {
+  auto map = [&](Index& i) { i = old_to_new[i]; };
+  map(joint_);
+  for (Index& i : nodes_) map(i);
+  for (Side* s : {&m_, &n_}) {
+    if (auto* r = std::get_if<RodEdgeSide>(s)) {
+      map(r->from);
+      map(r->to);
+    } else if (auto* t = std::get_if<TriangleSide>(s)) {
+      for (Index& i : t->nodes) map(i);
+    } else {
+      for (Index& i : std::get<TetSide>(*s).nodes) map(i);
+    }
+  }
 }
 
 }  // namespace sewn::connect

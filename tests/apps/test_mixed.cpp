@@ -279,6 +279,40 @@ TEST_CASE("sewn check reports the simulated complex of a mesh with a face list, 
   CHECK(out.find("simulated: 411 volumes, 34 surface cells, 4 segments") != std::string::npos);
   CHECK(out.find("; 1 component (cells sharing a point)") != std::string::npos);
   CHECK(out.find("  tag 4 \"top\": ") != std::string::npos);
+  // the fin along 4 edges of the block, the mast from one node of the fin
+  CHECK(out.find("3 components):\n  point: 1 rod-shell\n  curve: 4 shell-solid\n") != std::string::npos);
+  REQUIRE(sewn_stdout("check " + fin + " --json", out) == 0);
+  const auto j = nlohmann::json::parse(out.substr(out.find("\n{") + 1));  // after the text (stderr, unbuffered)
+  CHECK(j["connections"]["curve"]["shell-solid"] == 4);
+  CHECK(j["connections"]["point"]["rod-shell"] == 1);
+  CHECK(j["connections"]["surface"].empty());
+}
+
+TEST_CASE("connections of a mixed mesh: the flap's edge line is curves, the rod's node a point, a face a surface") {
+  const IndexedMesh m = block_flap_rod();
+  Scene s = mixed_scene();
+  auto found = [&] { return mesh_connections(m, cell_models(m, io::embedded_cells(m), s, "m")); };
+  auto count = [](const MeshConnections& c, connect::ConnectionKind k, connect::Body a, connect::Body b) {
+    return c.found.counts[static_cast<std::size_t>(k)][static_cast<std::size_t>(connect::body_pair_index(a, b))];
+  };
+  using connect::Body;
+  using connect::ConnectionKind;
+  MeshConnections c = found();
+  REQUIRE(c.skipped.empty());
+  CHECK(count(c, ConnectionKind::curve, Body::shell, Body::solid) == 2);  // the flap shares the edges (0, 1), (1, 2)
+  CHECK(count(c, ConnectionKind::point, Body::rod, Body::shell) == 1);
+  CHECK(c.found.total() == 3);
+  // the labels simulated: the tet face as a shell lies on the block, the tet edge as a rod along it
+  s.model_groups = {{4, "shell", {}}, {5, "rod", {}}};
+  c = found();
+  CHECK(count(c, ConnectionKind::surface, Body::shell, Body::solid) == 1);
+  CHECK(count(c, ConnectionKind::curve, Body::rod, Body::solid) == 1);
+  CHECK(count(c, ConnectionKind::curve, Body::rod, Body::shell) == 1);  // that edge is also the face-shell's
+  // a mesh with other cells: said, not guessed
+  IndexedMesh h = hex_grid(1, 1, 1);
+  const auto hm = mesh_connections(h, std::vector<CellModel>(h.num_cells(), CellModel::mass_spring));
+  CHECK(hm.skipped == "cell 0 is not a segment, triangle or tetrahedron");
+  CHECK(connections_json(hm)["skipped"] == hm.skipped);
 }
 
 }  // namespace mixed_test

@@ -243,6 +243,25 @@ TEST_CASE("point connections term: a split cantilever rejoined with k_b = EI/D b
   CHECK(rigid.tip > whole.tip);  // stiffer than the rod
 }
 
+TEST_CASE("point connections term: compaction renumbers the connection's own node ids, not only its DOFs") {
+  RodInShell s(TwistUpdate::incremental_ii);
+  const std::vector<Index> old_to_new{0, 3, 5, 6};  // as if nodes had been removed before each
+  s.joint->remap_nodes(old_to_new);
+  const PointConnection& c = s.joint->connection(0);
+  CHECK(c.joint() == 3);
+  CHECK((c.position_nodes() == std::vector<Index>{0, 3, 3, 5, 6}));
+}
+
+TEST_CASE("point connections term: a connection whose node is removed goes with it, the table compacts") {
+  RodInShell s(TwistUpdate::incremental_ii);
+  CHECK(s.joint->remove_dangling(s.sys.nodes()) == 0);  // nothing removed: kept
+  s.sys.nodes().remove(3);                               // a corner of the triangle side
+  CHECK_THROWS_WITH_AS(s.joint->check_nodes(s.sys.nodes()), doctest::Contains("point connection 'rod in shell' refers to node 3"),
+                       physics::InputError);  // without the rule, compaction refuses it by name
+  CHECK(s.joint->remove_dangling(s.sys.nodes()) == 1);
+  CHECK(s.joint->size() == 0);
+}
+
 TEST_CASE("point connections term: a rod side needs the rods' twist as angle DOFs") {
   physics::System sys;
   const Index a = sys.nodes().add(Vec3(0, 0, 0), Vec3::Zero(), 1.0);

@@ -13,8 +13,11 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "sewn/apps/scene.hpp"
 #include "sewn/cmap/mesh.hpp"
+#include "sewn/connect/detect.hpp"
 
 namespace sewn::app {
 
@@ -51,5 +54,19 @@ struct SimulatedComplex {
 
 /// Counts what `models` makes of `mesh` (models[c] == label: a label). O(cells α(points)).
 SimulatedComplex simulated_complex(const IndexedMesh& mesh, const std::vector<CellModel>& models);
+
+/// Where the simulated bodies of a mesh meet (connect/detect.hpp): each non-label cell as its
+/// model takes it (rod, shell, solid; a mass-spring cell by its dimension, as `mixed` would).
+/// `skipped` says why nothing was computed: a simulated cell that is not a segment, triangle or
+/// tetrahedron. O(cells log cells).
+struct MeshConnections {
+  connect::FoundConnections found;
+  std::string skipped;
+};
+MeshConnections mesh_connections(const IndexedMesh& mesh, const std::vector<CellModel>& models);
+
+/// {"point": {"rod-shell": n, ...}, "curve": {...}, "surface": {...}, "components": n} with the
+/// nonzero counts only, or {"skipped": why}.
+nlohmann::json connections_json(const MeshConnections& c);
 
 }  // namespace sewn::app

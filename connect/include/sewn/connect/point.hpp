@@ -22,11 +22,13 @@
 //   rod edge:  x_from (3), x_to (3), θ (1)   — 7; from/to in the rod's own edge direction
 //   triangle:  x_joint (3), x_next (3), x_prev (3) — 9; the triangle's nodes rotated so that
 //              the joint comes first (orientation, hence the normal's sign, is kept)
+//   tet:       x_joint, then the other three in their order (12); F does not depend on the order
 // The shared node thus has one 3-block per side; an assembler adds both. position_nodes()
 // lists the node of every 3-block in order.
 
 #include <array>
 #include <optional>
+#include <span>
 #include <string>
 #include <variant>
 #include <vector>
@@ -64,7 +66,17 @@ struct TriangleSide {
   std::optional<Vec3> rest_axis;
 };
 
-using Side = std::variant<RodEdgeSide, TriangleSide>;
+/// A solid's tetrahedron as a side (PHYSICS_NOTES §3.5, solid option i): the rest frame — m̄3 =
+/// `rest_axis` (the surface vertex normal at the joint, pointing out of the solid; the tet is
+/// the one the inward normal ray enters), m̄1 any unit vector ⟂ to it — carried by the tet's
+/// deformation gradient F and re-orthonormalised, m3 first: m3 = ±hat(F m̄3),
+/// m1 = hat(F m̄1 − (F m̄1·m3) m3). The joint is one of its nodes.
+struct TetSide {
+  std::array<Index, 4> nodes{};
+  Vec3 rest_axis{0, 0, 1};
+};
+
+using Side = std::variant<RodEdgeSide, TriangleSide, TetSide>;
 
 /// How δ is followed through a motion (PHYSICS_NOTES §3.5). The incremental updates freeze
 /// their history within a step and are advanced by accept(); both need each step's increment
@@ -128,11 +140,10 @@ class PointConnection {
   /// ½k_b|d − d̄|² (equal to ½k_bω² to O(ω⁴), and differentiable there). Near the singular
   /// configurations the values are still returned, flagged; a rod edge of zero length or a
   /// triangle of zero area *now* gives non-finite values (callers check, as for the rods).
-  /// Throws physics::InputError naming the connection if q has the wrong size or is not finite. Cost O(1): measured ~0.7 µs for the
-  /// energy, ~7–15 µs with the gradient (18-wide forward AD; AMD EPYC, shared machine).
+  /// Throws physics::InputError naming the connection if q has the wrong size or is not finite. Cost O(1) (18-wide
+  /// forward AD, connect/src/jet.hpp, for the gradient).
   /// With `hessian`, also d²E/dq² (and the gradient), by `method` (see HessianMethod): exact
-  /// to round-off, symmetric, not projected (indefinite away from rest). Cost: see docs/connect.md
-  /// (nested_ad ~0.65 ms).
+  /// to round-off, symmetric, not projected (indefinite away from rest). Cost: see docs/connect.md.
   [[nodiscard]] PointEval evaluate(const Eigen::VectorXd& q, TwistUpdate update, bool want_gradient,
                                    Eigen::MatrixXd* hessian = nullptr, HessianMethod method = HessianMethod::chained) const;
 
@@ -140,6 +151,8 @@ class PointConnection {
   /// and each rod side's frame history is transported to its current tangent (what
   /// Rod::update_frames does to the rod's own). O(1).
   void accept(const Eigen::VectorXd& q, TwistUpdate update);
+  /// Renames every node id (sides, joint, layout; old → new) after the node table was compacted.
+  void remap_nodes(std::span<const Index> old_to_new);
 
  private:
   std::string name_;
@@ -147,7 +160,9 @@ class PointConnection {
   PointStiffness k_;
   int dofs_m_ = 0, dofs_n_ = 0;
   double sign_m_ = 1, sign_n_ = 1;
-  std::array<double, 2> coef_m_{}, coef_n_{};  // triangle sides: the rest axis in (e1, e2)
+  // Per side, constants of its frame: a triangle's rest axis in (e1, e2) (2); a tet's
+  // Dm⁻¹m̄3 and Dm⁻¹m̄1 (6), so that F m̄ = Ds (Dm⁻¹ m̄).
+  std::array<double, 6> coef_m_{}, coef_n_{};
   Index joint_ = 0;
   std::vector<Index> nodes_;
   double rest_twist_ = 0, accepted_twist_ = 0;

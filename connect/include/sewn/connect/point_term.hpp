@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "sewn/connect/point.hpp"
+#include "sewn/connect/stencil_dofs.hpp"
 #include "sewn/physics/force_term.hpp"
 #include "sewn/physics/rods/rods_term.hpp"
 
@@ -35,7 +36,17 @@ struct RodEdgeRef {
   Index rod = 0;
   int edge = 0;
 };
-using SideRef = std::variant<RodEdgeRef, TriangleSide>;
+using SideRef = std::variant<RodEdgeRef, TriangleSide, TetSide>;
+
+/// A rod edge of the Rods term as a side at state s (its nodes, its current reference frame) and
+/// the System angle holding its θ. Throws physics::InputError naming `owner`: no rods, rods
+/// without angle DOFs, a rod or edge out of range. O(1).
+struct RodEdgeBinding {
+  RodEdgeSide side;
+  Index angle = 0;
+};
+[[nodiscard]] RodEdgeBinding bind_rod_edge(const physics::rods::Rods* rods, const RodEdgeRef& r, const physics::StateView& s,
+                                           const std::string& owner);
 
 /// Largest change of the twist δ within one step before a state counts as singular (rad).
 inline constexpr double max_twist_increment = 2.8;
@@ -58,6 +69,12 @@ class PointConnections final : public physics::ForceTerm {
   /// constructor refuses. Returns the connection's index. O(1).
   Index add(const std::string& name, const SideRef& m, const SideRef& n, PointStiffness k, const physics::StateView& s);
   [[nodiscard]] Index size() const { return static_cast<Index>(items_.size()); }
+  /// The rule when nodes go (a cut or a refinement removing them): a connection with a removed
+  /// node in its stencil is removed with it (one of its sides no longer exists there), every
+  /// other one is kept as it is; so none is left dangling. Call it after removing nodes and before
+  /// System::compact_nodes(), whose node check otherwise refuses the connection by name. Returns
+  /// how many were removed. O(connections).
+  Index remove_dangling(const physics::NodeTable& nodes);
   [[nodiscard]] const PointConnection& connection(Index c) const { return items_.at(c).connection; }
   /// Values of connection c at state s (energy, angles, flags). O(1).
   [[nodiscard]] PointEval evaluate(Index c, const physics::StateView& s) const;
@@ -73,23 +90,11 @@ class PointConnections final : public physics::ForceTerm {
   void remap_nodes(std::span<const Index> old_to_new) override;
 
  private:
-  // One stencil DOF: a node's axis or a System angle.
-  struct Dof {
-    bool angle = false;
-    Index id = 0;   // node or angle
-    int axis = 0;   // for a node
-  };
   struct Item {
     PointConnection connection;
-    std::vector<Dof> dofs;           // stencil order
-    std::vector<Index> blocks;       // distinct block rows of the stencil (set in collect_pairs)
-    std::vector<int> block_of;       // per DOF: its index in blocks
-    std::vector<Index> slots;        // blocks × blocks
+    StencilDofs dofs;  // stencil order
+    [[nodiscard]] std::string owner() const { return "point connection '" + connection.name() + "'"; }
   };
-  [[nodiscard]] static Eigen::VectorXd gather(const std::vector<Dof>& dofs, const physics::StateView& s, const std::string& name);
-  // Block row and component of a DOF in the Jacobian (angles by the System's AngleLayout).
-  [[nodiscard]] Index block_row(const Dof& d) const;
-  [[nodiscard]] int component(const Dof& d) const;
   // Energy, or +inf at a singular configuration (see the header comment).
   [[nodiscard]] double guarded_energy(const Item& it, const PointEval& e) const;
 
