@@ -35,6 +35,39 @@ Dart dart_at(const MssModel<D>& m, Dart ring, Index node) {
   return {};
 }
 
+// A side midpoint that no neighbour has as a corner goes with the coarsening, joining the side's
+// two halves; it cannot when a cut ends there (one half free, the other still sewn to a coarser
+// neighbour, so three edges meet at it). 2D. O(family).
+template <int D, class No>
+bool side_midpoints_removable(const MssModel<D>& m, Index p, const No& no) {
+  const Index first = m.elements()[p].first_child;
+  const Index centre = m.element_nodes(first)[2];
+  for (Index k = 0; k < 4; ++k) {
+    const Index mid = m.element_nodes(first + k)[1];
+    bool kept = false, free_half = false, sewn_half = false;
+    for (Index c = first; c < first + 4; ++c) {
+      Dart x = m.elements()[c].dart;
+      do {
+        const Dart next = m.map().beta(x, 1);
+        const bool at_mid = m.node_of(x) == mid || m.node_of(next) == mid;
+        if (at_mid && m.node_of(x) != centre && m.node_of(next) != centre) {
+          const Dart across = m.map().beta(x, 2);
+          (across.is_null() ? free_half : sewn_half) = true;
+          if (!across.is_null()) {  // the neighbour's darts at the midpoint: is it a corner of one?
+            const Dart at = m.node_of(across) == mid ? across : m.map().beta(across, 1);
+            kept = kept || m.is_corner_dart(at);
+          }
+        }
+        x = next;
+      } while (x != m.elements()[c].dart);
+    }
+    if (!kept && free_half && sewn_half)
+      return no("has a cut ending at the midpoint of its side " + std::to_string(k) + " (particle " + std::to_string(mid) +
+                "), which a coarser neighbour still shares: the midpoint can neither go nor stay a corner; cut the side's other half or refine the neighbour first");
+  }
+  return true;
+}
+
 }  // namespace
 
 template <int D>
@@ -73,7 +106,7 @@ bool can_coarsen(const MssModel<D>& m, Index p, std::string* why) {
       x = next;
     } while (x != m.elements()[c].dart);
   }
-  return true;
+  return side_midpoints_removable(m, p, no);
 }
 
 template <int D>

@@ -2,8 +2,7 @@
 #include <algorithm>
 #include <map>
 
-#include <Eigen/Cholesky>
-
+#include "hierarchy/bilinear.hpp"
 #include "hierarchy/segment_walk.hpp"
 #include "hierarchy/sides.hpp"
 #include "sewn/refine/hierarchy.hpp"
@@ -20,26 +19,6 @@ constexpr std::array<std::array<int, 2>, 12> hex_edges = {
     {{0, 1}, {3, 2}, {4, 5}, {7, 6}, {0, 3}, {1, 2}, {4, 7}, {5, 6}, {0, 4}, {1, 5}, {2, 6}, {3, 7}}};
 constexpr std::array<std::array<int, 4>, 6> hex_faces = {
     {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4}, {3, 2, 6, 7}, {0, 3, 7, 4}, {1, 2, 6, 5}}};
-
-// (s, t) of rest point r in the bilinear patch q0 q1 q2 q3 (q0 at (0,0), q1 (1,0), q2 (1,1)),
-// by Gauss-Newton; false if r is off the patch or on its border.
-bool bilinear_inside(const std::array<Vec3, 4>& q, const Vec3& r, double& s, double& t) {
-  s = t = 0.5;
-  double scale = (q[2] - q[0]).norm();
-  for (int it = 0; it < 30; ++it) {
-    const Vec3 p = (1 - s) * (1 - t) * q[0] + s * (1 - t) * q[1] + s * t * q[2] + (1 - s) * t * q[3];
-    const Vec3 ds = (1 - t) * (q[1] - q[0]) + t * (q[2] - q[3]), dt = (1 - s) * (q[3] - q[0]) + s * (q[2] - q[1]);
-    Eigen::Matrix<double, 3, 2> J;
-    J << ds, dt;
-    const Eigen::Vector2d step = (J.transpose() * J).ldlt().solve(J.transpose() * (r - p));
-    s += step[0];
-    t += step[1];
-    if (step.norm() < 1e-15) break;
-  }
-  const Vec3 p = (1 - s) * (1 - t) * q[0] + s * (1 - t) * q[1] + s * t * q[2] + (1 - s) * t * q[3];
-  constexpr double eps = 1e-9;
-  return (p - r).norm() <= 1e-12 * scale && s > eps && s < 1 - eps && t > eps && t < 1 - eps;
-}
 
 template <int D>
 void quad_t_junctions(const MssModel<D>& m, Index e, std::vector<TJunction>& out) {
@@ -84,7 +63,7 @@ void hex_t_junctions(const MssModel<D>& m, Index e, std::vector<TJunction>& out)
       std::array<Vec3, 4> q;
       for (std::size_t k = 0; k < 4; ++k) q[k] = m.rest_position(corner[static_cast<std::size_t>(f[k])]);
       double s = 0, t = 0;
-      if (!bilinear_inside(q, m.rest_position(n), s, t)) continue;
+      if (!detail::bilinear_inside(q, m.rest_position(n), s, t)) continue;
       TJunction tj{n, e, 4, {}, {(1 - s) * (1 - t), s * (1 - t), s * t, (1 - s) * t}};
       for (std::size_t k = 0; k < 4; ++k) tj.master[k] = corner[static_cast<std::size_t>(f[k])];
       out.push_back(tj);
