@@ -8,6 +8,7 @@
 #include <string>
 
 #include "hierarchy/bilinear.hpp"
+#include "hierarchy/sides.hpp"
 #include "sewn/refine/hierarchy.hpp"
 #include "sewn/refine/subdivide.hpp"
 
@@ -151,26 +152,113 @@ bool inside(const MssModel<D>& m, const RestFacet& r, const Facet& g) {
   return in_box(c) && detail::bilinear_inside(r.corner, c, s, t, 1e-9);
 }
 
+// The elements to refine so that a cut of `facets` leaves no particle with no mass, nor (3D) a
+// T-junction on sides whose corners it separated. Unsewing splits each vertex of the
+// facets into one particle per group of darts around it that stay joined once the facets' links
+// are gone (what the map's split hooks do); a group in which no element has the vertex as a
+// corner holds only T-junctions of its elements: nothing would weigh that copy. Returns, for
+// each such group, its coarsest element, whose refinement makes the vertex a corner there (or
+// brings it one level closer). Facets of full dimension only (faces of 3-maps, edges of 2-maps):
+// the others (edges of membranes in 3-maps) are never refined. O(facet darts · vertex degree).
+template <int D>
+std::vector<Index> orphan_holders(const MssModel<D>& m, std::span<const Facet> facets) {
+  const auto& map = m.map();
+  std::set<std::uint32_t> unsewn;  // darts whose β_D link the cut removes
+  std::vector<Dart> starts;
+  for (const Facet& f : facets) {
+    if (f.index != D) continue;
+    for (Dart x : facet_darts(m, f))
+      if (const Dart y = map.beta(x, D); !y.is_null()) {
+        unsewn.insert(x.index());
+        unsewn.insert(y.index());
+        starts.push_back(x);
+        starts.push_back(y);
+      }
+  }
+  auto link = [&](Dart x, int j) { return j == D && unsewn.count(x.index()) ? Dart{} : map.beta(x, j); };
+  std::set<std::uint32_t> seen;
+  std::vector<Index> out;
+  for (Dart s : starts) {
+    if (seen.count(s.index())) continue;
+    std::vector<std::vector<Dart>> groups;
+    for (Dart r : map.template cell<0>(s)) {
+      if (!seen.insert(r.index()).second) continue;
+      // the darts at the vertex that stay joined: the map's vertex generators without the cut links
+      std::vector<Dart> group{r};
+      auto visit = [&](Dart z) {
+        if (!z.is_null() && seen.insert(z.index()).second) group.push_back(z);
+      };
+      for (std::size_t h = 0; h < group.size(); ++h) {
+        const Dart x = group[h], x0 = map.beta(x, 0);
+        for (int j = 2; j <= D; ++j) {
+          if (const Dart y = link(x, j); !y.is_null()) {
+            visit(map.beta(y, 1));
+            for (int k = 2; k <= D; ++k)
+              if (k != j) visit(link(y, k));
+          }
+          if (!x0.is_null()) visit(link(x0, j));
+        }
+      }
+      groups.push_back(std::move(group));
+    }
+    for (const auto& group : groups) {
+      bool weighed = false;
+      Index coarsest = invalid_index;
+      for (Dart x : group) {
+        const Index e = m.element_of(x);
+        if (e == invalid_index) continue;
+        if (m.is_corner_dart(x))
+          weighed = true;
+        else if (coarsest == invalid_index || m.elements()[e].level < m.elements()[coarsest].level)
+          coarsest = e;
+      }
+      if (!weighed && coarsest != invalid_index) out.push_back(coarsest);
+      // 3D: a vertex the cut splits must not end a side that holds T-junctions, nor be one: many
+      // elements share an edge, and a T-junction the cut leaves whole could stay on the sides of
+      // elements whose corners it separated, slaved to one side and off the other
+      if constexpr (D == 3)
+        if (groups.size() > 1)
+          for (Dart x : group) {
+            const Index e = m.element_of(x);
+            if (e != invalid_index && (!m.is_corner_dart(x) || detail::edge_level(m, x) > m.elements()[e].level)) out.push_back(e);
+          }
+    }
+    groups.clear();
+  }
+  return out;
+}
+
+// The elements to refine before cutting `facets`: the coarser side of each facet on a level jump
+// and the holders of would-be massless copies (orphan_holders). Throws physics::InputError if
+// one is no quad of a 2-map or hexahedron (nothing else refines).
+template <int D>
+std::vector<Index> to_refine(const MssModel<D>& m, std::span<const Facet> facets) {
+  std::vector<Index> out = orphan_holders(m, facets);
+  for (const Facet& f : facets)
+    if (Index c = invalid_index; level_jump(m, f, c)) out.push_back(c);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  for (Index e : out)
+    if (m.elements()[e].kind != (D == 2 ? ElementKind::quad : ElementKind::hexahedron))
+      throw InputError("cut: element " + std::to_string(e) +
+                       " holds T-junctions on the cut (a level jump) but cannot be refined to meet it (only quads of 2-maps and hexahedra are)");
+  return out;
+}
+
 // The facets to unsew for the requested ones. A facet across a level jump holds T-junctions of
-// its coarser element; separating them would leave copies that are corners of no element, with
-// no mass. So the coarser element is refined first (the paper's own operation: the T-junctions
-// become its children's corners, with mass), as often as the jump needs, and the facet is cut
-// as the finer facets it became. A refinement may split another requested facet between equal
-// levels, creating a jump there: the loop runs until no facet inside a requested one has a jump.
-// Throws physics::InputError, before any change, if a coarser side is no quad or hexahedron.
+// its coarser element, and in 3D an element that only touches a facet along an edge may hold one
+// at a facet's vertex; separating such a T-junction from the elements it is a corner of would
+// leave a copy that is a corner of no element, with no mass, which the model cannot integrate.
+// So those elements are refined first (the paper's own operation, mass and momentum exact: the
+// T-junctions become their children's corners), as often as needed, and each facet is cut as the
+// finer facets it became. A refinement may split another requested facet between equal levels:
+// each requested facet is kept as a piece of the rest configuration, and the loop runs until
+// nothing inside the pieces needs refining. Throws physics::InputError, before any change, if an
+// element to refine first is no quad or hexahedron.
 template <int D>
 std::vector<Facet> level_facets(MssModel<D>& m, std::span<const Facet> facets, std::uint32_t& refined) {
-  bool any = false;
-  for (const Facet& f : facets) {
-    Index coarser = invalid_index;
-    if (!level_jump(m, f, coarser)) continue;
-    any = true;
-    const ElementKind k = m.elements()[coarser].kind;
-    if (k != (D == 2 ? ElementKind::quad : ElementKind::hexahedron))
-      throw InputError("cut: the facet at dart " + std::to_string(f.dart.index()) + " lies on a level jump whose coarser element " +
-                       std::to_string(coarser) + " cannot be refined to meet it (only quads of 2-maps and hexahedra are)");
-  }
-  if (!any) return {facets.begin(), facets.end()};
+  std::vector<Index> coarse = to_refine(m, facets);
+  if (coarse.empty()) return {facets.begin(), facets.end()};
   std::vector<RestFacet> pieces;
   std::vector<Facet> whole;  // triangles: never split
   for (const Facet& f : facets) {
@@ -181,26 +269,19 @@ std::vector<Facet> level_facets(MssModel<D>& m, std::span<const Facet> facets, s
     else
       whole.push_back(f);
   }
-  RefineOptions up_to_the_finer;  // a refinement here never passes the finer side's level
+  RefineOptions up_to_the_finer;  // a refinement here never passes the finest level around
   up_to_the_finer.max_level = 20;  // the largest index refine_element accepts
   for (;;) {
-    std::vector<Facet> within;
-    std::vector<Index> coarse;
-    for (const Facet& g : inner_facets(m)) {
-      if (std::none_of(pieces.begin(), pieces.end(), [&](const RestFacet& r) { return inside(m, r, g); })) continue;
-      within.push_back(g);
-      if (Index c = invalid_index; level_jump(m, g, c)) coarse.push_back(c);
-    }
-    if (coarse.empty()) {
-      within.insert(within.end(), whole.begin(), whole.end());
-      return within;
-    }
-    std::sort(coarse.begin(), coarse.end());
-    coarse.erase(std::unique(coarse.begin(), coarse.end()), coarse.end());
     for (Index e : coarse) {
       (void)refine_element(m, e, up_to_the_finer);
       ++refined;
     }
+    std::vector<Facet> within;
+    for (const Facet& g : inner_facets(m))
+      if (std::any_of(pieces.begin(), pieces.end(), [&](const RestFacet& r) { return inside(m, r, g); })) within.push_back(g);
+    within.insert(within.end(), whole.begin(), whole.end());
+    coarse = to_refine(m, std::span<const Facet>(within));
+    if (coarse.empty()) return within;
   }
 }
 

@@ -7,6 +7,7 @@
 
 #include "hierarchy/coarsen_detail.hpp"
 #include "hierarchy/model_access.hpp"
+#include "hierarchy/sides.hpp"
 #include "sewn/physics/errors.hpp"
 #include "sewn/refine/hierarchy.hpp"
 
@@ -44,7 +45,7 @@ bool side_midpoints_removable(const MssModel<D>& m, Index p, const No& no) {
   const Index centre = m.element_nodes(first)[2];
   for (Index k = 0; k < 4; ++k) {
     const Index mid = m.element_nodes(first + k)[1];
-    bool kept = false, free_half = false, sewn_half = false;
+    bool kept = false, free_half = false, sewn_half = false, split_half = false;
     for (Index c = first; c < first + 4; ++c) {
       Dart x = m.elements()[c].dart;
       do {
@@ -53,6 +54,7 @@ bool side_midpoints_removable(const MssModel<D>& m, Index p, const No& no) {
         if (at_mid && m.node_of(x) != centre && m.node_of(next) != centre) {
           const Dart across = m.map().beta(x, 2);
           (across.is_null() ? free_half : sewn_half) = true;
+          split_half = split_half || detail::edge_level(m, x) != m.elements()[first].level;
           if (!across.is_null()) {  // the neighbour's darts at the midpoint: is it a corner of one?
             const Dart at = m.node_of(across) == mid ? across : m.map().beta(across, 1);
             kept = kept || m.is_corner_dart(at);
@@ -61,6 +63,9 @@ bool side_midpoints_removable(const MssModel<D>& m, Index p, const No& no) {
         x = next;
       } while (x != m.elements()[c].dart);
     }
+    if (!kept && split_half)
+      return no("has its side " + std::to_string(k) + " still split next to its midpoint (particle " + std::to_string(mid) +
+                ") by a T-junction that a cut separated from the finer neighbour making it: the halves cannot be joined");
     if (!kept && free_half && sewn_half)
       return no("has a cut ending at the midpoint of its side " + std::to_string(k) + " (particle " + std::to_string(mid) +
                 "), which a coarser neighbour still shares: the midpoint can neither go nor stay a corner; cut the side's other half or refine the neighbour first");
@@ -93,6 +98,7 @@ bool can_coarsen(const MssModel<D>& m, Index p, std::string* why) {
       for (Dart x : m.map().template cell<3>(m.elements()[c].dart))
         if (m.node_of(x) == centre && m.map().beta(x, 3).is_null())
           return no("has a cut between its children (child " + std::to_string(c) + "): a cut family stays refined");
+    if (const std::string conflict = detail::hex_cut_conflict(m, p); !conflict.empty()) return no(conflict);
     return true;
   }
   // a cut between siblings: an interior edge (from the centre) left free
