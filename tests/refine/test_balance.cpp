@@ -82,6 +82,7 @@ void random_balanced(MssModel<D> m, int steps, int max_level, unsigned seed) {
     const auto r = sewn::refine::refine_element(m, e, o);
     extra += static_cast<int>(r.elements) - 1;
     refine_test::check_all(m);
+    refine_test::check_constraints_fresh(m);
     REQUIRE(unbalanced_pairs(m) == 0);
     std::string why;
     CHECK(sewn::refine::is_balanced(m, &why));

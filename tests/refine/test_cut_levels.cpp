@@ -290,6 +290,7 @@ void random_sequences(MssModel<D> (*make)(), int steps, int max_level, std::init
       const int op = random_operation(m, rng, o, cuts);
       CAPTURE(op);
       refine_test::check_all(m);
+      refine_test::check_constraints_fresh(m);
       REQUIRE(unweighed(m) == 0);
       CHECK(std::abs(m.node_mass() - mass0) <= 1e-13 * mass0);
       REQUIRE((momentum(m) - p0).norm() <= 1e-12 * p0.norm());

@@ -73,6 +73,13 @@ bool side_midpoints_removable(const MssModel<D>& m, Index p, const No& no) {
   return true;
 }
 
+// After a coarsening: the constraints that can change are those of the parent's particles (a
+// kept midpoint becomes the parent's T-junction) and of the removed ones (dropped).
+template <int D>
+void retie_t_junctions(MssModel<D>& m, Index p) {
+  update_t_junctions(m, std::span<const Index>(&p, 1));
+}
+
 }  // namespace
 
 template <int D>
@@ -122,7 +129,7 @@ CoarsenReport coarsen(MssModel<D>& m, Index p) {
   CoarsenReport report;
   if constexpr (D == 3) {
     report = detail::coarsen_hex(m, p);
-    constrain_t_junctions(m, m.system().slaves().treatment());
+    retie_t_junctions(m, p);
   } else {
     using A = detail::ModelAccess<2>;
     auto& map = A::map(m);
@@ -220,7 +227,7 @@ CoarsenReport coarsen(MssModel<D>& m, Index p) {
     for (const auto& [n, mv] : before)
       if (nodes.is_alive(n)) ke_after += 0.5 * nodes.mass(n) * nodes.velocity(n).squaredNorm();
     report.dissipated_energy = ke_before - ke_after;
-    constrain_t_junctions(m, m.system().slaves().treatment());
+    retie_t_junctions(m, p);
   }
   return report;
 }

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "hierarchy/neighbours.hpp"
 #include "hierarchy/refiner_base.hpp"
 #include "sewn/physics/errors.hpp"
 #include "sewn/refine/hierarchy.hpp"
@@ -39,20 +40,6 @@ void check_refinable(const MssModel<D>& m, Index e, const RefineOptions& o) {
                      ": its children would pass the maximum level " + std::to_string(o.max_level));
 }
 
-// The live elements sharing an edge with element e (faces included), each once. O(darts of e ·
-// edge degree).
-template <int D>
-std::vector<Index> edge_neighbours(const MssModel<D>& m, Index e) {
-  const auto& map = m.map();
-  std::vector<Index> out;
-  for (Dart x : map.template cell<D>(m.elements()[e].dart))
-    for (Dart y : map.template cell<1>(x))
-      if (const Index n = m.element_of(y); n != physics::invalid_index && n != e && m.elements()[n].alive) out.push_back(n);
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
-}
-
 template <int D>
 void refine_one(MssModel<D>& m, Index e, RefineReport& report) {
   detail::ModelAccess<D>::set_refining(m, true);
@@ -75,7 +62,7 @@ template <int D>
 void refine_balanced(MssModel<D>& m, Index e, const RefineOptions& o, RefineReport& report) {
   for (;;) {
     std::vector<Index> coarser;
-    for (Index n : edge_neighbours(m, e))
+    for (Index n : detail::edge_neighbours(m, e))
       if (m.elements()[n].level < m.elements()[e].level) coarser.push_back(n);
     if (coarser.empty()) break;
     for (Index n : coarser)
@@ -93,7 +80,7 @@ template <int D>
 bool is_balanced(const MssModel<D>& m, std::string* why) {
   for (Index e = 0; e < m.elements().size(); ++e) {
     if (!m.elements()[e].alive) continue;
-    for (Index n : edge_neighbours(m, e))
+    for (Index n : detail::edge_neighbours(m, e))
       if (m.elements()[n].level > 2 * m.elements()[e].level) {
         if (why)
           *why = "elements " + std::to_string(e) + " (level " + std::to_string(level_index(m.elements()[e].level)) + ") and " +
@@ -112,7 +99,7 @@ bool coarsening_keeps_balance(const MssModel<D>& m, Index parent) {
   const Index n = p.kind == physics::ElementKind::hexahedron ? 8 : 4;
   for (Index c = p.first_child; c < p.first_child + n; ++c) {
     if (!m.elements()[c].alive) continue;
-    for (Index o : edge_neighbours(m, c))
+    for (Index o : detail::edge_neighbours(m, c))
       if (m.elements()[o].parent != parent && m.elements()[o].level > 2 * p.level) return false;
   }
   return true;
@@ -137,7 +124,7 @@ RefineReport refine_elements(MssModel<D>& m, std::span<const Index> elements, co
     else
       refine_one(m, e, report);
   }
-  if (!elements.empty()) constrain_t_junctions(m, m.system().slaves().treatment());
+  if (!elements.empty()) update_t_junctions(m, std::span<const Index>(report.children));
   return report;
 }
 

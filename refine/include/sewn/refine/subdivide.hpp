@@ -10,7 +10,7 @@
 // the rest configuration (refining under load keeps the stress), each child adds Baudet's
 // stiffness at its own size to its sides by the series rule k_E·l_e/l_E, and the parent's
 // diagonals are replaced by 2 (4) per child. After each call the system's T-junction
-// constraints are rebuilt (constrain_t_junctions, hierarchy.hpp).
+// constraints are brought up to date (update_t_junctions, hierarchy.hpp).
 
 #include <cstdint>
 #include <span>
@@ -51,7 +51,8 @@ struct RefineReport {
 /// here — or whose children would pass options.max_level. Invalidates nothing held by the
 /// caller (particles, springs and elements are appended; the parent stays, not alive).
 /// O(darts of the element and of the paths its insertions walk) plus the model's resync of the
-/// touched particles and an O(model) rebuild of the T-junction constraints.
+/// touched particles and the incremental update of the T-junction constraints (update_t_junctions:
+/// the children's particles and the elements around them, plus the constraints' reordering).
 template <int D>
 RefineReport refine_element(MssModel<D>& m, Index e, const RefineOptions& options = {});
 
