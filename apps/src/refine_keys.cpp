@@ -73,6 +73,8 @@ Field refinement_schema() {
                 field("coarsen", Kind::boolean).fallback(false)
                     .doc("Merge a family of 8 back into its parent when the criteria have allowed it for `calm_steps` steps running (momentum kept, the fine-scale kinetic energy dissipated)."),
                 field("calm_steps", Kind::integer).fallback(20).at_least(1).at_most(1000000).doc("Hysteresis of coarsening, in steps."),
+                field("balance", Kind::boolean).fallback(false)
+                    .doc("2:1 balance: before an element is refined, its neighbours (sharing an edge or a face) that would end more than one level coarser are refined first, and coarsening skips families whose merge would break it."),
                 field("t_junctions", Kind::string).one_of({"reduction", "paper_projection"}).fallback("reduction")
                     .doc("`reduction`: slave particles with shape-function weights, forces passed to their masters and the reduced system solved (keeps linear and angular momentum); `paper_projection`: the 2014 paper's equal force shares then projection (loses angular momentum).")});
   return r;
@@ -85,6 +87,7 @@ RefinementSpec read_refinement(const nlohmann::json& j, const Field& schema, con
   s.max_level = static_cast<std::uint32_t>(r.integer("max_level"));
   s.coarsen = r.boolean("coarsen");
   s.calm_steps = static_cast<std::uint32_t>(r.integer("calm_steps"));
+  s.balance = r.boolean("balance");
   s.t_junctions = r.string("t_junctions");
   const Field& cs = *schema.member("criteria")->element_;
   for (std::size_t i = 0; i < r["criteria"].size(); ++i) {
@@ -141,6 +144,7 @@ RefinementRun::RefinementRun(const Scene& scene, physics::MssModel<3>& model) : 
   refine::RefineOptions options;
   options.max_level = static_cast<int>(spec.max_level);
   options.max_elements = static_cast<std::uint64_t>(spec.max_elements);
+  options.balance = spec.balance;
   impl_->options = options;
   for (std::size_t i = 0; i < spec.pre_refine.size(); ++i) {
     const PreRefineSpec& p = spec.pre_refine[i];

@@ -1,10 +1,16 @@
 #include "sewn/refine/cut.hpp"
-#include "sewn/refine/hierarchy.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <map>
 #include <set>
+#include <stdexcept>
 #include <string>
+
+#include "hierarchy/bilinear.hpp"
+#include "hierarchy/sides.hpp"
+#include "sewn/refine/hierarchy.hpp"
+#include "sewn/refine/subdivide.hpp"
 
 namespace sewn::refine {
 
@@ -69,6 +75,214 @@ template <int D>
 CutReport difference(const Counts<D>& before, const MssModel<D>& m, std::uint32_t facets) {
   const Counts<D> after(m);
   return {facets, after.particles - before.particles, after.springs - before.springs, after.elements - before.elements};
+}
+
+// The coarser of a facet's two elements when their levels differ (a level jump: the facet is a
+// whole side or face of the finer element and a part of one of the coarser).
+template <int D>
+bool level_jump(const MssModel<D>& m, const Facet& f, Index& coarser) {
+  const Dart other = m.map().beta(f.dart, f.index);
+  if (other.is_null()) return false;
+  const Index a = m.element_of(f.dart), b = m.element_of(other);
+  if (a == invalid_index || b == invalid_index) return false;
+  const std::uint32_t la = m.elements()[a].level, lb = m.elements()[b].level;
+  if (la == lb) return false;
+  coarser = la < lb ? a : b;
+  return true;
+}
+
+// A requested facet as a piece of the rest configuration: the 2 ends of an edge or the 4 corners
+// of a hexahedron face, taken on its finer side, which holds it whole. Refining the coarser side
+// splits the facet; the facets it becomes are those inside this piece.
+struct RestFacet {
+  int index = 0;
+  std::array<Vec3, 4> corner;
+  Vec3 lo, hi;  // bounding box, padded for round-off
+};
+
+template <int D>
+bool rest_facet(const MssModel<D>& m, const Facet& f, RestFacet& r) {
+  Dart d = f.dart;
+  if (Index coarser = invalid_index; level_jump(m, f, coarser) && m.element_of(d) == coarser) d = m.map().beta(d, f.index);
+  r.index = f.index;
+  int n = 0;
+  if (f.index == 2) {
+    r.corner[0] = m.rest_position(m.node_of(d));
+    r.corner[1] = m.rest_position(m.node_of(m.map().beta(d, 1)));
+    n = 2;
+  } else {
+    Dart x = d;
+    do {
+      if (m.is_corner_dart(x)) {
+        if (n == 4) return false;
+        r.corner[static_cast<std::size_t>(n++)] = m.rest_position(m.node_of(x));
+      }
+      x = m.map().beta(x, 1);
+    } while (x != d);
+    if (n != 4) return false;  // a triangle: tetrahedra are never refined, so it stays one facet
+  }
+  r.lo = r.hi = r.corner[0];
+  for (int k = 1; k < n; ++k) {
+    r.lo = r.lo.cwiseMin(r.corner[static_cast<std::size_t>(k)]);
+    r.hi = r.hi.cwiseMax(r.corner[static_cast<std::size_t>(k)]);
+  }
+  const double pad = 1e-9 * (r.hi - r.lo).norm();
+  r.lo.array() -= pad;
+  r.hi.array() += pad;
+  return true;
+}
+
+// True if facet g (now) lies inside the rest piece r.
+template <int D>
+bool inside(const MssModel<D>& m, const RestFacet& r, const Facet& g) {
+  if (g.index != r.index) return false;
+  auto in_box = [&](const Vec3& p) { return (p.array() >= r.lo.array()).all() && (p.array() <= r.hi.array()).all(); };
+  if (r.index == 2) {
+    const Vec3 u = r.corner[1] - r.corner[0];
+    for (const Dart x : {g.dart, m.map().beta(g.dart, 1)}) {
+      const Vec3 p = m.rest_position(m.node_of(x));
+      if (!in_box(p)) return false;
+      const double t = (p - r.corner[0]).dot(u) / u.squaredNorm();
+      if ((p - r.corner[0] - t * u).norm() > 1e-9 * u.norm()) return false;
+    }
+    return true;
+  }
+  const Vec3 c = facet_centroid(m, g);
+  double s = 0, t = 0;
+  return in_box(c) && detail::bilinear_inside(r.corner, c, s, t, 1e-9);
+}
+
+// The elements to refine so that a cut of `facets` leaves no particle with no mass, nor (3D) a
+// T-junction on sides whose corners it separated. Unsewing splits each vertex of the
+// facets into one particle per group of darts around it that stay joined once the facets' links
+// are gone (what the map's split hooks do); a group in which no element has the vertex as a
+// corner holds only T-junctions of its elements: nothing would weigh that copy. Returns, for
+// each such group, its coarsest element, whose refinement makes the vertex a corner there (or
+// brings it one level closer). Facets of full dimension only (faces of 3-maps, edges of 2-maps):
+// the others (edges of membranes in 3-maps) are never refined. O(facet darts · vertex degree).
+template <int D>
+std::vector<Index> orphan_holders(const MssModel<D>& m, std::span<const Facet> facets) {
+  const auto& map = m.map();
+  std::set<std::uint32_t> unsewn;  // darts whose β_D link the cut removes
+  std::vector<Dart> starts;
+  for (const Facet& f : facets) {
+    if (f.index != D) continue;
+    for (Dart x : facet_darts(m, f))
+      if (const Dart y = map.beta(x, D); !y.is_null()) {
+        unsewn.insert(x.index());
+        unsewn.insert(y.index());
+        starts.push_back(x);
+        starts.push_back(y);
+      }
+  }
+  auto link = [&](Dart x, int j) { return j == D && unsewn.count(x.index()) ? Dart{} : map.beta(x, j); };
+  std::set<std::uint32_t> seen;
+  std::vector<Index> out;
+  for (Dart s : starts) {
+    if (seen.count(s.index())) continue;
+    std::vector<std::vector<Dart>> groups;
+    for (Dart r : map.template cell<0>(s)) {
+      if (!seen.insert(r.index()).second) continue;
+      // the darts at the vertex that stay joined: the map's vertex generators without the cut links
+      std::vector<Dart> group{r};
+      auto visit = [&](Dart z) {
+        if (!z.is_null() && seen.insert(z.index()).second) group.push_back(z);
+      };
+      for (std::size_t h = 0; h < group.size(); ++h) {
+        const Dart x = group[h], x0 = map.beta(x, 0);
+        for (int j = 2; j <= D; ++j) {
+          if (const Dart y = link(x, j); !y.is_null()) {
+            visit(map.beta(y, 1));
+            for (int k = 2; k <= D; ++k)
+              if (k != j) visit(link(y, k));
+          }
+          if (!x0.is_null()) visit(link(x0, j));
+        }
+      }
+      groups.push_back(std::move(group));
+    }
+    for (const auto& group : groups) {
+      bool weighed = false;
+      Index coarsest = invalid_index;
+      for (Dart x : group) {
+        const Index e = m.element_of(x);
+        if (e == invalid_index) continue;
+        if (m.is_corner_dart(x))
+          weighed = true;
+        else if (coarsest == invalid_index || m.elements()[e].level < m.elements()[coarsest].level)
+          coarsest = e;
+      }
+      if (!weighed && coarsest != invalid_index) out.push_back(coarsest);
+      // 3D: a vertex the cut splits must not end a side that holds T-junctions, nor be one: many
+      // elements share an edge, and a T-junction the cut leaves whole could stay on the sides of
+      // elements whose corners it separated, slaved to one side and off the other
+      if constexpr (D == 3)
+        if (groups.size() > 1)
+          for (Dart x : group) {
+            const Index e = m.element_of(x);
+            if (e != invalid_index && (!m.is_corner_dart(x) || detail::edge_level(m, x) > m.elements()[e].level)) out.push_back(e);
+          }
+    }
+    groups.clear();
+  }
+  return out;
+}
+
+// The elements to refine before cutting `facets`: the coarser side of each facet on a level jump
+// and the holders of would-be massless copies (orphan_holders). Throws physics::InputError if
+// one is no quad of a 2-map or hexahedron (nothing else refines).
+template <int D>
+std::vector<Index> to_refine(const MssModel<D>& m, std::span<const Facet> facets) {
+  std::vector<Index> out = orphan_holders(m, facets);
+  for (const Facet& f : facets)
+    if (Index c = invalid_index; level_jump(m, f, c)) out.push_back(c);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  for (Index e : out)
+    if (m.elements()[e].kind != (D == 2 ? ElementKind::quad : ElementKind::hexahedron))
+      throw InputError("cut: element " + std::to_string(e) +
+                       " holds T-junctions on the cut (a level jump) but cannot be refined to meet it (only quads of 2-maps and hexahedra are)");
+  return out;
+}
+
+// The facets to unsew for the requested ones. A facet across a level jump holds T-junctions of
+// its coarser element, and in 3D an element that only touches a facet along an edge may hold one
+// at a facet's vertex; separating such a T-junction from the elements it is a corner of would
+// leave a copy that is a corner of no element, with no mass, which the model cannot integrate.
+// So those elements are refined first (the paper's own operation, mass and momentum exact: the
+// T-junctions become their children's corners), as often as needed, and each facet is cut as the
+// finer facets it became. A refinement may split another requested facet between equal levels:
+// each requested facet is kept as a piece of the rest configuration, and the loop runs until
+// nothing inside the pieces needs refining. Throws physics::InputError, before any change, if an
+// element to refine first is no quad or hexahedron.
+template <int D>
+std::vector<Facet> level_facets(MssModel<D>& m, std::span<const Facet> facets, std::uint32_t& refined) {
+  std::vector<Index> coarse = to_refine(m, facets);
+  if (coarse.empty()) return {facets.begin(), facets.end()};
+  std::vector<RestFacet> pieces;
+  std::vector<Facet> whole;  // triangles: never split
+  for (const Facet& f : facets) {
+    if (m.map().beta(f.dart, f.index).is_null()) continue;  // already free
+    RestFacet r;
+    if (rest_facet(m, f, r))
+      pieces.push_back(r);
+    else
+      whole.push_back(f);
+  }
+  RefineOptions up_to_the_finer;  // a refinement here never passes the finest level around
+  up_to_the_finer.max_level = 20;  // the largest index refine_element accepts
+  for (;;) {
+    for (Index e : coarse) {
+      (void)refine_element(m, e, up_to_the_finer);
+      ++refined;
+    }
+    std::vector<Facet> within;
+    for (const Facet& g : inner_facets(m))
+      if (std::any_of(pieces.begin(), pieces.end(), [&](const RestFacet& r) { return inside(m, r, g); })) within.push_back(g);
+    within.insert(within.end(), whole.begin(), whole.end());
+    coarse = to_refine(m, std::span<const Facet>(within));
+    if (coarse.empty()) return within;
+  }
 }
 
 }  // namespace
@@ -169,33 +383,26 @@ std::vector<Index> elements_in(const MssModel<D>& m, const Region& region) {
 
 template <int D>
 CutReport cut(MssModel<D>& m, std::span<const Facet> facets) {
-  // A facet on a level jump holds T-junctions of the coarser element: separating them would leave
-  // particles that no element weighs. Refused before anything changes.
-  for (const Facet& f : facets) {
+  for (const Facet& f : facets)
     if (!m.map().is_alive(f.dart)) throw InputError("cut: dart " + std::to_string(f.dart.index()) + " is not a live dart");
-    const Dart other = m.map().beta(f.dart, f.index);
-    if (other.is_null()) continue;
-    const Index a = m.element_of(f.dart), b = m.element_of(other);
-    if (a != physics::invalid_index && b != physics::invalid_index && m.elements()[a].level != m.elements()[b].level)
-      throw InputError("cut: the facet at dart " + std::to_string(f.dart.index()) + " lies between element " + std::to_string(a) +
-                       " (level " + std::to_string(m.elements()[a].level) + ") and element " + std::to_string(b) + " (level " +
-                       std::to_string(m.elements()[b].level) +
-                       "): cutting across a level jump is not supported yet; refine the coarser element first");
-  }
   const Counts<D> before(m);
+  std::uint32_t refined = 0;
+  const std::vector<Facet> level = level_facets(m, facets, refined);
   std::uint32_t done = 0;
   // One batch per facet dimension: a vertex or an edge shared by several of the facets is then
   // walked once, when its cell is rebuilt, instead of once per facet (each interior vertex of a
   // cut plane bounds four of its faces). Facets already separated are skipped by unsew_all.
   std::vector<Dart> faces, edges;
-  for (const Facet& f : facets) (f.index == 3 ? faces : edges).push_back(f.dart);
+  for (const Facet& f : level) (f.index == 3 ? faces : edges).push_back(f.dart);
   m.edit([&](auto& map) {
     if constexpr (D == 3) done += map.template unsew_all<3>(faces);
     done += map.template unsew_all<2>(edges);
   });
   // a particle duplicated by the cut may be a T-junction or a master of one
   if (!m.system().slaves().empty()) constrain_t_junctions(m, m.system().slaves().treatment());
-  return difference(before, m, done);
+  CutReport report = difference(before, m, done);
+  report.refined = refined;
+  return report;
 }
 
 template <int D>

@@ -76,6 +76,7 @@ TEST_CASE("scene refinement: defaults, criteria and pre-refined regions") {
   CHECK(r.pre_refine.at(0).levels == 1);
   CHECK_FALSE(r.coarsen);
   CHECK(r.calm_steps == 20);
+  CHECK_FALSE(r.balance);
   CHECK(r.t_junctions == "reduction");
   CHECK(r.max_elements == doctest::Approx(8e9 / 4400));
 }
@@ -139,6 +140,15 @@ TEST_CASE("scene refinement: the Table 1 beam refined adaptively by the run") {
   CHECK(header.find(",refined,coarsened") != std::string::npos);
   // the last frame's element count is 16 + 7 per refined child
   CHECK(csv_value(header, last, "elements") == 16 + 7 * static_cast<double>(s.refined - 2));
+
+  // with 2:1 balance: the same run, balanced refinements counted with the criterion's
+  json balanced = j;
+  balanced["refinement"]["balance"] = true;
+  const Scene bs = parse_scene(balanced, "beam.json");
+  CHECK(bs.refinement.balance);
+  const RunSummary b = run(bs, o);
+  CHECK(b.refined >= s.refined);
+  CHECK(b.refined <= 2 + 16);
 
   // without refinement, the same scene keeps its two elements
   json plain = beam_scene();

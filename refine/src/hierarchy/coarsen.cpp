@@ -7,6 +7,7 @@
 
 #include "hierarchy/coarsen_detail.hpp"
 #include "hierarchy/model_access.hpp"
+#include "hierarchy/sides.hpp"
 #include "sewn/physics/errors.hpp"
 #include "sewn/refine/hierarchy.hpp"
 
@@ -35,6 +36,50 @@ Dart dart_at(const MssModel<D>& m, Dart ring, Index node) {
   return {};
 }
 
+// A side midpoint that no neighbour has as a corner goes with the coarsening, joining the side's
+// two halves; it cannot when a cut ends there (one half free, the other still sewn to a coarser
+// neighbour, so three edges meet at it). 2D. O(family).
+template <int D, class No>
+bool side_midpoints_removable(const MssModel<D>& m, Index p, const No& no) {
+  const Index first = m.elements()[p].first_child;
+  const Index centre = m.element_nodes(first)[2];
+  for (Index k = 0; k < 4; ++k) {
+    const Index mid = m.element_nodes(first + k)[1];
+    bool kept = false, free_half = false, sewn_half = false, split_half = false;
+    for (Index c = first; c < first + 4; ++c) {
+      Dart x = m.elements()[c].dart;
+      do {
+        const Dart next = m.map().beta(x, 1);
+        const bool at_mid = m.node_of(x) == mid || m.node_of(next) == mid;
+        if (at_mid && m.node_of(x) != centre && m.node_of(next) != centre) {
+          const Dart across = m.map().beta(x, 2);
+          (across.is_null() ? free_half : sewn_half) = true;
+          split_half = split_half || detail::edge_level(m, x) != m.elements()[first].level;
+          if (!across.is_null()) {  // the neighbour's darts at the midpoint: is it a corner of one?
+            const Dart at = m.node_of(across) == mid ? across : m.map().beta(across, 1);
+            kept = kept || m.is_corner_dart(at);
+          }
+        }
+        x = next;
+      } while (x != m.elements()[c].dart);
+    }
+    if (!kept && split_half)
+      return no("has its side " + std::to_string(k) + " still split next to its midpoint (particle " + std::to_string(mid) +
+                ") by a T-junction that a cut separated from the finer neighbour making it: the halves cannot be joined");
+    if (!kept && free_half && sewn_half)
+      return no("has a cut ending at the midpoint of its side " + std::to_string(k) + " (particle " + std::to_string(mid) +
+                "), which a coarser neighbour still shares: the midpoint can neither go nor stay a corner; cut the side's other half or refine the neighbour first");
+  }
+  return true;
+}
+
+// After a coarsening: the constraints that can change are those of the parent's particles (a
+// kept midpoint becomes the parent's T-junction) and of the removed ones (dropped).
+template <int D>
+void retie_t_junctions(MssModel<D>& m, Index p) {
+  update_t_junctions(m, std::span<const Index>(&p, 1));
+}
+
 }  // namespace
 
 template <int D>
@@ -60,6 +105,7 @@ bool can_coarsen(const MssModel<D>& m, Index p, std::string* why) {
       for (Dart x : m.map().template cell<3>(m.elements()[c].dart))
         if (m.node_of(x) == centre && m.map().beta(x, 3).is_null())
           return no("has a cut between its children (child " + std::to_string(c) + "): a cut family stays refined");
+    if (const std::string conflict = detail::hex_cut_conflict(m, p); !conflict.empty()) return no(conflict);
     return true;
   }
   // a cut between siblings: an interior edge (from the centre) left free
@@ -73,7 +119,7 @@ bool can_coarsen(const MssModel<D>& m, Index p, std::string* why) {
       x = next;
     } while (x != m.elements()[c].dart);
   }
-  return true;
+  return side_midpoints_removable(m, p, no);
 }
 
 template <int D>
@@ -83,7 +129,7 @@ CoarsenReport coarsen(MssModel<D>& m, Index p) {
   CoarsenReport report;
   if constexpr (D == 3) {
     report = detail::coarsen_hex(m, p);
-    constrain_t_junctions(m, m.system().slaves().treatment());
+    retie_t_junctions(m, p);
   } else {
     using A = detail::ModelAccess<2>;
     auto& map = A::map(m);
@@ -181,7 +227,7 @@ CoarsenReport coarsen(MssModel<D>& m, Index p) {
     for (const auto& [n, mv] : before)
       if (nodes.is_alive(n)) ke_after += 0.5 * nodes.mass(n) * nodes.velocity(n).squaredNorm();
     report.dissipated_energy = ke_before - ke_after;
-    constrain_t_junctions(m, m.system().slaves().treatment());
+    retie_t_junctions(m, p);
   }
   return report;
 }

@@ -2,6 +2,7 @@
 // What quad and hexahedron coarsening share.
 
 #include <cstdint>
+#include <string>
 
 #include "hierarchy/model_access.hpp"
 #include "sewn/refine/coarsen.hpp"
@@ -45,5 +46,9 @@ void revive_parent(physics::MssModel<D>& m, physics::Index p, physics::Index chi
 }
 
 CoarsenReport coarsen_hex(physics::MssModel<3>& m, physics::Index p);
+
+/// Why the removals of coarsen_hex could not run on p's family because of cuts on its outer
+/// faces (a face centre or an edge midpoint that should go where a cut ends), or empty. O(family).
+std::string hex_cut_conflict(const physics::MssModel<3>& m, physics::Index p);
 
 }  // namespace sewn::refine::detail

@@ -1,8 +1,10 @@
 // Coarsening of a hexahedron family (PHYSICS_NOTES §2.8): the 1:8 refinement undone in reverse
 // order with the map's removals (hex_refine.cpp names the lattice and the steps).
+#include <algorithm>
 #include <array>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "hierarchy/coarsen_detail.hpp"
 #include "hierarchy/hex_codes.hpp"
@@ -140,6 +142,118 @@ class HexCoarsener {
 };
 
 }  // namespace
+
+std::string hex_cut_conflict(const physics::MssModel<3>& m, Index p) {
+  const auto& map = m.map();
+  const Index first = m.elements()[p].first_child;
+  std::array<Index, 27> lat{};
+  for (std::size_t v = 0; v < 8; ++v) {
+    const auto n = m.element_nodes(first + static_cast<Index>(v));
+    for (std::size_t w = 0; w < 8; ++w) {
+      Lat q{};
+      for (std::size_t a = 0; a < 3; ++a) q[a] = corner_lattice[v][a] / 2 + corner_lattice[w][a] / 2;
+      lat[static_cast<std::size_t>(at(q))] = n[w];
+    }
+  }
+  auto node = [&](const Lat& q) { return lat[static_cast<std::size_t>(at(q))]; };
+  auto in_family = [&](Index e) { return e >= first && e < first + 8; };
+  std::vector<Dart> darts;  // the family's darts
+  for (Index c = first; c < first + 8; ++c)
+    for (Dart x : map.template cell<3>(m.elements()[c].dart)) darts.push_back(x);
+  auto at_node = [&](Index n) {
+    std::vector<Dart> out;
+    for (Dart x : darts)
+      if (m.node_of(x) == n) out.push_back(x);
+    return out;
+  };
+  // whether an element outside the family has the particle at x as a corner there (then
+  // coarsening keeps it, with the faces and edges that meet at it)
+  auto kept = [&](Dart x) {
+    for (Dart y : map.template cell<0>(x))
+      if (const Index e = m.element_of(y); e != physics::invalid_index && !in_family(e) && m.is_corner_dart(y)) return true;
+    return false;
+  };
+  // a face centre that goes takes the edges inside the face with it: they must join faces that
+  // are all sewn to one neighbour or all free, not some cut and some not (three faces at an edge)
+  std::vector<Index> centres_going;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side : {0, 2}) {
+      Lat q{};
+      q[static_cast<std::size_t>(axis)] = side;
+      q[static_cast<std::size_t>((axis + 1) % 3)] = q[static_cast<std::size_t>((axis + 2) % 3)] = 1;
+      const Index fc = node(q);
+      const auto here = at_node(fc);
+      if (here.empty() || kept(here.front())) continue;
+      centres_going.push_back(fc);
+      bool sewn = false, free = false;
+      for (Dart x : here) {
+        const Dart y = map.beta(x, 3);
+        if (y.is_null())
+          free = true;
+        else if (!in_family(m.element_of(y)))
+          sewn = true;
+      }
+      if (sewn && free)
+        return "has a face partly cut (particle " + std::to_string(fc) +
+               " at its centre): its split can be undone only once the whole face is cut or none of it";
+    }
+  // a particle that stays becomes a T-junction of the parent, slaved to its corners; if it is one
+  // of another element too, that element must hold the same particles where the parent's corners
+  // are (a cut may have separated them: the particle would be slaved to one side and off the other)
+  const double size = (m.rest_position(node({2, 2, 2})) - m.rest_position(node({0, 0, 0}))).norm();
+  for (int q = 0; q < 27; ++q) {
+    const Lat l = {q % 3, (q / 3) % 3, q / 9};
+    const int odd = (l[0] == 1) + (l[1] == 1) + (l[2] == 1);
+    if (odd == 0 || odd == 3) continue;
+    const auto here = at_node(lat[static_cast<std::size_t>(q)]);
+    if (here.empty() || !kept(here.front())) continue;
+    std::vector<Index> masters;
+    for (const Lat& c : corner_lattice) {
+      bool on = true;
+      for (std::size_t a = 0; a < 3; ++a) on = on && (l[a] == 1 || l[a] == c[a]);
+      if (on) masters.push_back(node(c));
+    }
+    for (Dart y : map.template cell<0>(here.front())) {
+      const Index e = m.element_of(y);
+      if (e == physics::invalid_index || in_family(e) || m.is_corner_dart(y)) continue;
+      for (Dart z : map.template cell<3>(y))
+        for (Index c : masters)
+          if (m.node_of(z) != c && (m.rest_position(m.node_of(z)) - m.rest_position(c)).norm() <= 1e-12 * size)
+            return "would slave particle " + std::to_string(lat[static_cast<std::size_t>(q)]) + " to its corners while element " +
+                   std::to_string(e) + ", which also holds it inside a side, has another particle (a cut's copy) at corner " +
+                   std::to_string(c) + ": coarsen or cut that element first";
+    }
+  }
+  // an edge midpoint that goes joins its edge's two halves: then only those two edges may meet
+  // at it (each one edge, not one a cut doubled), beside the edges to face centres going too
+  for (const auto& [a, b] : hex_edge_ends) {
+    Lat mid{};
+    for (std::size_t k = 0; k < 3; ++k) mid[k] = (corner_lattice[a][k] + corner_lattice[b][k]) / 2;
+    const Index n = node(mid);
+    const auto here = at_node(n);
+    if (here.empty() || kept(here.front())) continue;
+    const Index ea = node(corner_lattice[a]), eb = node(corner_lattice[b]);
+    std::vector<std::uint32_t> cells[2];
+    for (Dart y : map.template cell<0>(here.front())) {
+      const Index t = end_node(m, y);
+      if (t != ea && t != eb) {
+        if (std::find(centres_going.begin(), centres_going.end(), t) != centres_going.end()) continue;
+        return "has an edge whose middle (particle " + std::to_string(n) +
+               ") a cut separated from the finer neighbour that keeps an edge there: coarsen or cut that neighbour first";
+      }
+      std::uint32_t least = y.index();
+      for (Dart z : map.template cell<1>(y)) least = std::min(least, z.index());
+      cells[t == ea ? 0 : 1].push_back(least);
+    }
+    for (auto& c : cells) {
+      std::sort(c.begin(), c.end());
+      if (std::unique(c.begin(), c.end()) - c.begin() > 1)
+        return "has an edge cut on one half only (particle " + std::to_string(n) +
+               " at its middle): its halves can be joined only once both are cut alike";
+    }
+  }
+  return {};
+}
 
 CoarsenReport coarsen_hex(physics::MssModel<3>& m, Index p) {
   CoarsenReport report;

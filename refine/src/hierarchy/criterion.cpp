@@ -68,7 +68,7 @@ typename Adapter<D>::Report Adapter<D>::update(MssModel<D>& m) {
     calm_[e] = el.alive && criterion_.allows_coarsening(m, e) ? calm_[e] + 1 : 0;
   }
   for (Index p = 0; p < m.elements().size(); ++p) {
-    if (!can_coarsen(m, p)) continue;
+    if (!can_coarsen(m, p) || (options_.refine.balance && !coarsening_keeps_balance(m, p))) continue;
     const Index first = m.elements()[p].first_child;
     bool calm = true;
     const Index n = m.elements()[p].kind == physics::ElementKind::hexahedron ? 8 : 4;

@@ -2,8 +2,11 @@
 // was), then the quad or hexahedron refiner inside MssModel::edit().
 #include "sewn/refine/subdivide.hpp"
 
+#include <algorithm>
 #include <string>
+#include <vector>
 
+#include "hierarchy/neighbours.hpp"
 #include "hierarchy/refiner_base.hpp"
 #include "sewn/physics/errors.hpp"
 #include "sewn/refine/hierarchy.hpp"
@@ -37,7 +40,70 @@ void check_refinable(const MssModel<D>& m, Index e, const RefineOptions& o) {
                      ": its children would pass the maximum level " + std::to_string(o.max_level));
 }
 
+template <int D>
+void refine_one(MssModel<D>& m, Index e, RefineReport& report) {
+  detail::ModelAccess<D>::set_refining(m, true);
+  try {
+    m.edit([&](auto&) {
+      if constexpr (D == 2) detail::refine_quad(m, e, report);
+      else detail::refine_hex(m, e, report);
+    });
+  } catch (...) {
+    detail::ModelAccess<D>::set_refining(m, false);
+    throw;
+  }
+  detail::ModelAccess<D>::set_refining(m, false);
+}
+
+// 2:1 balance: e's children will be at twice its level, so every neighbour coarser than e would
+// end more than one level coarser than them; each is refined first (its own coarser neighbours
+// before it), until none is left. The recursion is as deep as the levels below e's.
+template <int D>
+void refine_balanced(MssModel<D>& m, Index e, const RefineOptions& o, RefineReport& report) {
+  for (;;) {
+    std::vector<Index> coarser;
+    for (Index n : detail::edge_neighbours(m, e))
+      if (m.elements()[n].level < m.elements()[e].level) coarser.push_back(n);
+    if (coarser.empty()) break;
+    for (Index n : coarser)
+      if (m.elements()[n].alive) {
+        check_refinable(m, n, o);
+        refine_balanced(m, n, o, report);
+      }
+  }
+  refine_one(m, e, report);
+}
+
 }  // namespace
+
+template <int D>
+bool is_balanced(const MssModel<D>& m, std::string* why) {
+  for (Index e = 0; e < m.elements().size(); ++e) {
+    if (!m.elements()[e].alive) continue;
+    for (Index n : detail::edge_neighbours(m, e))
+      if (m.elements()[n].level > 2 * m.elements()[e].level) {
+        if (why)
+          *why = "elements " + std::to_string(e) + " (level " + std::to_string(level_index(m.elements()[e].level)) + ") and " +
+                 std::to_string(n) + " (level " + std::to_string(level_index(m.elements()[n].level)) +
+                 ") share an edge across more than one level";
+        return false;
+      }
+  }
+  return true;
+}
+
+template <int D>
+bool coarsening_keeps_balance(const MssModel<D>& m, Index parent) {
+  const physics::Element& p = m.elements()[parent];
+  if (p.first_child == physics::invalid_index) return true;
+  const Index n = p.kind == physics::ElementKind::hexahedron ? 8 : 4;
+  for (Index c = p.first_child; c < p.first_child + n; ++c) {
+    if (!m.elements()[c].alive) continue;
+    for (Index o : detail::edge_neighbours(m, c))
+      if (m.elements()[o].parent != parent && m.elements()[o].level > 2 * p.level) return false;
+  }
+  return true;
+}
 
 template <int D>
 RefineReport refine_element(MssModel<D>& m, Index e, const RefineOptions& options) {
@@ -48,20 +114,17 @@ template <int D>
 RefineReport refine_elements(MssModel<D>& m, std::span<const Index> elements, const RefineOptions& options) {
   RefineReport report;
   for (Index e : elements) {
+    // with balance, an element of the list may have been refined already, for an earlier one
+    if (options.balance && e < m.elements().size() && m.elements()[e].first_child != physics::invalid_index &&
+        std::any_of(report.children.begin(), report.children.end(), [&](Index c) { return m.elements()[c].parent == e; }))
+      continue;
     check_refinable(m, e, options);
-    detail::ModelAccess<D>::set_refining(m, true);
-    try {
-      m.edit([&](auto&) {
-        if constexpr (D == 2) detail::refine_quad(m, e, report);
-        else detail::refine_hex(m, e, report);
-      });
-    } catch (...) {
-      detail::ModelAccess<D>::set_refining(m, false);
-      throw;
-    }
-    detail::ModelAccess<D>::set_refining(m, false);
+    if (options.balance)
+      refine_balanced(m, e, options, report);
+    else
+      refine_one(m, e, report);
   }
-  if (!elements.empty()) constrain_t_junctions(m, m.system().slaves().treatment());
+  if (!elements.empty()) update_t_junctions(m, std::span<const Index>(report.children));
   return report;
 }
 
@@ -78,6 +141,10 @@ template RefineReport refine_element(MssModel<3>&, Index, const RefineOptions&);
 template RefineReport refine_elements(MssModel<2>&, std::span<const Index>, const RefineOptions&);
 template RefineReport refine_elements(MssModel<3>&, std::span<const Index>, const RefineOptions&);
 template RefineReport refine_all(MssModel<2>&, const RefineOptions&);
+template bool is_balanced(const MssModel<2>&, std::string*);
+template bool coarsening_keeps_balance(const MssModel<2>&, Index);
+template bool coarsening_keeps_balance(const MssModel<3>&, Index);
+template bool is_balanced(const MssModel<3>&, std::string*);
 template RefineReport refine_all(MssModel<3>&, const RefineOptions&);
 
 }  // namespace sewn::refine

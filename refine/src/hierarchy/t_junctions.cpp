@@ -1,9 +1,10 @@
 // T-junctions of the hierarchy and their slave-node constraints (PHYSICS_NOTES §2.6).
 #include <algorithm>
 #include <map>
+#include <utility>
+#include <vector>
 
-#include <Eigen/Cholesky>
-
+#include "hierarchy/bilinear.hpp"
 #include "hierarchy/segment_walk.hpp"
 #include "hierarchy/sides.hpp"
 #include "sewn/refine/hierarchy.hpp"
@@ -20,26 +21,6 @@ constexpr std::array<std::array<int, 2>, 12> hex_edges = {
     {{0, 1}, {3, 2}, {4, 5}, {7, 6}, {0, 3}, {1, 2}, {4, 7}, {5, 6}, {0, 4}, {1, 5}, {2, 6}, {3, 7}}};
 constexpr std::array<std::array<int, 4>, 6> hex_faces = {
     {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4}, {3, 2, 6, 7}, {0, 3, 7, 4}, {1, 2, 6, 5}}};
-
-// (s, t) of rest point r in the bilinear patch q0 q1 q2 q3 (q0 at (0,0), q1 (1,0), q2 (1,1)),
-// by Gauss-Newton; false if r is off the patch or on its border.
-bool bilinear_inside(const std::array<Vec3, 4>& q, const Vec3& r, double& s, double& t) {
-  s = t = 0.5;
-  double scale = (q[2] - q[0]).norm();
-  for (int it = 0; it < 30; ++it) {
-    const Vec3 p = (1 - s) * (1 - t) * q[0] + s * (1 - t) * q[1] + s * t * q[2] + (1 - s) * t * q[3];
-    const Vec3 ds = (1 - t) * (q[1] - q[0]) + t * (q[2] - q[3]), dt = (1 - s) * (q[3] - q[0]) + s * (q[2] - q[1]);
-    Eigen::Matrix<double, 3, 2> J;
-    J << ds, dt;
-    const Eigen::Vector2d step = (J.transpose() * J).ldlt().solve(J.transpose() * (r - p));
-    s += step[0];
-    t += step[1];
-    if (step.norm() < 1e-15) break;
-  }
-  const Vec3 p = (1 - s) * (1 - t) * q[0] + s * (1 - t) * q[1] + s * t * q[2] + (1 - s) * t * q[3];
-  constexpr double eps = 1e-9;
-  return (p - r).norm() <= 1e-12 * scale && s > eps && s < 1 - eps && t > eps && t < 1 - eps;
-}
 
 template <int D>
 void quad_t_junctions(const MssModel<D>& m, Index e, std::vector<TJunction>& out) {
@@ -84,7 +65,7 @@ void hex_t_junctions(const MssModel<D>& m, Index e, std::vector<TJunction>& out)
       std::array<Vec3, 4> q;
       for (std::size_t k = 0; k < 4; ++k) q[k] = m.rest_position(corner[static_cast<std::size_t>(f[k])]);
       double s = 0, t = 0;
-      if (!bilinear_inside(q, m.rest_position(n), s, t)) continue;
+      if (!detail::bilinear_inside(q, m.rest_position(n), s, t)) continue;
       TJunction tj{n, e, 4, {}, {(1 - s) * (1 - t), s * (1 - t), s * t, (1 - s) * t}};
       for (std::size_t k = 0; k < 4; ++k) tj.master[k] = corner[static_cast<std::size_t>(f[k])];
       out.push_back(tj);
@@ -143,9 +124,82 @@ void constrain_t_junctions(MssModel<D>& m, physics::SlaveTreatment treatment) {
   sn.set_treatment(treatment);
 }
 
+template <int D>
+void update_t_junctions(MssModel<D>& m, std::span<const Index> changed) {
+  physics::SlaveNodes& sn = m.system().slaves();
+  if (sn.treatment() != physics::SlaveTreatment::reduction) {
+    constrain_t_junctions(m, sn.treatment());
+    return;
+  }
+  // the particles of the changed elements are the only ones whose constraint can change; the
+  // elements that may hold one inside a side are those around it
+  const physics::NodeTable& nodes = m.nodes();
+  std::vector<char> again(nodes.size(), 0);
+  std::vector<Index> els;
+  for (Index e : changed) {
+    if (e >= m.elements().size() || !m.elements()[e].alive) continue;
+    for (Dart x : m.map().template cell<D>(m.elements()[e].dart)) {
+      if (std::exchange(again[m.node_of(x)], 1)) continue;
+      for (Dart y : m.map().template cell<0>(x))
+        if (const Index n = m.element_of(y); n != physics::invalid_index && m.elements()[n].alive) els.push_back(n);
+    }
+  }
+  std::sort(els.begin(), els.end());
+  els.erase(std::unique(els.begin(), els.end()), els.end());
+  std::vector<TJunction> found;
+  for (Index e : els) {
+    const Element& el = m.elements()[e];
+    if (el.kind == ElementKind::quad) quad_t_junctions(m, e, found);
+    if constexpr (D == 3)
+      if (el.kind == ElementKind::hexahedron) hex_t_junctions(m, e, found);
+  }
+  std::erase_if(found, [&](const TJunction& t) { return !again[t.node]; });
+  // as t_junctions(): coarsest first, ties in element order, the first entry of a particle wins
+  std::stable_sort(found.begin(), found.end(),
+                   [&](const TJunction& a, const TJunction& b) { return m.elements()[a.element].level < m.elements()[b.element].level; });
+  std::vector<physics::SlaveNode> list;
+  for (const physics::SlaveNode& s : sn.slaves()) {
+    bool keep = s.node < nodes.size() && nodes.is_alive(s.node) && !again[s.node];
+    for (int k = 0; k < s.masters; ++k) keep = keep && nodes.is_alive(s.master[static_cast<std::size_t>(k)]);
+    if (keep) list.push_back(s);
+  }
+  std::vector<char> listed(nodes.size(), 0);
+  for (const TJunction& t : found)
+    if (!std::exchange(listed[t.node], 1)) list.push_back({t.node, t.master, t.weight, t.masters});
+  // masters that are slaves before the slaves they master: a depth-first order on that relation
+  std::vector<std::size_t> slot(nodes.size(), list.size());
+  for (std::size_t i = 0; i < list.size(); ++i) slot[list[i].node] = i;
+  std::vector<char> state(list.size(), 0);  // 0 new, 1 open, 2 placed
+  std::vector<physics::SlaveNode> ordered;
+  ordered.reserve(list.size());
+  std::vector<std::pair<std::size_t, int>> stack;
+  for (std::size_t r = 0; r < list.size(); ++r) {
+    if (state[r]) continue;
+    stack.emplace_back(r, 0);
+    state[r] = 1;
+    while (!stack.empty()) {
+      auto& [i, k] = stack.back();
+      if (k < list[i].masters) {
+        const Index c = list[i].master[static_cast<std::size_t>(k++)];
+        if (c < slot.size() && slot[c] < list.size() && state[slot[c]] == 0) {
+          state[slot[c]] = 1;
+          stack.emplace_back(slot[c], 0);
+        }
+        continue;
+      }
+      state[i] = 2;
+      ordered.push_back(list[i]);
+      stack.pop_back();
+    }
+  }
+  sn.set(std::move(ordered));
+}
+
 template std::vector<TJunction> t_junctions(const MssModel<2>&);
 template std::vector<TJunction> t_junctions(const MssModel<3>&);
 template void constrain_t_junctions(MssModel<2>&, physics::SlaveTreatment);
 template void constrain_t_junctions(MssModel<3>&, physics::SlaveTreatment);
+template void update_t_junctions(MssModel<2>&, std::span<const Index>);
+template void update_t_junctions(MssModel<3>&, std::span<const Index>);
 
 }  // namespace sewn::refine

@@ -114,6 +114,7 @@ struct RefinementSpec {
   std::vector<PreRefineSpec> pre_refine;
   bool coarsen = false;
   std::uint32_t calm_steps = 20;
+  bool balance = false;  // 2:1 balance across edges and faces
   std::string t_junctions = "reduction";  // or "paper_projection"
   double max_elements = 0;  // live elements limits.memory allows (not a key: derived from it)
 };

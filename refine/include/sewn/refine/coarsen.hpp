@@ -33,7 +33,8 @@ template <int D>
 /// can_coarsen(), the model unchanged. Invalidates the children's element indices (they stay in
 /// the element array, not alive) and the removed particles and springs (removed, not compacted).
 /// O(family) (hexahedra: O(family · elements), to find which particles neighbours still use) plus
-/// the model's resync and an O(model) update of the T-junction constraints.
+/// the model's resync and the incremental update of the T-junction constraints (the parent's
+/// particles and the elements around them, plus the constraints' reordering).
 template <int D>
 CoarsenReport coarsen(MssModel<D>& m, Index parent);
 

@@ -44,7 +44,8 @@ class DiagonalStrain : public Criterion<D> {
 
 /// Refines, once each, the live quads (2-maps) or hexahedra (3-maps) the criterion wants,
 /// skipping those whose children would pass options.max_level. Throws physics::InputError, the
-/// model unchanged, if the pass would leave more than options.max_elements live elements.
+/// model unchanged, if the pass would leave more than options.max_elements live elements (the
+/// criterion's picks; with options.balance, the neighbours the balance refines come on top).
 /// O(elements · criterion) plus the refinements.
 /// `chosen`, if given, receives the elements refined, in the order refined: refine_elements()
 /// of that list on the model as it was repeats the pass exactly.
@@ -55,7 +56,8 @@ RefineReport adapt(MssModel<D>& m, const Criterion<D>& criterion, const RefineOp
 /// Refinement and coarsening driven step by step (PHYSICS_NOTES §2.7-2.8): call update() after
 /// each accepted step. It refines what the criterion wants (adapt()), then counts, per live leaf,
 /// the consecutive updates the criterion allowed coarsening (hysteresis), and coarsens every
-/// family whose children have all been calm for `calm_steps` updates and that can_coarsen().
+/// family whose children have all been calm for `calm_steps` updates and that can_coarsen()
+/// (and, with options.refine.balance, whose merge keeps the 2:1 balance).
 /// O(elements · criterion) plus the operations.
 template <int D>
 class Adapter {

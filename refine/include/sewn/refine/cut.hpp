@@ -34,6 +34,7 @@ struct Facet {
 struct CutReport {
   std::uint32_t facets = 0;  ///< facets unsewn
   std::int64_t particles = 0, springs = 0, elements = 0;  ///< change in live particles, springs, elements
+  std::uint32_t refined = 0;  ///< elements refined first, so that no facet cut lies on a level jump
 };
 
 /// A predicate on rest positions (points, or element / facet centroids).
@@ -66,7 +67,14 @@ std::vector<Facet> facets_among_points(const MssModel<D>& m, std::span<const std
 template <int D>
 std::vector<Index> elements_in(const MssModel<D>& m, const Region& region);
 
-/// Unsews the facets (those already free are skipped). O(facets + touched cells).
+/// Unsews the facets (those already free are skipped). A facet between elements of different
+/// levels (a level jump, with T-junctions of the coarser element on it) is cut after its coarser
+/// side has been refined to the finer side's level, as the finer facets it then became: every
+/// particle keeps an element that weighs it, the T-junctions on the cut become corners (free
+/// particles) and mass and linear momentum are conserved exactly (the refinement's). Throws
+/// physics::InputError, before any change, for a dead dart or a level jump whose coarser element
+/// is no quad (2-map) or hexahedron. O(facets + touched cells); with level jumps, plus
+/// O(darts + inner facets · facets) per round of refinement.
 template <int D>
 CutReport cut(MssModel<D>& m, std::span<const Facet> facets);
 

@@ -11,6 +11,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -43,10 +44,22 @@ template <int D>
 
 /// Makes the T-junctions the system's slave nodes (physics::SlaveNodes) with the given
 /// treatment: the virtual-work reduction, or the 2014 paper's equal force shares among the
-/// particles of the elements the T-junction is a corner of, then projection. refine_element()
-/// calls it after every refinement with the treatment in place. O(model).
+/// particles of the elements the T-junction is a corner of, then projection. cut() calls it after
+/// every cut with the treatment in place (refinement and coarsening update incrementally,
+/// update_t_junctions). O(model).
 template <int D>
 void constrain_t_junctions(MssModel<D>& m, physics::SlaveTreatment treatment);
+
+/// Brings the system's T-junction constraints up to date after an operation that created or
+/// revived only the `changed` elements (a refinement: the children; a coarsening: the parent):
+/// the constraints of their particles are found again (each from the coarsest live element it
+/// lies strictly inside a side or face of, as t_junctions() does; such elements share an edge
+/// with a changed one), those of removed particles dropped, the others kept, and the list put back
+/// in master-before-slave order: the constraints constrain_t_junctions() would build. With the
+/// paper's projection (whose force shares reach further) it rebuilds everything.
+/// O(changed elements' darts · edge degree + their neighbours' darts + slaves).
+template <int D>
+void update_t_junctions(MssModel<D>& m, std::span<const Index> changed);
 
 /// What check_hierarchy() found: one line per violated invariant, naming the element, dart or
 /// particle.

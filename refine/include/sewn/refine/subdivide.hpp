@@ -10,10 +10,11 @@
 // the rest configuration (refining under load keeps the stress), each child adds Baudet's
 // stiffness at its own size to its sides by the series rule k_E·l_e/l_E, and the parent's
 // diagonals are replaced by 2 (4) per child. After each call the system's T-junction
-// constraints are rebuilt (constrain_t_junctions, hierarchy.hpp).
+// constraints are brought up to date (update_t_junctions, hierarchy.hpp).
 
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "sewn/physics/mss_model.hpp"
@@ -28,6 +29,11 @@ struct RefineOptions {
   /// adapt() refuses a pass that would leave more live elements than this (a bound on memory:
   /// an adaptive run whose criterion keeps firing would otherwise grow until memory runs out).
   std::uint64_t max_elements = std::uint64_t{1} << 32;
+  /// 2:1 balance (PHYSICS_NOTES §2.6): before an element is refined, every live element sharing
+  /// an edge with it that is coarser than it is refined first (recursively, with balance), so
+  /// that no two elements sharing an edge differ by more than one level. Elements the balance
+  /// refines are below the refined element's level, hence within max_level.
+  bool balance = false;
 };
 
 /// What a refinement changed.
@@ -45,14 +51,27 @@ struct RefineReport {
 /// here — or whose children would pass options.max_level. Invalidates nothing held by the
 /// caller (particles, springs and elements are appended; the parent stays, not alive).
 /// O(darts of the element and of the paths its insertions walk) plus the model's resync of the
-/// touched particles and an O(model) rebuild of the T-junction constraints.
+/// touched particles and the incremental update of the T-junction constraints (update_t_junctions:
+/// the children's particles and the elements around them, plus the constraints' reordering).
 template <int D>
 RefineReport refine_element(MssModel<D>& m, Index e, const RefineOptions& options = {});
 
 /// Refines each listed element in turn (each must be refinable when its turn comes; an element
-/// refined earlier in the list is an error). O(Σ of the above).
+/// refined earlier in the list is an error, unless the balance refined it). O(Σ of the above).
 template <int D>
 RefineReport refine_elements(MssModel<D>& m, std::span<const Index> elements, const RefineOptions& options = {});
+
+/// True if no two live elements sharing an edge (quads of a 2-map, hexahedra of a 3-map) differ
+/// by more than one level (2:1 balance); otherwise `why` names the first such pair. O(darts ·
+/// edge degree).
+template <int D>
+[[nodiscard]] bool is_balanced(const MssModel<D>& m, std::string* why = nullptr);
+
+/// True if merging parent's family back would keep the 2:1 balance: no element sharing an edge
+/// with one of its children is more than one level finer than the parent. O(family's darts ·
+/// edge degree).
+template <int D>
+[[nodiscard]] bool coarsening_keeps_balance(const MssModel<D>& m, Index parent);
 
 /// Refines every live element once: a uniform refinement. O(model).
 template <int D>
