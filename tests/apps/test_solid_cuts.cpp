@@ -40,7 +40,7 @@ struct SolidBody {
     mo.gravity.setZero();
     mo.damping = physics::DampingModel::none;
     model = std::make_unique<physics::MssModel<3>>(mesh, materials, std::vector<std::uint32_t>{}, mo);
-    parts = build_continuum(s, materials, mesh, cell_models(mesh, io::embedded_cells(mesh), s, "m"), *model);
+    parts = build_continuum(s, materials, mesh, cell_models(mesh, io::embedded_cells(mesh), s, "m"), std::vector<int>(mesh.num_cells(), -1), *model);
   }
   void deform(std::mt19937& rng, double amount) {
     std::uniform_real_distribution<double> u(-amount, amount);
