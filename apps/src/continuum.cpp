@@ -108,17 +108,6 @@ std::vector<Chain> chain_segments(const std::vector<Segment>& segs, Index num_no
   return chains;
 }
 
-// A rod straight at rest with a round section has the same energy when all its material angles
-// turn together; with no end held in twist (a free end, or a joint that passes no moment) the
-// twist solve's θ block is then singular, and Rod::solve_twist wanders along that direction
-// without converging. Holding one angle removes the direction and changes no energy or force.
-void fix_twist_gauge(physics::rods::Rod& rod) {
-  if (rod.section().EI1 != rod.section().EI2) return;
-  for (int s = 0; s < rod.num_stencils(); ++s)
-    if (std::abs(rod.stencil_rest(s).kappa1) > 1e-12 || std::abs(rod.stencil_rest(s).kappa2) > 1e-12) return;
-  rod.fix_theta(0);
-}
-
 physics::rods::Section rod_section(const Scene& scene, const physics::MaterialParams& mat, int group) {
   const auto axes = group >= 0 ? scene.model_groups[static_cast<std::size_t>(group)].semi_axes : std::array<double, 2>{};
   if (axes[0] > 0) return physics::rods::Section::elliptic(mat.young, mat.poisson, axes[0], axes[1]);
@@ -148,7 +137,6 @@ void add_rods(const Scene& scene, const std::vector<physics::MaterialParams>& ma
     } catch (const physics::InputError& e) {
       throw SceneError(scene.file, key, "the rod through mesh cell " + std::to_string(first.mesh_cell) + " cannot be built: " + e.what());
     }
-    fix_twist_gauge(parts.rods->rod(r));
     for (std::size_t j = 0; j < c.elements.size(); ++j) parts.rod_edge_of_element[c.elements[j]] = {r, static_cast<int>(j)};
   }
 }
