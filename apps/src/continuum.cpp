@@ -14,8 +14,9 @@ namespace {
 using physics::Index;
 using Vec3d = Eigen::Vector3d;
 
-// Cuts are followed on tetrahedra and shells (follow_cut); a rod's stencils across a cut vertex
-// and its twist angles would have to split into two rods, which the Rods term cannot do yet.
+// Cuts and piercing are followed on tetrahedra and shells (follow_cut); a rod's stencils across
+// a cut vertex and its twist angles would have to split into two rods, which the Rods term
+// cannot do yet.
 void check_cuts(const Scene& scene, const std::vector<CellModel>& models) {
   if (scene.cuts.empty()) return;
   const auto rods = std::count(models.begin(), models.end(), CellModel::rod);
@@ -23,10 +24,6 @@ void check_cuts(const Scene& scene, const std::vector<CellModel>& models) {
     throw SceneError(scene.file, "cuts",
                      "cutting is supported on solid tetrahedra and shells only, and this scene has " + std::to_string(rods) +
                          " rod segments (a rod's stencils and twist angles cannot follow a cut yet)");
-  for (std::size_t k = 0; k < scene.cuts.size(); ++k)
-    if (scene.cuts[k].type == "pierce")
-      throw SceneError(scene.file, "cuts[" + std::to_string(k) + "].type",
-                       "\"pierce\" is not supported with model \"" + scene.model + "\": it removes elements, which the tetrahedra cannot follow yet; use a plane, faces or particles cut");
 }
 
 // Checks what a continuum model cannot take and removes the springs it replaces.
@@ -237,16 +234,32 @@ ContinuumParts build_continuum(const Scene& scene, const std::vector<physics::Ma
   add_solids(materials, mesh, models, model, scene, parts);
   add_shells(materials, mesh, models, model, scene, parts);
   add_rods(scene, materials, mesh, models, groups, model, parts);
+  // every edit of the model (a cut, a piercing) is followed before the model compacts its
+  // particles, so that elements it removed are retired while their nodes still exist; the
+  // listener keeps its own copy of the parts (term pointers and index tables, fixed from here)
+  if (parts.tets || parts.membranes) model.after_edits([copy = parts, &model] { follow_cut(copy, model); });
   return parts;
 }
 
 void follow_cut(const ContinuumParts& parts, const physics::MssModel<3>& model) {
+  // an element a piercing removed takes its term's element with it
+  auto alive = [&](Index e) { return model.elements()[e].alive; };
   for (Index k = 0; k < parts.element_of_tet.size(); ++k) {
+    if (!parts.tets->is_alive(k)) continue;
+    if (!alive(parts.element_of_tet[k])) {
+      parts.tets->retire_element(k);
+      continue;
+    }
     const std::vector<Index> nodes = model.element_nodes(parts.element_of_tet[k]);
     parts.tets->set_element_nodes(k, {nodes[0], nodes[1], nodes[2], nodes[3]});
   }
   std::vector<std::array<Index, 3>> tri(parts.element_of_membrane.size());
   for (Index k = 0; k < tri.size(); ++k) {
+    if (!parts.membranes->is_alive(k)) continue;
+    if (!alive(parts.element_of_membrane[k])) {
+      parts.membranes->retire_element(k);
+      continue;
+    }
     const std::vector<Index> nodes = model.element_nodes(parts.element_of_membrane[k]);
     tri[k] = {nodes[0], nodes[1], nodes[2]};
     parts.membranes->set_element_nodes(k, tri[k]);
@@ -254,6 +267,10 @@ void follow_cut(const ContinuumParts& parts, const physics::MssModel<3>& model) 
   for (Index h = 0; h < parts.hinge_corners.size(); ++h) {
     if (!parts.hinges->is_alive(h)) continue;
     const HingeCorners& c = parts.hinge_corners[h];
+    if (!parts.membranes->is_alive(c.a) || !parts.membranes->is_alive(c.b)) {
+      parts.hinges->retire_element(h);
+      continue;
+    }
     const auto& a = tri[c.a];
     const auto& b = tri[c.b];
     // the edge's two particles, as each triangle now has them: different copies mean the cut

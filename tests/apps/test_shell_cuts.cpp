@@ -63,10 +63,13 @@ struct ShellBody {
       if (parts.hinges->is_alive(h)) e[h] = parts.hinges->element_energy(h, parts.hinges->gather(s, h));
     return e;
   }
-  // Every membrane sits on its model element's current corners, and every live hinge on two
-  // of those triangles: its edge's particles in both, its wings one in each.
+  // Every membrane sits on its model element's current corners (or left with it), and every
+  // live hinge on two of those triangles: its edge's particles in both, its wings one in each.
   [[nodiscard]] bool terms_on_elements() const {
     for (Index k = 0; k < parts.element_of_membrane.size(); ++k) {
+      // a membrane leaves its term exactly when its model element was pierced away
+      if (parts.membranes->is_alive(k) != model->elements()[parts.element_of_membrane[k]].alive) return false;
+      if (!parts.membranes->is_alive(k)) continue;
       const auto nodes = model->element_nodes(parts.element_of_membrane[k]);
       const auto& held = parts.membranes->element_nodes(k);
       if (!std::equal(held.begin(), held.end(), nodes.begin())) return false;
@@ -181,6 +184,47 @@ TEST_CASE("shell cut: random sequences of plane cuts keep the map valid, energy,
     }
     CHECK(facets_cut > 0);
     CHECK(b.model->nodes().size() > 30);  // particles were duplicated
+  }
+}
+
+TEST_CASE("shell pierce: random triangles pierced away or loosened, energy and mass follow, forces stay exact") {
+  for (std::uint32_t seed = 1; seed <= 6; ++seed) {
+    CAPTURE(seed);
+    ShellBody b(5, 4);
+    std::mt19937 rng(seed);
+    sewn::physics::System& sys = b.model->system();
+    for (int k = 0; k < 3; ++k) {
+      const bool remove = (seed + static_cast<std::uint32_t>(k)) % 2 == 0;
+      CAPTURE(remove);
+      b.deform(rng, 0.005);
+      const double e0 = sys.potential_energy();
+      const std::vector<double> hinges_before = b.hinge_energies();
+      std::vector<double> membranes_before(b.parts.membranes->size(), 0.0);
+      for (Index m = 0; m < membranes_before.size(); ++m)
+        if (b.parts.membranes->is_alive(m))
+          membranes_before[m] = b.parts.membranes->element_energy(m, b.parts.membranes->gather(sys.state(), m));
+      // two live triangles at random
+      std::vector<Index> live;
+      for (Index e = 0; e < b.model->elements().size(); ++e)
+        if (b.model->elements()[e].alive) live.push_back(e);
+      std::shuffle(live.begin(), live.end(), rng);
+      live.resize(2);
+      (void)sewn::refine::pierce(*b.model, live, remove);  // the continuum follows through after_edits
+      CHECK(b.model->map().validate().ok());
+      CHECK(b.terms_on_elements());
+      // the energy lost is what the retired membranes and hinges held
+      double lost = 0;
+      for (Index m = 0; m < membranes_before.size(); ++m)
+        if (!b.parts.membranes->is_alive(m)) lost += membranes_before[m];
+      for (Index h = 0; h < hinges_before.size(); ++h)
+        if (!b.parts.hinges->is_alive(h)) lost += hinges_before[h];
+      CHECK(std::abs(sys.potential_energy() - (e0 - lost)) <= 1e-12 * e0);
+      CHECK(std::abs(b.model->node_mass() - b.model->element_mass()) <= 1e-12 * b.model->node_mass());
+      if (!remove)
+        for (Index e : live) CHECK(b.model->elements()[e].alive);
+      std::uniform_int_distribution<Index> any(0, b.model->nodes().size() - 1);
+      for (int j = 0; j < 3; ++j) CHECK(force_error(*b.model, any(rng)) <= 1e-6);
+    }
   }
 }
 

@@ -53,17 +53,20 @@ void apply_rod_sections(const Scene& scene, const IndexedMesh& mesh, const std::
 /// triangles share), Rods (rod segments chained wherever exactly two segments of one group and
 /// material meet; sections from the group, else the circle of the material's area). `groups`:
 /// per mesh cell its model.groups entry, -1: none (match_groups). Throws
-/// SceneError for what a continuum model cannot take (per-spring damping; cuts of rods, whose
-/// stencils cannot follow a cut yet; piercing, which removes elements) and for a rod or hinge
-/// the rest shape makes impossible, naming the key. O(cells).
+/// SceneError for what a continuum model cannot take (per-spring damping; cuts and piercing
+/// of rods, whose stencils cannot follow a cut yet) and for a rod or hinge the rest shape
+/// makes impossible, naming the key. Registers follow_cut with the model (after_edits). O(cells).
 ContinuumParts build_continuum(const Scene& scene, const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh,
                                const std::vector<CellModel>& models, const std::vector<int>& groups, physics::MssModel<3>& model);
 
-/// Brings the continuum in line with the model after refine::cut: the tetrahedra and membrane
-/// triangles move onto the particles the cut duplicated (same rest data, so their energy at the
-/// current state does not change); a hinge whose two triangles still share its edge's
-/// particles follows them, one whose edge the cut separated leaves the Hinges term for good
-/// (the energy drops by its own). O(tetrahedra + triangles + hinges).
+/// Brings the continuum in line with the model after refine::cut or refine::pierce: the
+/// tetrahedra and membrane triangles move onto the particles the cut duplicated (same rest
+/// data, so their energy at the current state does not change), and leave their term for good
+/// where the model element was removed; a hinge whose two triangles are still there and still
+/// share its edge's particles follows them, any other leaves the Hinges term (the energy drops
+/// by exactly what the removed elements held). build_continuum registers it to run after
+/// every edit of the model, before a piercing compacts the particles; calling it again
+/// changes nothing. O(tetrahedra + triangles + hinges).
 void follow_cut(const ContinuumParts& parts, const physics::MssModel<3>& model);
 
 /// The first material director m1 of each listed element's rod edge at the current state (the
