@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <map>
 #include <numeric>
+#include <string>
 
 namespace sewn::app {
 
@@ -57,16 +58,40 @@ const char* to_string(CellModel m) {
   return "?";
 }
 
+GroupMatch match_groups(const IndexedMesh& mesh, const MeshNames& names, const Scene& scene) {
+  // each entry's tags in this mesh: its number, or what this file calls its name
+  std::vector<std::vector<std::int32_t>> tags(scene.model_groups.size());
+  for (std::size_t k = 0; k < scene.model_groups.size(); ++k) {
+    const ModelGroup& g = scene.model_groups[k];
+    if (g.name.empty()) tags[k].push_back(g.tag);
+    for (const io::TagName& n : names.names)
+      if (!g.name.empty() && n.name == g.name) tags[k].push_back(n.tag);
+  }
+  GroupMatch out;
+  out.of_cell.assign(mesh.num_cells(), -1);
+  out.named_a_cell.assign(scene.model_groups.size(), false);
+  for (std::uint32_t c = 0; c < mesh.num_cells(); ++c)
+    for (std::size_t k = 0; k < tags.size(); ++k)
+      if (std::find(tags[k].begin(), tags[k].end(), mesh.tags[c]) != tags[k].end()) {
+        out.of_cell[c] = static_cast<int>(k);
+        out.named_a_cell[k] = true;
+      }
+  return out;
+}
+
 std::vector<CellModel> cell_models(const IndexedMesh& mesh, const std::vector<bool>& embedded, const Scene& scene,
                                    const std::string& path) {
+  return cell_models(mesh, embedded, scene, path, match_groups(mesh, MeshNames{}, scene).of_cell);
+}
+
+std::vector<CellModel> cell_models(const IndexedMesh& mesh, const std::vector<bool>& embedded, const Scene& scene,
+                                   const std::string& path, const std::vector<int>& groups) {
   std::vector<CellModel> out(mesh.num_cells());
   for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
     const CellType t = mesh.types[c];
-    std::size_t group = scene.model_groups.size();
-    for (std::size_t k = 0; k < scene.model_groups.size(); ++k)
-      if (scene.model_groups[k].tag == mesh.tags[c]) group = k;
-    const bool by_group = group < scene.model_groups.size();
-    const CellModel m = by_group ? parse_model(scene.model_groups[group].as)
+    const int group = groups[c];
+    const bool by_group = group >= 0;
+    const CellModel m = by_group ? parse_model(scene.model_groups[static_cast<std::size_t>(group)].as)
                         : embedded[c] ? CellModel::label
                                       : default_model(scene.model, t);
     out[c] = m;
@@ -84,11 +109,45 @@ std::vector<CellModel> cell_models(const IndexedMesh& mesh, const std::vector<bo
   return out;
 }
 
-void check_groups_used(const Scene& scene, const std::vector<std::int32_t>& tags_seen) {
-  for (std::size_t k = 0; k < scene.model_groups.size(); ++k)
-    if (std::find(tags_seen.begin(), tags_seen.end(), scene.model_groups[k].tag) == tags_seen.end())
-      throw SceneError(scene.file, "model.groups[" + std::to_string(k) + "].tag",
-                       "no cell of any mesh carries tag " + std::to_string(scene.model_groups[k].tag));
+namespace {
+
+// Why no cell answers to the physical name `name`: the groups of that name that have no cell,
+// or, when no mesh declares it, what each mesh does declare.
+std::string unused_name_reason(const std::string& name, const std::vector<MeshNames>& meshes) {
+  std::string declared, available, numbers_only;
+  std::size_t unnamed = 0;
+  for (const MeshNames& m : meshes) {
+    std::string list;
+    for (const io::TagName& n : m.names) {
+      const std::string one = "\"" + n.name + "\" (tag " + std::to_string(n.tag) + ", dimension " + std::to_string(n.dimension) + ")";
+      list += (list.empty() ? "" : ", ") + one;
+      if (n.name == name) declared += (declared.empty() ? "" : ", ") + m.path + "'s " + one;
+    }
+    if (!list.empty())
+      available += (available.empty() ? "" : "; ") + m.path + " (" + m.format + "): " + list;
+    else
+      numbers_only += (unnamed++ == 0 ? "" : ", ") + m.path + " (" + m.format + ")";
+  }
+  if (!declared.empty())
+    return "the physical group \"" + name + "\" has no cell: " + declared + " (0-dimensional groups hold points, which are not simulated cells)";
+  std::string reason = "no mesh declares a physical name \"" + name + "\"; ";
+  reason += available.empty() ? "no mesh of the scene has physical names" : "the physical names are: " + available;
+  if (!numbers_only.empty())
+    reason += "; " + numbers_only + (unnamed > 1 ? " have" : " has") +
+              " numeric tags only (MEDIT references, generated meshes): select their cells with \"tag\"";
+  return reason;
+}
+
+}  // namespace
+
+void check_groups_used(const Scene& scene, const std::vector<bool>& named_a_cell, const std::vector<MeshNames>& meshes) {
+  for (std::size_t k = 0; k < scene.model_groups.size(); ++k) {
+    if (named_a_cell[k]) continue;
+    const ModelGroup& g = scene.model_groups[k];
+    const std::string key = "model.groups[" + std::to_string(k) + "]";
+    if (g.name.empty()) throw SceneError(scene.file, key + ".tag", "no cell of any mesh carries tag " + std::to_string(g.tag));
+    throw SceneError(scene.file, key + ".name", unused_name_reason(g.name, meshes));
+  }
 }
 
 SimulatedComplex simulated_complex(const IndexedMesh& mesh, const std::vector<CellModel>& models) {

@@ -14,28 +14,16 @@ namespace {
 using physics::Index;
 using Vec3d = Eigen::Vector3d;
 
-// The last group naming `tag`, or -1.
-int group_of(const Scene& scene, std::int32_t tag) {
-  int g = -1;
-  for (std::size_t k = 0; k < scene.model_groups.size(); ++k)
-    if (scene.model_groups[k].tag == tag) g = static_cast<int>(k);
-  return g;
-}
-
-// Cuts are followed on tetrahedra only: a shell's hinge across a cut edge, or a rod's stencil
-// across a cut vertex, would have to leave its term, which has no removal yet.
+// Cuts and piercing are followed on tetrahedra and shells (follow_cut); a rod's stencils across
+// a cut vertex and its twist angles would have to split into two rods, which the Rods term
+// cannot do yet.
 void check_cuts(const Scene& scene, const std::vector<CellModel>& models) {
   if (scene.cuts.empty()) return;
-  const auto shells = std::count(models.begin(), models.end(), CellModel::shell);
   const auto rods = std::count(models.begin(), models.end(), CellModel::rod);
-  if (shells + rods > 0)
+  if (rods > 0)
     throw SceneError(scene.file, "cuts",
-                     "cutting is supported on solid tetrahedra only, and this scene has " + std::to_string(shells) +
-                         " shell triangles and " + std::to_string(rods) + " rod segments (their hinges and rod stencils cannot follow a cut yet)");
-  for (std::size_t k = 0; k < scene.cuts.size(); ++k)
-    if (scene.cuts[k].type == "pierce")
-      throw SceneError(scene.file, "cuts[" + std::to_string(k) + "].type",
-                       "\"pierce\" is not supported with model \"" + scene.model + "\": it removes elements, which the tetrahedra cannot follow yet; use a plane, faces or particles cut");
+                     "cutting is supported on solid tetrahedra and shells only, and this scene has " + std::to_string(rods) +
+                         " rod segments (a rod's stencils and twist angles cannot follow a cut yet)");
 }
 
 // Checks what a continuum model cannot take and removes the springs it replaces.
@@ -117,17 +105,6 @@ std::vector<Chain> chain_segments(const std::vector<Segment>& segs, Index num_no
   return chains;
 }
 
-// A rod straight at rest with a round section has the same energy when all its material angles
-// turn together; with no end held in twist (a free end, or a joint that passes no moment) the
-// twist solve's θ block is then singular, and Rod::solve_twist wanders along that direction
-// without converging. Holding one angle removes the direction and changes no energy or force.
-void fix_twist_gauge(physics::rods::Rod& rod) {
-  if (rod.section().EI1 != rod.section().EI2) return;
-  for (int s = 0; s < rod.num_stencils(); ++s)
-    if (std::abs(rod.stencil_rest(s).kappa1) > 1e-12 || std::abs(rod.stencil_rest(s).kappa2) > 1e-12) return;
-  rod.fix_theta(0);
-}
-
 physics::rods::Section rod_section(const Scene& scene, const physics::MaterialParams& mat, int group) {
   const auto axes = group >= 0 ? scene.model_groups[static_cast<std::size_t>(group)].semi_axes : std::array<double, 2>{};
   if (axes[0] > 0) return physics::rods::Section::elliptic(mat.young, mat.poisson, axes[0], axes[1]);
@@ -135,13 +112,13 @@ physics::rods::Section rod_section(const Scene& scene, const physics::MaterialPa
 }
 
 void add_rods(const Scene& scene, const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh,
-              const std::vector<CellModel>& models, physics::MssModel<3>& model, ContinuumParts& parts) {
+              const std::vector<CellModel>& models, const std::vector<int>& groups, physics::MssModel<3>& model, ContinuumParts& parts) {
   std::vector<Segment> segs;
   for (Index e = 0; e < model.elements().size(); ++e) {
     const auto& el = model.elements()[e];
     if (!el.alive || models[el.mesh_cell] != CellModel::rod) continue;
     const auto cell = mesh.cell(el.mesh_cell);
-    segs.push_back({{model.node_of_point(cell[0]), model.node_of_point(cell[1])}, e, {el.material, group_of(scene, mesh.tags[el.mesh_cell])}});
+    segs.push_back({{model.node_of_point(cell[0]), model.node_of_point(cell[1])}, e, {el.material, groups[el.mesh_cell]}});
   }
   if (segs.empty()) return;
   parts.rods = &model.system().add<physics::rods::Rods>();
@@ -149,7 +126,7 @@ void add_rods(const Scene& scene, const std::vector<physics::MaterialParams>& ma
   const std::vector<double> rest_x = rest_state(model);
   for (const Chain& c : chain_segments(segs, model.nodes().size())) {
     const auto& first = model.elements()[c.elements[0]];
-    const int group = group_of(scene, mesh.tags[first.mesh_cell]);
+    const int group = groups[first.mesh_cell];
     const std::string key = group >= 0 ? "model.groups[" + std::to_string(group) + "]" : "model.type";
     Index r = 0;
     try {
@@ -157,32 +134,60 @@ void add_rods(const Scene& scene, const std::vector<physics::MaterialParams>& ma
     } catch (const physics::InputError& e) {
       throw SceneError(scene.file, key, "the rod through mesh cell " + std::to_string(first.mesh_cell) + " cannot be built: " + e.what());
     }
-    fix_twist_gauge(parts.rods->rod(r));
     for (std::size_t j = 0; j < c.elements.size(); ++j) parts.rod_edge_of_element[c.elements[j]] = {r, static_cast<int>(j)};
   }
 }
 
+// Where each hinge sits in the triangles it was built from (all nodes distinct at build time,
+// so a triangle is known by its node set).
+std::vector<HingeCorners> hinge_corners(const physics::shells::Hinges& hinges, const std::vector<std::array<Index, 3>>& triangles) {
+  std::map<std::array<Index, 3>, Index> by_nodes;
+  for (Index t = 0; t < triangles.size(); ++t) {
+    auto key = triangles[t];
+    std::sort(key.begin(), key.end());
+    by_nodes.emplace(key, t);
+  }
+  auto find = [&](Index o, Index p, Index q, Index& tri, std::array<std::uint8_t, 3>& at) {
+    std::array<Index, 3> key{o, p, q};
+    std::sort(key.begin(), key.end());
+    tri = by_nodes.at(key);
+    const std::array<Index, 3> want{o, p, q};
+    for (std::size_t k = 0; k < 3; ++k)
+      at[k] = static_cast<std::uint8_t>(std::find(triangles[tri].begin(), triangles[tri].end(), want[k]) - triangles[tri].begin());
+  };
+  std::vector<HingeCorners> out(hinges.size());
+  for (Index h = 0; h < hinges.size(); ++h) {
+    const auto& n = hinges.element_nodes(h);
+    find(n[0], n[1], n[2], out[h].a, out[h].in_a);
+    find(n[3], n[1], n[2], out[h].b, out[h].in_b);
+  }
+  return out;
+}
+
 void add_shells(const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh, const std::vector<CellModel>& models,
-                physics::MssModel<3>& model, const Scene& scene) {
+                physics::MssModel<3>& model, const Scene& scene, ContinuumParts& parts) {
   std::vector<std::array<Index, 3>> triangles;
   std::vector<double> k_b;
-  physics::shells::Membranes* membranes = nullptr;
-  for (const auto& el : model.elements()) {
+  for (Index e = 0; e < model.elements().size(); ++e) {
+    const auto& el = model.elements()[e];
     if (!el.alive || models[el.mesh_cell] != CellModel::shell) continue;
-    if (!membranes) membranes = &model.system().add<physics::shells::Membranes>();
+    if (!parts.membranes) parts.membranes = &model.system().add<physics::shells::Membranes>();
     physics::shells::TriPositions X;
     const auto nodes = corner_nodes<3>(model, mesh.cell(el.mesh_cell), X);
     const auto& mat = materials[el.material];
-    membranes->add(nodes, X, mat.young, mat.poisson, mat.thickness);
+    parts.membranes->add(nodes, X, mat.young, mat.poisson, mat.thickness);
+    parts.element_of_membrane.push_back(e);
     triangles.push_back(nodes);
     k_b.push_back(physics::shells::hinge_stiffness(mat.young, mat.poisson, mat.thickness));
   }
   if (triangles.empty()) return;
+  parts.hinges = &model.system().add<physics::shells::Hinges>();
   try {
-    model.system().add<physics::shells::Hinges>().add_interior_edges(triangles, rest_state(model), k_b);
+    parts.hinges->add_interior_edges(triangles, rest_state(model), k_b);
   } catch (const physics::InputError& e) {
     throw SceneError(scene.file, "meshes", e.what());
   }
+  parts.hinge_corners = hinge_corners(*parts.hinges, triangles);
 }
 
 void add_solids(const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh, const std::vector<CellModel>& models,
@@ -203,12 +208,12 @@ void add_solids(const std::vector<physics::MaterialParams>& materials, const Ind
 
 }  // namespace
 
-void apply_rod_sections(const Scene& scene, const IndexedMesh& mesh, const std::vector<CellModel>& models,
+void apply_rod_sections(const Scene& scene, const IndexedMesh& mesh, const std::vector<CellModel>& models, const std::vector<int>& groups,
                         std::vector<physics::MaterialParams>& materials, std::vector<std::uint32_t>& material_of_cell) {
   std::map<std::pair<std::uint32_t, int>, std::uint32_t> copy;  // (material, group) -> its copy
   for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
     if (models[c] != CellModel::rod) continue;
-    const int g = group_of(scene, mesh.tags[c]);
+    const int g = groups[c];
     if (g < 0 || scene.model_groups[static_cast<std::size_t>(g)].semi_axes[0] <= 0) continue;
     const auto [it, added] = copy.try_emplace({material_of_cell[c], g}, static_cast<std::uint32_t>(materials.size()));
     if (added) {
@@ -222,20 +227,58 @@ void apply_rod_sections(const Scene& scene, const IndexedMesh& mesh, const std::
 }
 
 ContinuumParts build_continuum(const Scene& scene, const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh,
-                               const std::vector<CellModel>& models, physics::MssModel<3>& model) {
+                               const std::vector<CellModel>& models, const std::vector<int>& groups, physics::MssModel<3>& model) {
   check_cuts(scene, models);
   drop_springs(scene, model);
   ContinuumParts parts;
   add_solids(materials, mesh, models, model, scene, parts);
-  add_shells(materials, mesh, models, model, scene);
-  add_rods(scene, materials, mesh, models, model, parts);
+  add_shells(materials, mesh, models, model, scene, parts);
+  add_rods(scene, materials, mesh, models, groups, model, parts);
+  // every edit of the model (a cut, a piercing) is followed before the model compacts its
+  // particles, so that elements it removed are retired while their nodes still exist; the
+  // listener keeps its own copy of the parts (term pointers and index tables, fixed from here)
+  if (parts.tets || parts.membranes) model.after_edits([copy = parts, &model] { follow_cut(copy, model); });
   return parts;
 }
 
 void follow_cut(const ContinuumParts& parts, const physics::MssModel<3>& model) {
+  // an element a piercing removed takes its term's element with it
+  auto alive = [&](Index e) { return model.elements()[e].alive; };
   for (Index k = 0; k < parts.element_of_tet.size(); ++k) {
+    if (!parts.tets->is_alive(k)) continue;
+    if (!alive(parts.element_of_tet[k])) {
+      parts.tets->retire_element(k);
+      continue;
+    }
     const std::vector<Index> nodes = model.element_nodes(parts.element_of_tet[k]);
     parts.tets->set_element_nodes(k, {nodes[0], nodes[1], nodes[2], nodes[3]});
+  }
+  std::vector<std::array<Index, 3>> tri(parts.element_of_membrane.size());
+  for (Index k = 0; k < tri.size(); ++k) {
+    if (!parts.membranes->is_alive(k)) continue;
+    if (!alive(parts.element_of_membrane[k])) {
+      parts.membranes->retire_element(k);
+      continue;
+    }
+    const std::vector<Index> nodes = model.element_nodes(parts.element_of_membrane[k]);
+    tri[k] = {nodes[0], nodes[1], nodes[2]};
+    parts.membranes->set_element_nodes(k, tri[k]);
+  }
+  for (Index h = 0; h < parts.hinge_corners.size(); ++h) {
+    if (!parts.hinges->is_alive(h)) continue;
+    const HingeCorners& c = parts.hinge_corners[h];
+    if (!parts.membranes->is_alive(c.a) || !parts.membranes->is_alive(c.b)) {
+      parts.hinges->retire_element(h);
+      continue;
+    }
+    const auto& a = tri[c.a];
+    const auto& b = tri[c.b];
+    // the edge's two particles, as each triangle now has them: different copies mean the cut
+    // ran along this edge, and the two faces no longer bend about a common hinge
+    if (a[c.in_a[1]] != b[c.in_b[1]] || a[c.in_a[2]] != b[c.in_b[2]])
+      parts.hinges->retire_element(h);
+    else
+      parts.hinges->set_element_nodes(h, {a[c.in_a[0]], a[c.in_a[1]], a[c.in_a[2]], b[c.in_b[0]]});
   }
 }
 

@@ -140,9 +140,10 @@ void restore_model(physics::MssModel<3>& model, const ContinuumParts& continuum,
                                       std::to_string(model.elements().size()) + " elements");
     refinement->restore(c.refinement);
   }
-  // the run moved its tetrahedra onto the duplicated particles after each cut; once after all
-  // of them gives the same node lists, as each follows the model's elements as they end up
-  if (continuum.tets) follow_cut(continuum, model);
+  // the run moved its tetrahedra and shells onto the duplicated particles after each cut; once
+  // after all of them gives the same node lists, as each follows the model's elements as they
+  // end up, and retires the same hinges (a cut never sews an edge back)
+  follow_cut(continuum, model);
   physics::NodeTable& nodes = model.nodes();
   if (c.x.size() != nodes.x().size())
     throw CheckpointError(file, "holds " + std::to_string(c.x.size() / 3) + " particles for a model of " + std::to_string(nodes.size()));

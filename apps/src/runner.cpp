@@ -74,8 +74,10 @@ bool selects_cell(const Selector& s, const IndexedMesh& m, std::uint32_t c) {
   }
 }
 
-IndexedMesh generate(const MeshSpec& spec, const std::string& file, const std::string& path) {
+// The mesh of `spec`, and in `names` what its file says of its tags.
+IndexedMesh generate(const MeshSpec& spec, const std::string& file, const std::string& path, MeshNames& names) {
   IndexedMesh m;
+  names.path = path;
   if (spec.type == "hex_grid" || spec.type == "tet_grid") {
     GridSpec g;
     for (int k = 0; k < 3; ++k) {
@@ -118,7 +120,10 @@ IndexedMesh generate(const MeshSpec& spec, const std::string& file, const std::s
     m = io::voxelize(io::read_surface(spec.path), spec.cells[0], spec.path);
     transform(m, spec.scale, spec.translate);
   } else if (spec.type == "file") {
-    m = io::read_mesh(spec.path);
+    io::MeshFile read = io::read_mesh_file(spec.path);
+    names.format = io::to_string(read.format);
+    names.names = std::move(read.tag_names);
+    m = std::move(read.mesh);
     io::drop_unused_points(m);
     transform(m, spec.scale, spec.translate);
     io::check_mesh_geometry(m, spec.path);
@@ -235,9 +240,11 @@ void split_elongated(const Scene& scene, Assembly& a) {
   physics::BoxSplit split = physics::split_boxes(a.mesh, wanted, scene.file);
   std::vector<std::uint32_t> material(split.source_cell.size());
   std::vector<CellModel> model(split.source_cell.size());
+  std::vector<int> group(split.source_cell.size());
   for (std::size_t c = 0; c < material.size(); ++c) {
     material[c] = a.material_of_cell[split.source_cell[c]];
     model[c] = a.model_of_cell[split.source_cell[c]];
+    group[c] = a.group_of_cell[split.source_cell[c]];
   }
   for (std::uint32_t& first : a.first_cell)
     first = static_cast<std::uint32_t>(std::lower_bound(split.source_cell.begin(), split.source_cell.end(), first) -
@@ -245,6 +252,7 @@ void split_elongated(const Scene& scene, Assembly& a) {
   a.mesh = std::move(split.mesh);
   a.material_of_cell = std::move(material);
   a.model_of_cell = std::move(model);
+  a.group_of_cell = std::move(group);
   a.split_asked = split.asked;
   a.split_cells = split.split;
 }
@@ -263,23 +271,27 @@ Assembly assemble(const Scene& scene) {
   auto material_index = [&](const std::string& name) {
     return static_cast<std::uint32_t>(std::find(a.material_names.begin(), a.material_names.end(), name) - a.material_names.begin());
   };
-  std::vector<std::int32_t> tags_seen;
+  std::vector<bool> group_used(scene.model_groups.size(), false);
+  std::vector<MeshNames> mesh_names(scene.meshes.size());
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     const MeshSpec& spec = scene.meshes[i];
     const std::string path = "meshes[" + std::to_string(i) + "]";
-    const IndexedMesh whole = generate(spec, scene.file, path);
-    const std::vector<CellModel> models = cell_models(whole, io::embedded_cells(whole), scene, path);
-    tags_seen.insert(tags_seen.end(), whole.tags.begin(), whole.tags.end());
+    const IndexedMesh whole = generate(spec, scene.file, path, mesh_names[i]);
+    const GroupMatch groups = match_groups(whole, mesh_names[i], scene);
+    const std::vector<CellModel> models = cell_models(whole, io::embedded_cells(whole), scene, path, groups.of_cell);
+    for (std::size_t k = 0; k < group_used.size(); ++k) group_used[k] = group_used[k] || groups.named_a_cell[k];
     // the simulated cells and the labels, on the same points
     IndexedMesh piece, labels;
     piece.points = whole.points;
     std::vector<CellModel> piece_models;
+    std::vector<int> piece_groups;
     for (std::uint32_t c = 0; c < whole.num_cells(); ++c) {
       if (models[c] == CellModel::label) {
         labels.add_cell(whole.types[c], whole.cell(c), whole.tags[c]);
       } else {
         piece.add_cell(whole.types[c], whole.cell(c), whole.tags[c]);
         piece_models.push_back(models[c]);
+        piece_groups.push_back(groups.of_cell[c]);
       }
     }
     if (piece.num_cells() == 0)
@@ -297,8 +309,9 @@ Assembly assemble(const Scene& scene) {
     }
     a.material_of_cell.insert(a.material_of_cell.end(), mat.begin(), mat.end());
     a.model_of_cell.insert(a.model_of_cell.end(), piece_models.begin(), piece_models.end());
+    a.group_of_cell.insert(a.group_of_cell.end(), piece_groups.begin(), piece_groups.end());
   }
-  check_groups_used(scene, tags_seen);
+  check_groups_used(scene, group_used, mesh_names);
   split_elongated(scene, a);
   a.labels.points = a.mesh.points;
   return a;
@@ -340,7 +353,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     materials.push_back({ms.young, ms.poisson, ms.density, ms.thickness, ms.area,
                          ms.elongated == "clamp" ? physics::ElongatedPolicy::clamp : physics::ElongatedPolicy::refuse});
   }
-  apply_rod_sections(scene, assembly.mesh, assembly.model_of_cell, materials, assembly.material_of_cell);
+  apply_rod_sections(scene, assembly.mesh, assembly.model_of_cell, assembly.group_of_cell, materials, assembly.material_of_cell);
   physics::MssOptions mo;
   mo.gravity = Vec3d(scene.gravity[0], scene.gravity[1], scene.gravity[2]);
   mo.damping = scene.damping == "viscous" ? physics::DampingModel::viscous
@@ -378,7 +391,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   // The continuum models (solids, shells, rods) and the volume term join or replace the springs.
   const IndexedMesh& mesh = assembly.mesh;
   ContinuumParts continuum;
-  if (scene.model != "mass-spring") continuum = build_continuum(scene, materials, mesh, assembly.model_of_cell, *model);
+  if (scene.model != "mass-spring") continuum = build_continuum(scene, materials, mesh, assembly.model_of_cell, assembly.group_of_cell, *model);
 
   add_volume_term(scene, assembly.material_names, *model);
 

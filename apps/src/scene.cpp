@@ -196,7 +196,8 @@ Field build_schema() {
 
   Field group = field("group", Kind::object);
   group.doc("How the cells of one mesh tag (Gmsh physical group, MEDIT reference) are simulated; overrides `model.type` and the boundary-label rule for them.")
-      .members({field("tag", Kind::integer).required().at_least(-2147483647).at_most(2147483647).doc("The mesh tag (every mesh of the scene)."),
+      .members({field("tag", Kind::integer).at_least(-2147483647).at_most(2147483647).doc("The mesh tag (every mesh of the scene). Give `tag` or `name`."),
+                field("name", Kind::string).doc("A Gmsh physical name ($PhysicalNames of a `.msh` file), instead of `tag`: each mesh file resolves it to its own tag. MEDIT references and generated meshes have numbers only: select them with `tag`."),
                 field("as", Kind::string).one_of({"solid", "shell", "rod", "label"}).required()
                     .doc("`solid`: tetrahedra; `shell`: triangles (membrane + hinges); `rod`: segments, chained into discrete elastic rods wherever exactly two meet; `label`: not simulated, only a name for `tag` selectors (fixed, velocities)."),
                 field("radius", Kind::number).unit("m").above(0).doc("`rod`: a solid circular section of this radius (default: the circle of the material's `area`)."),
@@ -207,7 +208,7 @@ Field build_schema() {
   model.doc("What the bodies' elasticity is made of (docs/elastic.md, docs/mixed.md). In every model, a triangle that is a face of a tetrahedron (a segment that is an edge of a triangle or tetrahedron) is a boundary label, not simulated, unless `groups` says otherwise: mesh generators list such faces (tetgen's face list, Gmsh's boundary groups) to name boundaries.")
       .fallback(nlohmann::json::object())
       .members({field("type", Kind::string).one_of({"mass-spring", "solid", "shell", "mixed"}).fallback("mass-spring")
-                    .doc("`mass-spring`: the 2013 paper's springs on the map's edges; `solid`: finite-element tetrahedra (tetrahedral meshes only); `shell`: CST membranes with Green strain plus hinge bending with k_B = D/6 on the interior edges, thickness from the material (triangle meshes only); `mixed`: each cell by its dimension (tetrahedra solid, triangles shell, segments rod), components touching at points or curves sharing their nodes. `solid` cells follow plane, faces and particles cuts; scenes with shell or rod cells take no cuts yet, and none takes `pierce`. The damping of `solid`, `shell` and `mixed` comes from `rayleigh` α or `environment`, as spring damping does not apply."),
+                    .doc("`mass-spring`: the 2013 paper's springs on the map's edges; `solid`: finite-element tetrahedra (tetrahedral meshes only); `shell`: CST membranes with Green strain plus hinge bending with k_B = D/6 on the interior edges, thickness from the material (triangle meshes only); `mixed`: each cell by its dimension (tetrahedra solid, triangles shell, segments rod), components touching at points or curves sharing their nodes. `solid` and `shell` cells follow plane, faces and particles cuts and `pierce` (a hinge on a cut edge, and every element pierced away, is removed); scenes with rod cells take no cuts yet. The damping of `solid`, `shell` and `mixed` comes from `rayleigh` α or `environment`, as spring damping does not apply."),
                 field("law", Kind::string).one_of({"stvk", "stable_neo_hookean"}).fallback("stable_neo_hookean")
                     .doc("`solid` cells: St. Venant–Kirchhoff, or the inversion-safe stable neo-Hookean (Smith et al. 2018)."),
                 field("groups", Kind::array).of(group).items(0, 4096).fallback(nlohmann::json::array())
@@ -566,7 +567,13 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
       const std::string gpath = "model.groups[" + std::to_string(k) + "]";
       Reader g(gj, group_schema);
       ModelGroup mg;
-      mg.tag = static_cast<int>(g.integer("tag"));
+      if (g.has("tag") == g.has("name"))
+        throw SceneError(file, gpath, g.has("tag") ? "give either tag or name, not both" : "give the cells' tag (a number) or name (a Gmsh physical name)");
+      if (g.has("tag")) mg.tag = static_cast<int>(g.integer("tag"));
+      if (g.has("name")) {
+        mg.name = g.string("name");
+        if (mg.name.empty()) throw SceneError(file, gpath + ".name", "the physical name is empty");
+      }
       mg.as = g.string("as");
       if (g.has("radius")) mg.semi_axes = {g.number("radius"), g.number("radius")};
       if (g.has("semi_axes")) {

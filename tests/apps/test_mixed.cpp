@@ -93,23 +93,25 @@ TEST_CASE("cell models: faces and edges of higher cells are labels unless a grou
   Scene s = mixed_scene();
   // label, mass-spring, solid, shell, rod
   CHECK(count_models(cell_models(m, embedded, s, "meshes[0]")) == std::array<int, 5>{2, 0, 12, 4, 3});
-  s.model_groups = {{4, "shell", {}}, {5, "rod", {}}};
+  s.model_groups = {{4, "", "shell", {}}, {5, "", "rod", {}}};
   CHECK(count_models(cell_models(m, embedded, s, "meshes[0]")) == std::array<int, 5>{0, 0, 12, 5, 4});
-  s.model_groups = {{2, "label", {}}};
+  s.model_groups = {{2, "", "label", {}}};
   CHECK(count_models(cell_models(m, embedded, s, "meshes[0]")) == std::array<int, 5>{6, 0, 12, 0, 3});
   Scene ms;  // mass-spring: the same labels, every other cell springs
   CHECK(count_models(cell_models(m, embedded, ms, "meshes[0]")) == std::array<int, 5>{2, 19, 0, 0, 0});
 
-  s.model_groups = {{1, "shell", {}}};
+  s.model_groups = {{1, "", "shell", {}}};
   const std::string wrong = reason_of([&] { (void)cell_models(m, embedded, s, "meshes[0]"); });
   CHECK(wrong.find("model.groups[0].as: \"shell\" takes triangles only, but meshes[0] cell 0 (tag 1) is a tetrahedron") == 0);
   s.model = "solid";
   s.model_groups = {};
   CHECK(reason_of([&] { (void)cell_models(m, embedded, s, "meshes[0]"); }).find("model.type: \"solid\" needs tetrahedra only") == 0);
-  s.model_groups = {{2, "label", {}}, {3, "rod", {}}};  // the other kinds named: accepted
+  s.model_groups = {{2, "", "label", {}}, {3, "", "rod", {}}};  // the other kinds named: accepted
   CHECK(count_models(cell_models(m, embedded, s, "meshes[0]")) == std::array<int, 5>{6, 0, 12, 0, 3});
-  s.model_groups.push_back({9, "rod", {}});
-  CHECK(reason_of([&] { check_groups_used(s, m.tags); }) == "model.groups[2].tag: no cell of any mesh carries tag 9");
+  s.model_groups.push_back({9, "", "rod", {}});
+  const GroupMatch match = match_groups(m, MeshNames{}, s);
+  CHECK(match.named_a_cell == std::vector<bool>{true, true, false});
+  CHECK(reason_of([&] { check_groups_used(s, match.named_a_cell, {}); }) == "model.groups[2].tag: no cell of any mesh carries tag 9");
 }
 
 TEST_CASE("simulated complex: components are the pieces that share a node") {
@@ -125,7 +127,7 @@ TEST_CASE("simulated complex: components are the pieces that share a node") {
   CHECK(all.labels[0].dimension == 2);
   CHECK(all.labels[1].tag == 5);
   // without the flap, the rod hangs from nothing: two components; its points no longer count
-  s.model_groups = {{2, "label", {}}};
+  s.model_groups = {{2, "", "label", {}}};
   const SimulatedComplex split = simulated_complex(m, cell_models(m, io::embedded_cells(m), s, "m"));
   CHECK(split.components == 2);
   CHECK(split.points == m.num_points() - 2);
@@ -149,7 +151,7 @@ TEST_CASE("continuum on a mixed map: one node set, forces are the energy's gradi
   mo.gravity.setZero();
   mo.damping = physics::DampingModel::none;
   physics::MssModel<3> model(sim, materials, material_of_cell, mo);
-  const ContinuumParts parts = build_continuum(s, materials, sim, sim_models, model);
+  const ContinuumParts parts = build_continuum(s, materials, sim, sim_models, std::vector<int>(sim.num_cells(), -1), model);
   physics::System& sys = model.system();
   CHECK(model.springs().num_alive() == 0);
   CHECK(model.nodes().size() == m.num_points());  // the flap and the rod share the block's and the flap's nodes
@@ -219,7 +221,7 @@ TEST_CASE("rods: segments chain through nodes of two, split at junctions, close 
   physics::MssOptions mo;
   mo.damping = physics::DampingModel::none;
   physics::MssModel<3> model(m, materials, {}, mo);
-  const ContinuumParts parts = build_continuum(s, materials, m, models, model);
+  const ContinuumParts parts = build_continuum(s, materials, m, models, std::vector<int>(m.num_cells(), -1), model);
   REQUIRE(parts.rods != nullptr);
   REQUIRE(parts.rods->num_rods() == 4);
   int closed = 0, edges = 0;

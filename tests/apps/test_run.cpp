@@ -496,18 +496,31 @@ TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped b
   SUBCASE("per-spring damping") {
     expect_run_error<SceneError>(scene("tet_grid", R"({"model": "viscous"})", ""), "per-spring damping");
   }
-  SUBCASE("cuts: the tetrahedra follow a plane cut; piercing and cut shells are refused") {
+  SUBCASE("cuts: the tetrahedra and shells follow a plane cut and a piercing; cut rods are refused") {
     const LastFrame f = run_text(scene("tet_grid", rayleigh, R"(, "cuts": [{"type": "plane", "time": 0.05, "point": [0.2, 0, 0], "normal": [1, 0, 0]}])"),
                                  "solid_cut");
     CHECK(f.sum.cuts == 1);
     CHECK(f["springs"] == 0.0);
     CHECK(f["particles"] == 24.0);  // the 2 × 2 section points at x = 0.2 duplicated
     CHECK(f["elements"] == 24.0);
-    expect_run_error<SceneError>(scene("tet_grid", rayleigh, R"(, "cuts": [{"type": "pierce", "time": 0.05, "where": {"type": "all"}}])"),
-                                 "\"pierce\" is not supported with model \"solid\"");
+    // the last cube's 6 tetrahedra pierced away: their Tets elements leave with them
+    const LastFrame pierced = run_text(scene("tet_grid", rayleigh, R"(, "cuts": [{"type": "pierce", "time": 0.05, "remove": true,
+                                           "where": {"type": "box", "min": [0.3, -1, -1], "max": [1, 1, 1]}}])"),
+                                       "solid_pierce");
+    CHECK(pierced.sum.cuts == 1);
+    CHECK(pierced["elements"] == 18.0);
+    CHECK(pierced["particles"] == 16.0);  // the 4 corner points at x = 0.4 went with them
     std::string shell = scene("tri_grid", rayleigh, R"(, "cuts": [{"type": "plane", "time": 0.05, "point": [0.2, 0, 0], "normal": [1, 0, 0]}])");
     shell.replace(shell.find(R"("solid", "law": "stvk")"), 22, R"("shell")");
     shell.replace(shell.find(R"("cells": [4, 1, 1], "size": [0.4, 0.1, 0.1])"), 43, R"("cells": [4, 1], "size": [0.4, 0.1])");
-    expect_run_error<SceneError>(shell, "cutting is supported on solid tetrahedra only, and this scene has 8 shell triangles");
+    const LastFrame cut_shell = run_text(shell, "shell_cut");  // the membranes and hinges follow the cut
+    CHECK(cut_shell.sum.cuts == 1);
+    CHECK(cut_shell["particles"] == 12.0);  // the 2 points at x = 0.2 duplicated
+    CHECK(cut_shell["elements"] == 8.0);
+    const std::string rod = R"({"materials": {"m": {"young": 1e9, "density": 1000}},
+      "meshes": [{"type": "polyline", "material": "m", "points": [[0,0,0],[0.1,0,0],[0.2,0,0]]}],
+      "model": {"type": "mixed"}, "damping": )" + rayleigh + R"(, "integrator": {"type": "newton", "step": 0.005}, "duration": 0.1,
+      "cuts": [{"type": "plane", "time": 0.05, "point": [0.1, 0, 0], "normal": [1, 0, 0]}]})";
+    expect_run_error<SceneError>(rod, "cutting is supported on solid tetrahedra and shells only, and this scene has 2 rod segments");
   }
 }

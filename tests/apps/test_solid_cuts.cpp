@@ -3,6 +3,7 @@
 // valid, and leaves the pieces free of each other; random sequences of cuts keep all of it.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <set>
@@ -40,7 +41,7 @@ struct SolidBody {
     mo.gravity.setZero();
     mo.damping = physics::DampingModel::none;
     model = std::make_unique<physics::MssModel<3>>(mesh, materials, std::vector<std::uint32_t>{}, mo);
-    parts = build_continuum(s, materials, mesh, cell_models(mesh, io::embedded_cells(mesh), s, "m"), *model);
+    parts = build_continuum(s, materials, mesh, cell_models(mesh, io::embedded_cells(mesh), s, "m"), std::vector<int>(mesh.num_cells(), -1), *model);
   }
   void deform(std::mt19937& rng, double amount) {
     std::uniform_real_distribution<double> u(-amount, amount);
@@ -128,6 +129,55 @@ TEST_CASE("solid cut: random sequences of plane cuts keep the map valid, energy,
     }
     CHECK(facets_cut > 0);
     CHECK(b.model->nodes().size() > 64);  // particles were duplicated
+  }
+}
+
+TEST_CASE("solid pierce: random tetrahedra pierced away or loosened, energy and mass follow, forces stay exact") {
+  for (std::uint32_t seed = 1; seed <= 4; ++seed) {
+    CAPTURE(seed);
+    SolidBody b(3, 2, 2);
+    std::mt19937 rng(seed);
+    physics::System& sys = b.model->system();
+    for (int k = 0; k < 3; ++k) {
+      const bool remove = (seed + static_cast<std::uint32_t>(k)) % 2 == 1;
+      CAPTURE(remove);
+      b.deform(rng, 0.005);
+      const double e0 = sys.potential_energy();
+      std::vector<double> before(b.parts.tets->size(), 0.0);
+      for (physics::Index t = 0; t < before.size(); ++t)
+        if (b.parts.tets->is_alive(t)) before[t] = b.parts.tets->element_energy(t, b.parts.tets->gather(sys.state(), t));
+      std::vector<physics::Index> live;
+      for (physics::Index e = 0; e < b.model->elements().size(); ++e)
+        if (b.model->elements()[e].alive) live.push_back(e);
+      std::shuffle(live.begin(), live.end(), rng);
+      live.resize(3);
+      (void)refine::pierce(*b.model, live, remove);  // the tetrahedra follow through after_edits
+      CHECK(b.model->map().validate().ok());
+      double lost = 0;
+      for (physics::Index t = 0; t < before.size(); ++t) {
+        const bool element_alive = b.model->elements()[b.parts.element_of_tet[t]].alive;
+        CHECK(b.parts.tets->is_alive(t) == element_alive);
+        if (!b.parts.tets->is_alive(t)) lost += before[t];
+      }
+      CHECK((lost > 0) == remove);
+      CHECK(std::abs(sys.potential_energy() - (e0 - lost)) <= 1e-12 * e0);
+      CHECK(std::abs(b.model->node_mass() - b.model->element_mass()) <= 1e-12 * b.model->node_mass());
+      const physics::Index n = b.model->nodes().size() - 1;
+      sys.compute_forces();
+      const Eigen::Vector3d f = b.model->nodes().force(n), x = b.model->nodes().position(n);
+      for (int a = 0; a < 3; ++a) {
+        const double h = 1e-7;
+        Eigen::Vector3d xp = x, xm = x;
+        xp[a] += h;
+        xm[a] -= h;
+        b.model->nodes().set_position(n, xp);
+        const double ep = sys.potential_energy();
+        b.model->nodes().set_position(n, xm);
+        const double em = sys.potential_energy();
+        b.model->nodes().set_position(n, x);
+        CHECK(std::abs(-(ep - em) / (2 * h) - f[a]) <= 1e-6 * (1 + f.norm()));
+      }
+    }
   }
 }
 

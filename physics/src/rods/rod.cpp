@@ -203,6 +203,12 @@ int Rod::solve_twist(const Points& x) {
   for (int j = 0; j < m; ++j)
     if (!theta_fixed_[static_cast<std::size_t>(j)]) free_index[static_cast<std::size_t>(j)] = nf++;
   if (nf == 0 || num_stencils() == 0) return 0;
+  // With no angle held and an energy that turning every angle together leaves unchanged, the
+  // θ block is singular along (1, ..., 1): the exact gradient has no component there, but its
+  // round-off does, and a solve through the tiny shift below would turn that into a step of
+  // any size along it. Newton then wanders along the free direction without converging. The
+  // solve is kept orthogonal to it instead: the angles' mean stays where it was.
+  const bool gauge = nf == m && turns_freely();
   auto theta_energy = [&] {
     double E = 0;
     for (int s = 0; s < num_stencils(); ++s) E += eval_stencil(x, s, Want::energy).energy;
@@ -242,6 +248,7 @@ int Rod::solve_twist(const Points& x) {
         }
       }
     }
+    if (gauge) g.array() -= g.mean();
     // The θ block is PSD for twist alone and may lose definiteness where bending couples in;
     // a shift that grows until the factorisation is positive keeps every step a descent step.
     Eigen::SparseMatrix<double> A(nf, nf);
@@ -263,6 +270,7 @@ int Rod::solve_twist(const Points& x) {
       }
     }
     if (step.size() == 0 || !step.allFinite()) throw SolveError("rods::Rod::solve_twist: the twist Hessian could not be factored");
+    if (gauge) step.array() -= step.mean();
     if (step.lpNorm<Eigen::Infinity>() < 1e-13) return it;
     // Armijo backtracking; steps limited to π/4 per edge so no angle aliases.
     double alpha = std::min(1.0, (std::numbers::pi / 4) / step.lpNorm<Eigen::Infinity>());
@@ -291,6 +299,14 @@ int Rod::solve_twist(const Points& x) {
     if (alpha * step.lpNorm<Eigen::Infinity>() < 1e-13) return it + 1;
   }
   throw SolveError("rods::Rod::solve_twist: no convergence in 100 Newton iterations");
+}
+
+bool Rod::turns_freely() const {
+  // the same bound the rest curvatures of a straight rod built from mesh points stay under
+  constexpr double straight = 1e-12;
+  for (const Stencil& st : stencils_)
+    if (st.rest.EI1 != st.rest.EI2 || std::abs(st.rest.kappa1) > straight || std::abs(st.rest.kappa2) > straight) return false;
+  return true;
 }
 
 void Rod::update_frames(const Points& x) {

@@ -18,6 +18,7 @@
 #include "sewn/apps/scene.hpp"
 #include "sewn/cmap/mesh.hpp"
 #include "sewn/connect/detect.hpp"
+#include "sewn/io/read.hpp"
 
 namespace sewn::app {
 
@@ -26,17 +27,44 @@ enum class CellModel : std::uint8_t { label, mass_spring, solid, shell, rod };
 /// "label", "mass-spring", "solid", "shell", "rod".
 const char* to_string(CellModel m);
 
-/// Per cell of `mesh` (one scene mesh, `path` its key path): the last model.groups entry with
-/// the cell's tag decides; otherwise a cell in `embedded` (io::embedded_cells) is a label, and
-/// any other cell follows model.type (`mixed`: tetrahedra solid, 2D cells shell, segments rod).
-/// Throws SceneError naming the key (model.type or model.groups[k].as), the mesh and the first
-/// cell of a kind the model cannot take (solid: tetrahedra; shell: triangles; rod: segments).
-/// O(cells · groups).
+/// What a scene mesh offers to model.groups' names: its key path, its format ("Gmsh MSH",
+/// "MEDIT", "legacy VTK", or "generated"), and the Gmsh physical names it declares (none for
+/// the others: MEDIT references and generated tags are numbers only).
+struct MeshNames {
+  std::string path;
+  std::string format = "generated";
+  std::vector<io::TagName> names;
+};
+
+/// Which model.groups entries select the cells of one mesh: per cell the last entry that
+/// names it (-1: none), and per entry whether it names any cell (even one a later entry wins).
+/// An entry names a cell by its `tag`, or by its `name` through the mesh's physical names (of
+/// any dimension; a name declared twice selects both tags).
+struct GroupMatch {
+  std::vector<int> of_cell;
+  std::vector<bool> named_a_cell;
+};
+
+/// O(cells · groups + groups · names).
+GroupMatch match_groups(const IndexedMesh& mesh, const MeshNames& names, const Scene& scene);
+
+/// Per cell of `mesh` (one scene mesh, `path` its key path): the model.groups entry `groups`
+/// gives (match_groups().of_cell) decides; otherwise a cell in `embedded`
+/// (io::embedded_cells) is a label, and any other cell follows model.type (`mixed`:
+/// tetrahedra solid, 2D cells shell, segments rod). Throws SceneError naming the key
+/// (model.type or model.groups[k].as), the mesh and the first cell of a kind the model cannot
+/// take (solid: tetrahedra; shell: triangles; rod: segments). O(cells).
+std::vector<CellModel> cell_models(const IndexedMesh& mesh, const std::vector<bool>& embedded, const Scene& scene,
+                                   const std::string& path, const std::vector<int>& groups);
+/// The same, for a mesh with no physical names (groups selected by tag only).
 std::vector<CellModel> cell_models(const IndexedMesh& mesh, const std::vector<bool>& embedded, const Scene& scene,
                                    const std::string& path);
 
-/// Throws SceneError at model.groups[k].tag for a group whose tag no cell of `tags_seen` carries.
-void check_groups_used(const Scene& scene, const std::vector<std::int32_t>& tags_seen);
+/// Throws SceneError for a model.groups entry that named no cell of any mesh (`named_a_cell`,
+/// or-ed over the meshes): at .tag, "no cell of any mesh carries tag t"; at .name, either the
+/// physical group that has no cell, or, for a name no mesh declares, every mesh's physical
+/// names (and which meshes have numbers only).
+void check_groups_used(const Scene& scene, const std::vector<bool>& named_a_cell, const std::vector<MeshNames>& meshes);
 
 /// The simulated part of a mesh as read: cells counted by dimension and the components of the
 /// complex they form (cells sharing a point are connected), and the labels by tag.

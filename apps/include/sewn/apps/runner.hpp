@@ -47,6 +47,7 @@ struct Assembly {
   IndexedMesh mesh;
   IndexedMesh labels;
   std::vector<CellModel> model_of_cell;
+  std::vector<int> group_of_cell;  ///< the model.groups entry that selected the cell, -1: none
   std::vector<std::uint32_t> material_of_cell;
   std::vector<std::string> material_names;
   std::vector<std::uint32_t> first_cell;  ///< per scene mesh, its first cell in `mesh`

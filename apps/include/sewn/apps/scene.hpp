@@ -83,8 +83,11 @@ struct CutSpec {
 };
 
 /// model.groups[k]: the cells of one mesh tag simulated as a solid, shell or rod, or a label.
+/// The tag is given as a number, or as a Gmsh physical name that each mesh resolves through its
+/// own $PhysicalNames (cell_models.hpp): two files may number the same name differently.
 struct ModelGroup {
   int tag = 0;
+  std::string name;                   // a Gmsh physical name; empty: select by `tag`
   std::string as;                     // solid, shell, rod, label
   std::array<double, 2> semi_axes{};  // rod section (a = b: circular); 0: from the material's area
 };

@@ -70,8 +70,14 @@ class Rod {
   /// cyclic for a closed rod — with a backtracking line search), from the stored θ. Returns
   /// the Newton iterations used. Afterwards ∂E/∂θ = 0 on free edges, so the position
   /// gradient of evaluate() is the exact gradient of the reduced energy min_θ E (envelope
-  /// theorem). Throws SolveError if it does not converge in 100 iterations. O(n) per iteration.
+  /// theorem). A rod that turns_freely() with no angle held has a singular θ block along
+  /// (1, ..., 1): the solve keeps to the directions orthogonal to it, so the angles' mean stays
+  /// where it was (no hold needed). Throws SolveError if it does not converge in 100
+  /// iterations. O(n) per iteration.
   int solve_twist(const Points& x);
+  /// Whether the energy is unchanged when every θ turns by the same angle: a round section
+  /// (EI1 = EI2) and no natural curvature (|κ̄| ≤ 1e-12) at every stencil. O(n).
+  [[nodiscard]] bool turns_freely() const;
 
   /// The time-parallel update after an accepted step (or a static Newton iteration): each
   /// edge's reference director is transported from its stored tangent to the current one, and
