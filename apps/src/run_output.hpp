@@ -1,6 +1,6 @@
 #pragma once
 // The runner's output side: the model's state as a mesh of its live elements, the output folder
-// checked before any work, and the frame files' names.
+// checked before any work, the frame files' names and the last frame's picture.
 
 #include <cstdint>
 #include <filesystem>
@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "sewn/apps/runner.hpp"
+#include "sewn/apps/scene.hpp"
+#include "sewn/cmap/mesh.hpp"
 #include "sewn/io/write.hpp"
 #include "sewn/physics/mss_model.hpp"
 
@@ -45,5 +47,10 @@ void writing(F&& write) {
 
 /// frame_00042.vtu for frame 42.
 std::string frame_file(std::uint32_t frame);
+
+// Draws the last frame as the scene asks (colour, size, style), the faces a cut opened in
+// `mesh` (the mesh before any edit) highlighted; returns the picture's path in `out`.
+std::filesystem::path write_picture(const Scene& scene, double simulated, const std::filesystem::path& out, const IndexedMesh& mesh,
+                                    const physics::MssModel<3>& model, Snapshot& snap);
 
 }  // namespace sewn::app::detail

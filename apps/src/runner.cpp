@@ -6,8 +6,6 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
-#include <limits>
-#include <map>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -18,7 +16,6 @@
 #include "sewn/io/cleanup.hpp"
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/read.hpp"
-#include "sewn/io/render.hpp"
 #include "sewn/io/surface.hpp"
 #include "sewn/io/write.hpp"
 #include "sewn/physics/integrate/energy_ledger.hpp"
@@ -129,33 +126,6 @@ IndexedMesh generate(const MeshSpec& spec, const std::string& file, const std::s
     io::check_mesh_geometry(m, spec.path);
   }
   return m;
-}
-
-// A face as its sorted points (through `point`), padded: a set key.
-template <class F>
-std::array<std::uint32_t, 4> face_key(std::span<const std::uint32_t> face, F&& point) {
-  std::array<std::uint32_t, 4> k;
-  k.fill(std::numeric_limits<std::uint32_t>::max());
-  for (std::size_t i = 0; i < face.size() && i < 4; ++i) k[i] = point(face[i]);
-  std::sort(k.begin(), k.end());
-  return k;
-}
-
-// Faces shared by two volume cells of a mesh.
-std::set<std::array<std::uint32_t, 4>> interior_faces(const IndexedMesh& m) {
-  std::map<std::array<std::uint32_t, 4>, int> count;
-  for (std::uint32_t c = 0; c < m.num_cells(); ++c) {
-    const auto v = m.cell(c);
-    for (const auto& f : cell_faces(m.types[c])) {
-      std::array<std::uint32_t, 4> pts{};
-      for (std::size_t i = 0; i < f.size(); ++i) pts[i] = v[f[i]];
-      ++count[face_key(std::span<const std::uint32_t>(pts.data(), f.size()), [](std::uint32_t q) { return q; })];
-    }
-  }
-  std::set<std::array<std::uint32_t, 4>> out;
-  for (const auto& [k, n] : count)
-    if (n == 2) out.insert(k);
-  return out;
 }
 
 // A semi-implicit step, its stable-step refusal told in the scene's terms: the user sets scene
@@ -777,33 +747,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   if (sum.stopped) return sum;
 
   // 6) the picture of the last frame
-  if (scene.write_picture) {
-    snap.take(*model);
-    const std::vector<double>* scalar = &snap.displacement_norm;
-    std::string label = "|displacement| [m]";
-    if (scene.color_by == "speed") scalar = &snap.speed, label = "speed [m/s]";
-    if (scene.color_by == "force") scalar = &snap.force_norm, label = "|force| [N]";
-    if (scene.color_by == "fixed") scalar = &snap.fixed_scalar, label = "fixed";
-    if (scene.color_by == "material") scalar = &snap.material_scalar, label = "material";
-    if (scene.color_by == "level") scalar = &snap.level_scalar, label = "refinement level";
-    io::RenderOptions ro;
-    ro.width = static_cast<int>(scene.width);
-    ro.height = static_cast<int>(scene.height);
-    ro.mode = scene.style == "wireframe" ? io::RenderMode::wireframe : io::RenderMode::shaded;
-    char title[160];
-    std::snprintf(title, sizeof title, "%s, t = %.3g s", scene.name.c_str(), sum.simulated);
-    ro.title = title;
-    ro.scalar_name = label;
-    // Faces a cut opened: boundary faces now, whose particles stand for the points of a face
-    // that two volumes shared in the original mesh (the paper draws them red).
-    const auto interior = interior_faces(mesh);
-    if (!interior.empty())
-      ro.highlight = [&](std::span<const std::uint32_t> face) {
-        return interior.count(face_key(face, [&](std::uint32_t q) { return model->point_of_node(q); })) > 0;
-      };
-    sum.picture = sum.out / (scene.name + ".png");
-    writing([&] { io::render_png(sum.picture, snap.points, snap.cells(), *scalar, ro); });
-  }
+  if (scene.write_picture) sum.picture = detail::write_picture(scene, sum.simulated, sum.out, mesh, *model, snap);
   return sum;
 }
 
