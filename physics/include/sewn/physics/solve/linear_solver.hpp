@@ -70,8 +70,9 @@ struct SolverOptions {
   /// tolerance relative to it alone would chase that round-off; the floor stops there. 0: none.
   double absolute_tolerance = default_absolute_tolerance;
   int max_iterations = default_max_iterations;
-  /// cholmod-pcg, hypre-pcg: the factorization (AMG hierarchy) is refreshed before the next solve once a solve needed more
-  /// than this many iterations (and at once, with a retry, if CG fails with a stale factor).
+  /// cholmod-pcg, hypre-pcg: the factorization (AMG hierarchy) is refreshed before the next
+  /// solve once a solve needed more than this many iterations (and at once, with a retry, if CG
+  /// fails with a stale one).
   int refresh_iterations = 12;
 };
 
@@ -88,11 +89,12 @@ struct SolveReport {
 };
 
 /// What a backend keeps from one solve to the next that changes later results, for a
-/// checkpoint. cholmod-pcg (hypre-pcg) preconditions with a factorization (an AMG hierarchy) of an earlier matrix, refreshed
-/// when CG slows down: which matrix that was decides every later iterate, so the state holds
-/// its values and whether a refresh is due. jacobi keeps nothing, and cholmod's kept factor
-/// changes no result: it refactors whenever the values differ, and a factorization of equal
-/// values on the analysis of an equal pattern is the same, bit for bit.
+/// checkpoint. cholmod-pcg (hypre-pcg) preconditions with a factorization (an AMG hierarchy) of
+/// an earlier matrix, refreshed when CG slows down: which matrix that was decides every later
+/// iterate, so the state holds its values and whether a refresh is due. jacobi and petsc keep
+/// nothing (petsc sets its preconditioner up at every solve), and cholmod's kept factor changes
+/// no result: it refactors whenever the values differ, and a factorization of equal values on
+/// the analysis of an equal pattern is the same, bit for bit.
 struct SolverState {
   std::vector<double> factored;  ///< cholmod-pcg, hypre-pcg: the filtered matrix's stored entries when factored (empty: no factor)
   bool refresh_due = false;      ///< cholmod-pcg, hypre-pcg: the last solve needed more than refresh_iterations
