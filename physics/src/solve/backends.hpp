@@ -15,6 +15,12 @@ std::unique_ptr<LinearSolver> make_jacobi(SolverOptions o);
 std::unique_ptr<LinearSolver> make_cholmod(SolverOptions o);
 std::unique_ptr<LinearSolver> make_cholmod_pcg(SolverOptions o);
 #endif
+#ifdef SEWN_HAVE_HYPRE
+std::unique_ptr<LinearSolver> make_hypre_pcg(SolverOptions o);
+#endif
+#ifdef SEWN_HAVE_PETSC
+std::unique_ptr<LinearSolver> make_petsc(SolverOptions o);
+#endif
 
 /// Throws InputError unless b, x and free_dof (and mass_scale, if given) hold 3·A.size() values.
 void check_sizes(const char* who, const BlockMatrix& A, std::span<const double> b, std::span<const double> x,

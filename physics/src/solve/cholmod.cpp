@@ -1,7 +1,8 @@
 // The CHOLMOD backends: a sparse Cholesky solve, and CG preconditioned by a factorization kept
-// across solves. Both factor the filtered matrix K = S A S + (I - S): fixed axes become
-// identity rows and columns. K's scalar pattern is that of A's blocks whatever the mask, so
-// the symbolic analysis depends on A's pattern only and survives a change of fixed axes.
+// across solves (KeptPcg, kept_pcg.hpp). Both factor the filtered matrix K = S A S + (I - S):
+// fixed axes become identity rows and columns. K's scalar pattern is that of A's blocks whatever
+// the mask, so the symbolic analysis depends on A's pattern only and survives a change of fixed
+// axes.
 
 #include <cholmod.h>
 
@@ -11,23 +12,13 @@
 #include <vector>
 
 #include "backends.hpp"
+#include "kept_pcg.hpp"
 #include "sewn/physics/aligned.hpp"
 #include "sewn/physics/errors.hpp"
 
 namespace sewn::physics::solve::detail {
 
 namespace {
-
-// Eight partial sums in a fixed order (deterministic; see cg.cpp).
-double dot(const double* __restrict x, const double* __restrict y, std::size_t n) {
-  double part[8] = {};
-  const std::size_t n8 = n - n % 8;
-  for (std::size_t k = 0; k < n8; k += 8)
-    for (std::size_t q = 0; q < 8; ++q) part[q] += x[k + q] * y[k + q];
-  double s = ((part[0] + part[1]) + (part[2] + part[3])) + ((part[4] + part[5]) + (part[6] + part[7]));
-  for (std::size_t k = n8; k < n; ++k) s += x[k] * y[k];
-  return s;
-}
 
 // One CHOLMOD workspace, the filtered matrix in its upper-triangular CSC form, and its factor.
 class Factorization {
@@ -290,137 +281,11 @@ class CholmodDirect final : public LinearSolver {
   AlignedVector<double> xt_, r_;
 };
 
-class CholmodPcg final : public LinearSolver {
- public:
-  explicit CholmodPcg(SolverOptions o) : LinearSolver(o) {}
-  [[nodiscard]] Backend backend() const override { return Backend::cholmod_pcg; }
-  void reset() override {
-    f_.forget();
-    stale_ = false;
-  }
-  [[nodiscard]] SolverState state() const override {
-    SolverState s;
-    if (f_.valid()) s.factored = f_.factored_values();
-    s.refresh_due = stale_;
-    return s;
-  }
-  void restore(const BlockMatrix& A, const SolverState& s) override {
-    f_.forget();
-    if (!s.factored.empty()) f_.factor_values(A, s.factored, "cholmod-pcg restore");
-    stale_ = s.refresh_due;
-  }
-
-  SolveReport solve(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
-                    std::span<const double> mass_scale) override {
-    check_sizes("cholmod-pcg solve", A, b, x, free_dof, mass_scale);
-    SolveReport rep;
-    rep.backend = Backend::cholmod_pcg;
-    const double floor = absolute_floor(opt_, free_dof, mass_scale);
-    if (f_.sync_pattern(A) || !f_.valid() || stale_) refresh(A, free_dof, rep);
-    x0_.assign(x.begin(), x.end());
-    auto t = Clock::now();
-    bool ok = pcg(A, b, x, free_dof, floor, rep);
-    rep.solve_ms += ms_since(t);
-    if (!ok && rep.factorizations == 0) {
-      // The kept factor no longer preconditions well enough: refresh it and start over.
-      std::copy(x0_.begin(), x0_.end(), x.begin());
-      refresh(A, free_dof, rep);
-      const int before = rep.iterations;
-      t = Clock::now();
-      ok = pcg(A, b, x, free_dof, floor, rep);
-      rep.iterations += before;
-      rep.solve_ms += ms_since(t);
-    }
-    stale_ = rep.iterations > opt_.refresh_iterations;
-    if (breakdown_)
-      throw SolverError("cholmod-pcg solve: CG broke down (pᵀAp ≤ 0) with a fresh factorization: the matrix is not "
-                        "positive definite on the free axes",
-                        rep.iterations, rep.relative_residual);
-    return rep;
-  }
-
- private:
-  void refresh(const BlockMatrix& A, std::span<const double> free_dof, SolveReport& rep) {
-    auto t = Clock::now();
-    if (!f_.analysed()) {
-      f_.analyse();
-      rep.symbolic_analyses = 1;
-      rep.analyse_ms += ms_since(t);
-      t = Clock::now();
-    }
-    f_.fill_values(A, free_dof);
-    f_.factorize("cholmod-pcg solve", true);  // the values are kept for state()
-    ++rep.factorizations;
-    rep.factor_ms += ms_since(t);
-    stale_ = false;
-  }
-
-  // Filtered PCG (PHYSICS_NOTES §1.5) with z = S K⁻¹ r. Returns converged; sets breakdown_.
-  bool pcg(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
-           double floor, SolveReport& rep) {
-    const std::size_t n3 = b.size();
-    for (auto* v : {&r_, &z_, &p_, &q_}) v->resize(n3);
-    breakdown_ = false;
-    double bb = 0;
-    for (std::size_t k = 0; k < n3; ++k) bb += free_dof[k] * b[k] * b[k];
-    const double b_norm = std::sqrt(bb);
-    rep.iterations = 0;
-    if (bb == 0.0) {
-      for (std::size_t k = 0; k < n3; ++k)
-        if (free_dof[k] != 0.0) x[k] = 0.0;
-      rep.residual = rep.relative_residual = 0.0;
-      return rep.converged = true;
-    }
-    const double stop = std::max(opt_.tolerance * b_norm, floor);
-    A.multiply(x, q_);
-    for (std::size_t k = 0; k < n3; ++k) r_[k] = free_dof[k] * (b[k] - q_[k]);
-    double r_norm = std::sqrt(dot(r_.data(), r_.data(), n3));
-    auto precondition = [&] {
-      f_.solve(r_, z_);
-      for (std::size_t k = 0; k < n3; ++k) z_[k] *= free_dof[k];
-    };
-    if (r_norm > stop) precondition();
-    std::copy(z_.begin(), z_.end(), p_.begin());
-    double rz = dot(r_.data(), z_.data(), n3);
-    int it = 0;
-    while (r_norm > stop && it < opt_.max_iterations) {
-      A.multiply(p_, q_);
-      for (std::size_t k = 0; k < n3; ++k) q_[k] *= free_dof[k];
-      const double pq = dot(p_.data(), q_.data(), n3);
-      if (!(pq > 0.0)) {
-        breakdown_ = rep.factorizations > 0;  // with a stale factor: retried after a refresh
-        break;
-      }
-      const double alpha = rz / pq;
-      for (std::size_t k = 0; k < n3; ++k) {
-        x[k] += alpha * p_[k];
-        r_[k] -= alpha * q_[k];
-      }
-      ++it;
-      r_norm = std::sqrt(dot(r_.data(), r_.data(), n3));
-      if (r_norm <= stop) break;
-      precondition();
-      const double rz_new = dot(r_.data(), z_.data(), n3);
-      const double beta = rz_new / rz;
-      rz = rz_new;
-      for (std::size_t k = 0; k < n3; ++k) p_[k] = z_[k] + beta * p_[k];
-    }
-    rep.iterations = it;
-    rep.residual = r_norm;
-    rep.relative_residual = r_norm / b_norm;
-    rep.converged = std::isfinite(r_norm) && r_norm <= stop;
-    return rep.converged;
-  }
-
-  Factorization f_;
-  bool stale_ = false, breakdown_ = false;
-  AlignedVector<double> r_, z_, p_, q_;
-  std::vector<double> x0_;
-};
-
 }  // namespace
 
 std::unique_ptr<LinearSolver> make_cholmod(SolverOptions o) { return std::make_unique<CholmodDirect>(o); }
-std::unique_ptr<LinearSolver> make_cholmod_pcg(SolverOptions o) { return std::make_unique<CholmodPcg>(o); }
+std::unique_ptr<LinearSolver> make_cholmod_pcg(SolverOptions o) {
+  return std::make_unique<KeptPcg<Factorization>>(o, Backend::cholmod_pcg, "cholmod-pcg");
+}
 
 }  // namespace sewn::physics::solve::detail

@@ -13,22 +13,57 @@ std::string_view to_string(Backend b) {
     case Backend::jacobi: return "jacobi";
     case Backend::cholmod: return "cholmod";
     case Backend::cholmod_pcg: return "cholmod-pcg";
+    case Backend::hypre_pcg: return "hypre-pcg";
+    case Backend::petsc: return "petsc";
   }
   return "?";
 }
 
+namespace {
+constexpr Backend all_backends[] = {Backend::jacobi, Backend::cholmod, Backend::cholmod_pcg, Backend::hypre_pcg, Backend::petsc};
+
+// The library a backend needs at build time, for the message when it is missing.
+const char* library_of(Backend b) {
+  switch (b) {
+    case Backend::cholmod:
+    case Backend::cholmod_pcg: return "SuiteSparse CHOLMOD (Debian libsuitesparse-dev)";
+    case Backend::hypre_pcg: return "hypre (Debian libhypre-dev)";
+    case Backend::petsc: return "PETSc (Debian libpetsc-real-dev)";
+    default: return "nothing";
+  }
+}
+}  // namespace
+
 bool available(Backend b) {
+  switch (b) {
+    case Backend::automatic:
+    case Backend::jacobi: return true;
+    case Backend::cholmod:
+    case Backend::cholmod_pcg:
 #ifdef SEWN_HAVE_CHOLMOD
-  (void)b;
-  return true;
+      return true;
 #else
-  return b == Backend::automatic || b == Backend::jacobi;
+      return false;
 #endif
+    case Backend::hypre_pcg:
+#ifdef SEWN_HAVE_HYPRE
+      return true;
+#else
+      return false;
+#endif
+    case Backend::petsc:
+#ifdef SEWN_HAVE_PETSC
+      return true;
+#else
+      return false;
+#endif
+  }
+  return false;
 }
 
 std::vector<Backend> available_backends() {
   std::vector<Backend> out;
-  for (Backend b : {Backend::jacobi, Backend::cholmod, Backend::cholmod_pcg})
+  for (Backend b : all_backends)
     if (available(b)) out.push_back(b);
   return out;
 }
@@ -42,22 +77,28 @@ std::string built_in_list() {
 }  // namespace
 
 Backend parse_backend(std::string_view name) {
-  for (Backend b : {Backend::automatic, Backend::jacobi, Backend::cholmod, Backend::cholmod_pcg}) {
+  if (name == to_string(Backend::automatic)) return Backend::automatic;
+  std::string all;
+  for (Backend b : all_backends) {
+    all += ", " + std::string(to_string(b));
     if (name != to_string(b)) continue;
     if (!available(b))
-      throw InputError("solver '" + std::string(name) + "' is not built in (SuiteSparse CHOLMOD was not found at build time); built in: auto, " +
-                       built_in_list());
+      throw InputError("solver '" + std::string(name) + "' is not built in (" + library_of(b) +
+                       " was not found at build time); built in: auto, " + built_in_list());
     return b;
   }
-  throw InputError("unknown solver '" + std::string(name) + "'; expected one of auto, " + built_in_list());
+  throw InputError("unknown solver '" + std::string(name) + "'; expected one of auto" + all + " (built in: auto, " +
+                   built_in_list() + ")");
 }
 
 Backend default_backend(std::size_t nodes) {
   (void)nodes;
-  // Measured (docs/solvers.md, bench/solve): with Debian's reference BLAS under CHOLMOD, a
-  // factorization and its triangular solves cost more than block-Jacobi CG's iterations on
-  // every case from the 8×8×10 beam at h = 1 ms to the N = 8 cantilever at h = 10 ms (564
-  // iterations a step), in CPU time; so no size picks a CHOLMOD backend today.
+  // Measured (docs/solvers.md, bench/solve, CPU time per implicit step at equal or better error):
+  // block-Jacobi CG is the fastest of the five backends on every case, from the 1890-tet beam
+  // (480 nodes) to the N = 8 cantilever at h = 10 ms (6561 nodes, 564 iterations a step): a
+  // CHOLMOD factorization (reference BLAS; OpenBLAS makes it 3x faster, still not enough), a
+  // BoomerAMG or GAMG V-cycle cost more than the block-Jacobi iterations they save. So the rule
+  // is: jacobi at every size measured; larger models are to be measured before it changes.
   return Backend::jacobi;
 }
 
@@ -75,9 +116,19 @@ std::unique_ptr<LinearSolver> make_solver(Backend b, SolverOptions options, std:
     case Backend::cholmod: return detail::make_cholmod(options);
     case Backend::cholmod_pcg: return detail::make_cholmod_pcg(options);
 #endif
+#ifdef SEWN_HAVE_HYPRE
+    case Backend::hypre_pcg: return detail::make_hypre_pcg(options);
+#endif
+#ifdef SEWN_HAVE_PETSC
+    case Backend::petsc: return detail::make_petsc(options);
+#endif
     default: return detail::make_jacobi(options);
   }
 }
+
+#ifndef SEWN_HAVE_MPI
+int solver_ranks() { return 1; }
+#endif
 
 void LinearSolver::restore(const BlockMatrix& /*A*/, const SolverState& s) {
   if (!s.factored.empty())

@@ -20,7 +20,13 @@
 //                up to 3 refinement passes (reported as iterations) while the residual misses
 //                the tolerance (ill-conditioned matrices);
 //   cholmod-pcg  CG preconditioned by a CHOLMOD factorization of a recent A, kept across steps
-//                (and Newton iterations) while CG needs few iterations, refreshed when they grow.
+//                (and Newton iterations) while CG needs few iterations, refreshed when they grow;
+//   hypre-pcg    the same CG and refresh rule, preconditioned by one V-cycle of hypre's BoomerAMG
+//                (algebraic multigrid) set up on a recent A: set-up and V-cycle cost O(entries);
+//   petsc        PETSc's KSP (CG, GAMG preconditioner) on every MPI rank of the program, each
+//                rank owning a contiguous range of rows: the solve distributed, A assembled on
+//                every rank (docs/scaling.md).
+// hypre-pcg and petsc start MPI when the program did not (a serial program is one rank).
 // Backend::automatic picks by model size (default_backend(), measured: docs/solvers.md; today
 // jacobi at every size).
 
@@ -35,14 +41,15 @@
 
 namespace sewn::physics::solve {
 
-enum class Backend { automatic, jacobi, cholmod, cholmod_pcg };
+enum class Backend { automatic, jacobi, cholmod, cholmod_pcg, hypre_pcg, petsc };
 
-/// "auto", "jacobi", "cholmod", "cholmod-pcg". O(1).
+/// "auto", "jacobi", "cholmod", "cholmod-pcg", "hypre-pcg", "petsc". O(1).
 [[nodiscard]] std::string_view to_string(Backend b);
 /// The inverse of to_string; throws InputError listing the names (and saying which are not
 /// built in) for any other name. O(1).
 [[nodiscard]] Backend parse_backend(std::string_view name);
-/// The backends built in (jacobi always; the CHOLMOD ones when SuiteSparse was found). O(1).
+/// The backends built in (jacobi always; the others when their library was found at build
+/// time: SuiteSparse, hypre, PETSc). O(1).
 [[nodiscard]] std::vector<Backend> available_backends();
 [[nodiscard]] bool available(Backend b);
 
@@ -63,8 +70,9 @@ struct SolverOptions {
   /// tolerance relative to it alone would chase that round-off; the floor stops there. 0: none.
   double absolute_tolerance = default_absolute_tolerance;
   int max_iterations = default_max_iterations;
-  /// cholmod-pcg: the factorization is refreshed before the next solve once a solve needed more
-  /// than this many iterations (and at once, with a retry, if CG fails with a stale factor).
+  /// cholmod-pcg, hypre-pcg: the factorization (AMG hierarchy) is refreshed before the next
+  /// solve once a solve needed more than this many iterations (and at once, with a retry, if CG
+  /// fails with a stale one).
   int refresh_iterations = 12;
 };
 
@@ -81,14 +89,15 @@ struct SolveReport {
 };
 
 /// What a backend keeps from one solve to the next that changes later results, for a
-/// checkpoint. cholmod-pcg preconditions with a factorization of an earlier matrix, refreshed
-/// when CG slows down: which matrix that was decides every later iterate, so the state holds
-/// its values and whether a refresh is due. jacobi keeps nothing, and cholmod's kept factor
-/// changes no result: it refactors whenever the values differ, and a factorization of equal
-/// values on the analysis of an equal pattern is the same, bit for bit.
+/// checkpoint. cholmod-pcg (hypre-pcg) preconditions with a factorization (an AMG hierarchy) of
+/// an earlier matrix, refreshed when CG slows down: which matrix that was decides every later
+/// iterate, so the state holds its values and whether a refresh is due. jacobi and petsc keep
+/// nothing (petsc sets its preconditioner up at every solve), and cholmod's kept factor changes
+/// no result: it refactors whenever the values differ, and a factorization of equal values on
+/// the analysis of an equal pattern is the same, bit for bit.
 struct SolverState {
-  std::vector<double> factored;  ///< cholmod-pcg: the filtered matrix's stored entries when factored (empty: no factor)
-  bool refresh_due = false;      ///< cholmod-pcg: the last solve needed more than refresh_iterations
+  std::vector<double> factored;  ///< cholmod-pcg, hypre-pcg: the filtered matrix's stored entries when factored (empty: no factor)
+  bool refresh_due = false;      ///< cholmod-pcg, hypre-pcg: the last solve needed more than refresh_iterations
 };
 
 class LinearSolver {
@@ -115,7 +124,7 @@ class LinearSolver {
   /// See SolverState. O(entries of the kept factorization).
   [[nodiscard]] virtual SolverState state() const { return {}; }
   /// Takes up state() of a solver of this backend, for A's current pattern (the one it was
-  /// taken on, rebuilt): cholmod-pcg factors the stored values again, which gives the factor it
+  /// taken on, rebuilt): cholmod-pcg (hypre-pcg) factors (sets up on) the stored values again, which gives the factor it
   /// had. Throws InputError if the values do not fit A's pattern (or are given to a backend
   /// that keeps none), SolverError if they cannot be factored; the solver then starts afresh
   /// at its next solve. O(one factorization).
@@ -128,6 +137,11 @@ class LinearSolver {
 
 /// The backend `automatic` resolves to for a model of this many nodes (measured, docs/solvers.md).
 [[nodiscard]] Backend default_backend(std::size_t nodes);
+
+/// The number of MPI ranks the petsc backend shares its solves among: the size of
+/// MPI_COMM_WORLD (MPI is started if the program did not), 1 in a build without hypre or PETSc.
+/// Costs ~0.5 s the first time MPI starts, O(1) after.
+[[nodiscard]] int solver_ranks();
 
 /// A solver of backend b (automatic: default_backend(nodes)). Throws InputError if b is not
 /// built in. O(1); the first solve allocates.

@@ -1,0 +1,81 @@
+// The CG loop of the kept-preconditioner backends (kept_pcg.hpp).
+
+#include "kept_pcg.hpp"
+
+#include <cmath>
+
+namespace sewn::physics::solve::detail {
+
+namespace {
+
+// Eight partial sums in a fixed order (deterministic; see cg.cpp).
+double dot(const double* __restrict x, const double* __restrict y, std::size_t n) {
+  double part[8] = {};
+  const std::size_t n8 = n - n % 8;
+  for (std::size_t k = 0; k < n8; k += 8)
+    for (std::size_t q = 0; q < 8; ++q) part[q] += x[k + q] * y[k + q];
+  double s = ((part[0] + part[1]) + (part[2] + part[3])) + ((part[4] + part[5]) + (part[6] + part[7]));
+  for (std::size_t k = n8; k < n; ++k) s += x[k] * y[k];
+  return s;
+}
+
+}  // namespace
+
+PcgOutcome pcg_with(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
+                    double tolerance, double floor, int max_iterations,
+                    const std::function<void(std::span<const double>, std::span<double>)>& precondition, PcgWorkspace& ws) {
+  const std::size_t n3 = b.size();
+  for (auto* v : {&ws.r, &ws.z, &ws.p, &ws.q}) v->resize(n3);
+  auto &r = ws.r, &z = ws.z, &p = ws.p, &q = ws.q;
+  PcgOutcome out;
+  double bb = 0;
+  for (std::size_t k = 0; k < n3; ++k) bb += free_dof[k] * b[k] * b[k];
+  const double b_norm = std::sqrt(bb);
+  if (bb == 0.0) {
+    for (std::size_t k = 0; k < n3; ++k)
+      if (free_dof[k] != 0.0) x[k] = 0.0;
+    out.converged = true;
+    return out;
+  }
+  const double stop = std::max(tolerance * b_norm, floor);
+  A.multiply(x, q);
+  for (std::size_t k = 0; k < n3; ++k) r[k] = free_dof[k] * (b[k] - q[k]);
+  double r_norm = std::sqrt(dot(r.data(), r.data(), n3));
+  auto apply = [&] {
+    precondition(r, z);
+    for (std::size_t k = 0; k < n3; ++k) z[k] *= free_dof[k];
+  };
+  if (r_norm > stop) apply();
+  std::copy(z.begin(), z.end(), p.begin());
+  double rz = dot(r.data(), z.data(), n3);
+  int it = 0;
+  while (r_norm > stop && it < max_iterations) {
+    A.multiply(p, q);
+    for (std::size_t k = 0; k < n3; ++k) q[k] *= free_dof[k];
+    const double pq = dot(p.data(), q.data(), n3);
+    if (!(pq > 0.0) || !(rz > 0.0)) {
+      out.breakdown = true;
+      break;
+    }
+    const double alpha = rz / pq;
+    for (std::size_t k = 0; k < n3; ++k) {
+      x[k] += alpha * p[k];
+      r[k] -= alpha * q[k];
+    }
+    ++it;
+    r_norm = std::sqrt(dot(r.data(), r.data(), n3));
+    if (r_norm <= stop) break;
+    apply();
+    const double rz_new = dot(r.data(), z.data(), n3);
+    const double beta = rz_new / rz;
+    rz = rz_new;
+    for (std::size_t k = 0; k < n3; ++k) p[k] = z[k] + beta * p[k];
+  }
+  out.iterations = it;
+  out.residual = r_norm;
+  out.relative_residual = r_norm / b_norm;
+  out.converged = std::isfinite(r_norm) && r_norm <= stop;
+  return out;
+}
+
+}  // namespace sewn::physics::solve::detail

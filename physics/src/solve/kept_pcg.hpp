@@ -1,0 +1,127 @@
+#pragma once
+// Internal: CG preconditioned by something set up from a recent matrix and kept across solves
+// (a Cholesky factorization, an algebraic multigrid hierarchy), refreshed when CG slows down.
+// The backends cholmod-pcg and hypre-pcg are KeptPcg over their preconditioner.
+
+#include <algorithm>
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "backends.hpp"
+#include "sewn/physics/aligned.hpp"
+#include "sewn/physics/errors.hpp"
+
+namespace sewn::physics::solve::detail {
+
+struct PcgWorkspace {
+  AlignedVector<double> r, z, p, q;
+};
+
+/// What pcg_with() ended with.
+struct PcgOutcome {
+  int iterations = 0;
+  double residual = 0, relative_residual = 0;
+  bool converged = false;
+  bool breakdown = false;  ///< pᵀAp ≤ 0 or rᵀz ≤ 0: the matrix or the preconditioner is not positive definite
+};
+
+/// Filtered PCG (PHYSICS_NOTES §1.5) with z = S P⁻¹ r, P⁻¹ applied by `precondition(r, z)`
+/// (it may leave anything on the fixed axes: they are zeroed after). Stops when
+/// ‖S(b - Ax)‖ ≤ max(tolerance · ‖Sb‖, floor). Deterministic. O(iterations · (product + P⁻¹)).
+PcgOutcome pcg_with(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
+                    double tolerance, double floor, int max_iterations,
+                    const std::function<void(std::span<const double>, std::span<double>)>& precondition, PcgWorkspace& ws);
+
+/// The preconditioner P must offer (see Factorization in cholmod.cpp, AmgHierarchy in hypre.cpp):
+///   bool sync_pattern(A)           rebuild for A's pattern if it changed; true then
+///   bool analysed(), void analyse() the per-pattern set-up
+///   void fill_values(A, free_dof)  the filtered matrix S A S + (I - S) from A
+///   void factorize(who, keep)      the per-values set-up (throws SolverError if not SPD)
+///   bool valid(); const std::vector<double>& factored_values()
+///   void factor_values(A, values, who); void forget(); void solve(r, z)
+template <class P>
+class KeptPcg final : public LinearSolver {
+ public:
+  KeptPcg(SolverOptions o, Backend tag, const char* who) : LinearSolver(o), tag_(tag), who_(who) {}
+  [[nodiscard]] Backend backend() const override { return tag_; }
+  void reset() override {
+    p_.forget();
+    stale_ = false;
+  }
+  [[nodiscard]] SolverState state() const override {
+    SolverState s;
+    if (p_.valid()) s.factored = p_.factored_values();
+    s.refresh_due = stale_;
+    return s;
+  }
+  void restore(const BlockMatrix& A, const SolverState& s) override {
+    p_.forget();
+    if (!s.factored.empty()) p_.factor_values(A, s.factored, (who_ + " restore").c_str());
+    stale_ = s.refresh_due;
+  }
+
+  SolveReport solve(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
+                    std::span<const double> mass_scale) override {
+    check_sizes((who_ + " solve").c_str(), A, b, x, free_dof, mass_scale);
+    SolveReport rep;
+    rep.backend = tag_;
+    const double floor = absolute_floor(opt_, free_dof, mass_scale);
+    if (p_.sync_pattern(A) || !p_.valid() || stale_) refresh(A, free_dof, rep);
+    x0_.assign(x.begin(), x.end());
+    auto t = Clock::now();
+    PcgOutcome out = run(A, b, x, free_dof, floor);
+    rep.solve_ms += ms_since(t);
+    if ((!out.converged || out.breakdown) && rep.factorizations == 0) {
+      // The kept preconditioner no longer serves: refresh it and start over.
+      std::copy(x0_.begin(), x0_.end(), x.begin());
+      refresh(A, free_dof, rep);
+      const int before = out.iterations;
+      t = Clock::now();
+      out = run(A, b, x, free_dof, floor);
+      out.iterations += before;
+      rep.solve_ms += ms_since(t);
+    }
+    rep.iterations = out.iterations;
+    rep.residual = out.residual;
+    rep.relative_residual = out.relative_residual;
+    rep.converged = out.converged;
+    stale_ = rep.iterations > opt_.refresh_iterations;
+    if (out.breakdown)
+      throw SolverError(who_ + " solve: CG broke down (pᵀAp ≤ 0 or rᵀz ≤ 0) with a fresh preconditioner: the matrix is not "
+                               "positive definite on the free axes",
+                        rep.iterations, rep.relative_residual);
+    return rep;
+  }
+
+ private:
+  PcgOutcome run(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
+                 double floor) {
+    return pcg_with(A, b, x, free_dof, opt_.tolerance, floor, opt_.max_iterations,
+                    [this](std::span<const double> r, std::span<double> z) { p_.solve(r, z); }, ws_);
+  }
+  void refresh(const BlockMatrix& A, std::span<const double> free_dof, SolveReport& rep) {
+    auto t = Clock::now();
+    if (!p_.analysed()) {
+      p_.analyse();
+      rep.symbolic_analyses = 1;
+      rep.analyse_ms += ms_since(t);
+      t = Clock::now();
+    }
+    p_.fill_values(A, free_dof);
+    p_.factorize((who_ + " solve").c_str(), true);  // the values are kept for state()
+    ++rep.factorizations;
+    rep.factor_ms += ms_since(t);
+    stale_ = false;
+  }
+
+  Backend tag_;
+  std::string who_;
+  P p_;
+  bool stale_ = false;
+  PcgWorkspace ws_;
+  std::vector<double> x0_;
+};
+
+}  // namespace sewn::physics::solve::detail
