@@ -305,7 +305,7 @@ TEST_CASE("connections of a mixed mesh: the flap's edge line is curves, the rod'
   CHECK(count(c, ConnectionKind::point, Body::rod, Body::shell) == 1);
   CHECK(c.found.total() == 3);
   // the labels simulated: the tet face as a shell lies on the block, the tet edge as a rod along it
-  s.model_groups = {{4, "shell", {}}, {5, "rod", {}}};
+  s.model_groups = {{4, "", "shell", {}}, {5, "", "rod", {}}};
   c = found();
   CHECK(count(c, ConnectionKind::surface, Body::shell, Body::solid) == 1);
   CHECK(count(c, ConnectionKind::curve, Body::rod, Body::solid) == 1);
