@@ -26,6 +26,12 @@ std::unique_ptr<LinearSolver> make_petsc(SolverOptions o);
 void check_sizes(const char* who, const BlockMatrix& A, std::span<const double> b, std::span<const double> x,
                  std::span<const double> free_dof, std::span<const double> mass_scale);
 
+/// Throws SolverError naming `who`, the node and the axis if a free axis has a negative diagonal
+/// entry, which proves A indefinite (CG or a preconditioner alone may not notice: CG can converge
+/// on an indefinite matrix). Zero is let through: a node nothing stiffens or weighs has a zero row
+/// and a zero right-hand side. O(n).
+void check_diagonal(const char* who, const BlockMatrix& A, std::span<const double> free_dof);
+
 /// The iterative stopping floor: absolute_tolerance · ‖S m‖ (0 without masses).
 double absolute_floor(const SolverOptions& o, std::span<const double> free_dof, std::span<const double> mass_scale);
 

@@ -20,7 +20,7 @@ class JacobiPcg final : public LinearSolver {
                     std::span<const double> mass_scale) override {
     check_sizes("jacobi solve", A, b, x, free_dof, mass_scale);
     const auto t0 = Clock::now();
-    check_diagonal(A, free_dof);
+    check_diagonal("jacobi solve", A, free_dof);
     precond_.resize(9 * std::size_t{A.size()});
     block_jacobi_inverse(A, free_dof, precond_);
     const CgResult cg = filtered_pcg(A, b, x, free_dof, precond_, opt_.tolerance, opt_.max_iterations, ws_,
@@ -39,19 +39,6 @@ class JacobiPcg final : public LinearSolver {
   }
 
  private:
-  // A negative diagonal entry on a free axis proves A indefinite (CG alone may not notice:
-  // it can converge on an indefinite matrix). Zero is let through: a node nothing stiffens or
-  // weighs has a zero row and a zero right-hand side. O(n).
-  static void check_diagonal(const BlockMatrix& A, std::span<const double> free_dof) {
-    for (Index i = 0; i < A.size(); ++i) {
-      const auto B = A.block(A.diagonal(i));
-      for (int a = 0; a < 3; ++a)
-        if (free_dof[3 * std::size_t{i} + static_cast<std::size_t>(a)] != 0.0 && B(a, a) < 0.0)
-          throw SolverError("jacobi solve: the matrix is not positive definite on the free axes (diagonal entry " +
-                                std::to_string(B(a, a)) + " < 0 at node " + std::to_string(i) + ", axis " + "xyz"[a] + ")",
-                            0, 0);
-    }
-  }
   [[noreturn]] static void throw_breakdown(const CgResult& cg);
   AlignedVector<double> precond_;
   CgWorkspace ws_;

@@ -148,6 +148,17 @@ void check_sizes(const char* who, const BlockMatrix& A, std::span<const double> 
                      std::to_string(mass_scale.size()) + ")");
 }
 
+void check_diagonal(const char* who, const BlockMatrix& A, std::span<const double> free_dof) {
+  for (Index i = 0; i < A.size(); ++i) {
+    const auto B = A.block(A.diagonal(i));
+    for (int a = 0; a < 3; ++a)
+      if (free_dof[3 * std::size_t{i} + static_cast<std::size_t>(a)] != 0.0 && B(a, a) < 0.0)
+        throw SolverError(std::string(who) + ": the matrix is not positive definite on the free axes (diagonal entry " +
+                              std::to_string(B(a, a)) + " < 0 at node " + std::to_string(i) + ", axis " + "xyz"[a] + ")",
+                          0, 0);
+  }
+}
+
 double absolute_floor(const SolverOptions& o, std::span<const double> free_dof, std::span<const double> mass_scale) {
   if (mass_scale.empty() || o.absolute_tolerance == 0.0) return 0.0;
   double s = 0;

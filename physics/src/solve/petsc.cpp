@@ -67,7 +67,7 @@ class PetscKsp final : public LinearSolver {
   SolveReport solve(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
                     std::span<const double> mass_scale) override {
     check_sizes("petsc solve", A, b, x, free_dof, mass_scale);
-    check_diagonal(A, free_dof);
+    check_diagonal("petsc solve", A, free_dof);
     SolveReport rep;
     rep.backend = Backend::petsc;
     auto t = Clock::now();
@@ -128,18 +128,6 @@ class PetscKsp final : public LinearSolver {
   }
 
  private:
-  // As jacobi does: a negative diagonal entry on a free axis proves A indefinite; named. O(n).
-  static void check_diagonal(const BlockMatrix& A, std::span<const double> free_dof) {
-    for (Index i = 0; i < A.size(); ++i) {
-      const auto B = A.block(A.diagonal(i));
-      for (int a = 0; a < 3; ++a)
-        if (free_dof[3 * std::size_t{i} + static_cast<std::size_t>(a)] != 0.0 && B(a, a) < 0.0)
-          throw SolverError("petsc solve: the matrix is not positive definite on the free axes (diagonal entry " +
-                                std::to_string(B(a, a)) + " < 0 at node " + std::to_string(i) + ", axis " + "xyz"[a] + ")",
-                            0, 0);
-    }
-  }
-
   // The matrix for A's pattern, split by nodes over the ranks, its vectors and the KSP.
   void create(const BlockMatrix& A) {
     ensure_petsc();
