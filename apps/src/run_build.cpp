@@ -1,0 +1,351 @@
+#include "run_build.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <set>
+#include <string>
+
+#include "sewn/apps/obstacle_keys.hpp"
+#include "sewn/io/cleanup.hpp"
+#include "sewn/io/geometry.hpp"
+#include "sewn/io/read.hpp"
+#include "sewn/io/surface.hpp"
+#include "sewn/physics/solids/volume_term.hpp"
+#include "sewn/physics/split_boxes.hpp"
+#include "sewn/physics/stiffness.hpp"
+
+namespace sewn::app {
+
+namespace detail {
+
+bool selects_cell(const Selector& s, const IndexedMesh& m, std::uint32_t c) {
+  switch (s.type) {
+    case Selector::Type::tag: return m.tags[c] == s.tag;
+    case Selector::Type::points: {
+      for (std::uint32_t q : m.cell(c))
+        if (std::find(s.points.begin(), s.points.end(), q) == s.points.end()) return false;
+      return true;
+    }
+    default: {
+      Vec3 centroid{0, 0, 0};
+      const auto v = m.cell(c);
+      for (std::uint32_t q : v)
+        for (std::size_t k = 0; k < 3; ++k) centroid[k] += m.points[q][k] / static_cast<double>(v.size());
+      return s.contains(centroid);
+    }
+  }
+}
+
+}  // namespace detail
+
+namespace {
+
+using detail::selects_cell;
+using detail::to_vec3;
+using physics::Index;
+using Vec3d = Eigen::Vector3d;
+
+
+// The mesh of `spec`, and in `names` what its file says of its tags.
+IndexedMesh generate(const MeshSpec& spec, const std::string& file, const std::string& path, MeshNames& names) {
+  IndexedMesh m;
+  names.path = path;
+  if (spec.type == "hex_grid" || spec.type == "tet_grid") {
+    GridSpec g;
+    for (int k = 0; k < 3; ++k) {
+      g.spacing[static_cast<std::size_t>(k)] = spec.size[static_cast<std::size_t>(k)] / spec.cells[static_cast<std::size_t>(k)];
+      g.origin[static_cast<std::size_t>(k)] = spec.origin[static_cast<std::size_t>(k)];
+    }
+    m = spec.type == "hex_grid"
+            ? hex_grid(spec.cells[0], spec.cells[1], spec.cells[2], g)
+            : tet_grid(spec.cells[0], spec.cells[1], spec.cells[2], spec.split == "five" ? TetSplit::five : TetSplit::kuhn6, g);
+  } else if (spec.type == "quad_grid" || spec.type == "tri_grid") {
+    GridSpec g;
+    g.spacing = {spec.size[0] / spec.cells[0], spec.size[1] / spec.cells[1], 1.0};
+    m = spec.type == "quad_grid" ? quad_grid(spec.cells[0], spec.cells[1], g) : tri_grid(spec.cells[0], spec.cells[1], g);
+    place_in_plane(m, spec.plane);
+    transform(m, 1.0, spec.origin);
+  } else if (spec.type == "disc") {
+    m = disc(spec.radius, spec.rings, spec.sectors);
+    place_in_plane(m, spec.plane);
+    transform(m, 1.0, spec.origin);
+  } else if (spec.type == "cylinder") {
+    m = cylinder(spec.radius, spec.height, spec.rings, spec.sectors, spec.layers);
+    transform(m, 1.0, spec.origin);
+  } else if (spec.type == "boxes") {
+    std::vector<LatticeBox> boxes;
+    for (const auto& b : spec.boxes) boxes.push_back({b.lo, b.hi});
+    try {
+      m = box_union(boxes, GridSpec{{spec.size[0], spec.size[1], spec.size[2]}, {spec.origin[0], spec.origin[1], spec.origin[2]}});
+    } catch (const MeshError& e) {
+      throw SceneError(file, path + ".boxes", e.what());
+    }
+  } else if (spec.type == "polyline") {
+    std::vector<Point3> pts;
+    for (const Vec3& p : spec.points) pts.push_back({p[0], p[1], p[2]});
+    try {
+      m = polyline(pts);
+    } catch (const MeshError& e) {
+      throw SceneError(file, path + ".points", e.what());
+    }
+  } else if (spec.type == "surface") {
+    m = io::voxelize(io::read_surface(spec.path), spec.cells[0], spec.path);
+    transform(m, spec.scale, spec.translate);
+  } else if (spec.type == "file") {
+    io::MeshFile read = io::read_mesh_file(spec.path);
+    names.format = io::to_string(read.format);
+    names.names = std::move(read.tag_names);
+    m = std::move(read.mesh);
+    io::drop_unused_points(m);
+    transform(m, spec.scale, spec.translate);
+    io::check_mesh_geometry(m, spec.path);
+  }
+  return m;
+}
+
+
+// The particles a selector picks: those of tagged cells (simulated or labels; a label's points
+// that no simulated cell uses carry no particle), listed mesh points, or those whose rest
+// position lies in the region. Throws SceneError (at `path`) for a point of no cell or an
+// empty selection.
+std::set<Index> selected_nodes(const Selector& where, const Assembly& assembly, const physics::MssModel<3>& model,
+                               const std::string& file, const std::string& path) {
+  const IndexedMesh& mesh = assembly.mesh;
+  std::set<Index> nodes;
+  if (where.type == Selector::Type::tag) {
+    for (const IndexedMesh* cells : {&assembly.mesh, &assembly.labels})
+      for (std::uint32_t c = 0; c < cells->num_cells(); ++c)
+        if (cells->tags[c] == where.tag)
+          for (std::uint32_t q : cells->cell(c))
+            if (model.node_of_point(q) != physics::invalid_index) nodes.insert(model.node_of_point(q));
+  } else if (where.type == Selector::Type::points) {
+    for (std::uint32_t q : where.points) {
+      if (q >= mesh.num_points() || model.node_of_point(q) == physics::invalid_index)
+        throw SceneError(file, path + ".indices",
+                         "point " + std::to_string(q) + " is not a point of any cell (" + std::to_string(mesh.num_points()) + " points)");
+      nodes.insert(model.node_of_point(q));
+    }
+  } else {
+    for (Index i = 0; i < model.nodes().size(); ++i)
+      if (where.contains(to_vec3(model.rest_position(i)))) nodes.insert(i);
+  }
+  if (nodes.empty()) throw SceneError(file, path, "selects no particle");
+  return nodes;
+}
+
+// The "split" policy: hexahedra too elongated for Baudet's stiffness, of materials that ask
+// for it, are cut into near-cubes (physics/split_boxes.hpp) with their sheets' neighbours.
+void split_elongated(const Scene& scene, Assembly& a) {
+  a.source_cells = a.mesh.num_cells();
+  std::vector<std::uint8_t> wanted(a.mesh.num_cells(), 0);
+  bool any = false;
+  for (std::uint32_t c = 0; c < a.mesh.num_cells(); ++c) {
+    const MaterialSpec& m = scene.materials.at(a.material_names[a.material_of_cell[c]]);
+    if (m.elongated != "split" || a.mesh.types[c] != CellType::hexahedron) continue;
+    const auto len = physics::box_axis_lengths(a.mesh, c);
+    wanted[c] = !physics::baudet_box(m.young, m.poisson, len[0], len[1], len[2]).valid();
+    any = any || wanted[c] != 0;
+  }
+  if (!any) return;
+  physics::BoxSplit split = physics::split_boxes(a.mesh, wanted, scene.file);
+  std::vector<std::uint32_t> material(split.source_cell.size());
+  std::vector<CellModel> model(split.source_cell.size());
+  std::vector<int> group(split.source_cell.size());
+  for (std::size_t c = 0; c < material.size(); ++c) {
+    material[c] = a.material_of_cell[split.source_cell[c]];
+    model[c] = a.model_of_cell[split.source_cell[c]];
+    group[c] = a.group_of_cell[split.source_cell[c]];
+  }
+  for (std::uint32_t& first : a.first_cell)
+    first = static_cast<std::uint32_t>(std::lower_bound(split.source_cell.begin(), split.source_cell.end(), first) -
+                                       split.source_cell.begin());
+  a.mesh = std::move(split.mesh);
+  a.material_of_cell = std::move(material);
+  a.model_of_cell = std::move(model);
+  a.group_of_cell = std::move(group);
+  a.split_asked = split.asked;
+  a.split_cells = split.split;
+}
+
+// What the report says of where a mixed model's bodies meet.
+std::string connections_line(const Assembly& a) {
+  const MeshConnections c = mesh_connections(a.mesh, a.model_of_cell);
+  return c.skipped.empty() ? connect::connections_text(c.found) : "  not computed: " + c.skipped + "\n";
+}
+
+
+}  // namespace
+
+Assembly assemble(const Scene& scene) {
+  Assembly a;
+  for (const auto& [name, _] : scene.materials) a.material_names.push_back(name);
+  auto material_index = [&](const std::string& name) {
+    return static_cast<std::uint32_t>(std::find(a.material_names.begin(), a.material_names.end(), name) - a.material_names.begin());
+  };
+  std::vector<bool> group_used(scene.model_groups.size(), false);
+  std::vector<MeshNames> mesh_names(scene.meshes.size());
+  for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+    const MeshSpec& spec = scene.meshes[i];
+    const std::string path = "meshes[" + std::to_string(i) + "]";
+    const IndexedMesh whole = generate(spec, scene.file, path, mesh_names[i]);
+    const GroupMatch groups = match_groups(whole, mesh_names[i], scene);
+    const std::vector<CellModel> models = cell_models(whole, io::embedded_cells(whole), scene, path, groups.of_cell);
+    for (std::size_t k = 0; k < group_used.size(); ++k) group_used[k] = group_used[k] || groups.named_a_cell[k];
+    // the simulated cells and the labels, on the same points
+    IndexedMesh piece, labels;
+    piece.points = whole.points;
+    std::vector<CellModel> piece_models;
+    std::vector<int> piece_groups;
+    for (std::uint32_t c = 0; c < whole.num_cells(); ++c) {
+      if (models[c] == CellModel::label) {
+        labels.add_cell(whole.types[c], whole.cell(c), whole.tags[c]);
+      } else {
+        piece.add_cell(whole.types[c], whole.cell(c), whole.tags[c]);
+        piece_models.push_back(models[c]);
+        piece_groups.push_back(groups.of_cell[c]);
+      }
+    }
+    if (piece.num_cells() == 0)
+      throw SceneError(scene.file, path, whole.num_cells() == 0 ? "the mesh has no cell" : "every cell of the mesh is a label: nothing to simulate");
+    a.first_cell.push_back(a.mesh.num_cells());
+    std::vector<std::uint32_t> mat(piece.num_cells(), material_index(spec.material));
+    for (const auto& [where, name] : spec.regions)
+      for (std::uint32_t c = 0; c < piece.num_cells(); ++c)
+        if (selects_cell(where, piece, c)) mat[c] = material_index(name);
+    const std::uint32_t first_point = append(a.mesh, piece);
+    for (std::uint32_t c = 0; c < labels.num_cells(); ++c) {
+      std::vector<std::uint32_t> v(labels.cell(c).begin(), labels.cell(c).end());
+      for (auto& q : v) q += first_point;
+      a.labels.add_cell(labels.types[c], v, labels.tags[c]);
+    }
+    a.material_of_cell.insert(a.material_of_cell.end(), mat.begin(), mat.end());
+    a.model_of_cell.insert(a.model_of_cell.end(), piece_models.begin(), piece_models.end());
+    a.group_of_cell.insert(a.group_of_cell.end(), piece_groups.begin(), piece_groups.end());
+  }
+  check_groups_used(scene, group_used, mesh_names);
+  split_elongated(scene, a);
+  a.labels.points = a.mesh.points;
+  return a;
+}
+
+namespace {
+
+
+// takes its element's corner particles after the cut) but not refinement, whose new elements
+// would have none: a scene that refines is refused rather than given a term with holes.
+void add_volume_term(const Scene& scene, const std::vector<std::string>& material_names, physics::MssModel<3>& model) {
+  std::vector<double> kappa;
+  for (const auto& name : material_names) {
+    kappa.push_back(scene.materials.at(name).volume_stiffness);
+    if (kappa.back() > 0 && scene.refinement.enabled)
+      throw SceneError(scene.file, "materials." + name + ".volume_stiffness",
+                       "the volume term is not supported with refinement yet (the elements refinement creates would have no "
+                       "volume stencils)");
+  }
+  // Materials past the scene's own are copies apply_rod_sections made for rod cells, which have
+  // no volume to keep.
+  kappa.resize(model.materials().size(), 0.0);
+  (void)physics::solids::add_volume_preservation(model, kappa);
+}
+
+// The physical parameters of the scene's materials, in the assembly's material order.
+std::vector<physics::MaterialParams> material_params(const Scene& scene, const Assembly& assembly) {
+  std::vector<physics::MaterialParams> materials;
+  for (const auto& name : assembly.material_names) {
+    const MaterialSpec& ms = scene.materials.at(name);
+    materials.push_back({ms.young, ms.poisson, ms.density, ms.thickness, ms.area,
+                         ms.elongated == "clamp" ? physics::ElongatedPolicy::clamp : physics::ElongatedPolicy::refuse});
+  }
+  return materials;
+}
+
+physics::MssOptions model_options(const Scene& scene) {
+  physics::MssOptions mo;
+  mo.gravity = Vec3d(scene.gravity[0], scene.gravity[1], scene.gravity[2]);
+  mo.damping = scene.damping == "viscous" ? physics::DampingModel::viscous
+               : scene.damping == "rayleigh" ? physics::DampingModel::rayleigh
+                                             : physics::DampingModel::none;
+  mo.rayleigh_alpha = scene.rayleigh_alpha;
+  mo.rayleigh_beta = scene.rayleigh_beta;
+  mo.environment = scene.environment_damping;
+  mo.source = scene.file;
+  return mo;
+}
+
+// A policy that altered the cells is said so: the body is not the material's.
+void warn_elongation_policies(const RunSummary& sum, const Assembly& assembly) {
+  if (sum.clamped_cells > 0)
+    std::fprintf(stderr,
+                 "sewn: warning: %llu cells are too elongated for Baudet's stiffness and had their negative edge "
+                 "stiffnesses clamped to 0 (materials' elongated = \"clamp\"): the body is too stiff in bending, by "
+                 "4.8x at 2.5:1, 66x at 5:1 and 860x at 10:1 on a 1 m cantilever (issue 17's measurements); refine "
+                 "the mesh towards cubes for a faithful answer\n",
+                 static_cast<unsigned long long>(sum.clamped_cells));
+  if (assembly.split_cells > 0)
+    std::fprintf(stderr,
+                 "sewn: warning: %u cells are too elongated for Baudet's stiffness and were split into near-cubes "
+                 "(materials' elongated = \"split\"); %u cells were cut in all, those included with the cells sharing "
+                 "their split edges: %u cells and %u points now, from %u cells. Stiffnesses are Baudet's own, unaltered: on a 1 m cantilever the static tip is "
+                 "the cube-meshed beam's at 10:1 and 5:1 boxes and 3.1 %% softer at 2.5:1 (issue 17). Mesh cell numbers below "
+                 "are those of the split mesh\n",
+                 assembly.split_asked, assembly.split_cells, assembly.mesh.num_cells(), assembly.mesh.num_points(),
+                 assembly.source_cells);
+}
+
+// The fixed particles, then the initial velocities of their free axes.
+void set_initial_state(const Scene& scene, const Assembly& assembly, physics::MssModel<3>& model) {
+  for (std::size_t k = 0; k < scene.fixed.size(); ++k) {
+    const FixSpec& fix = scene.fixed[k];
+    physics::AxisMask axes = 0;
+    if (fix.axes[0]) axes |= physics::axis_x;
+    if (fix.axes[1]) axes |= physics::axis_y;
+    if (fix.axes[2]) axes |= physics::axis_z;
+    for (Index i : selected_nodes(fix.where, assembly, model, scene.file, "fixed[" + std::to_string(k) + "].where"))
+      model.nodes().fix(i, axes);
+  }
+  for (std::size_t k = 0; k < scene.velocities.size(); ++k) {
+    const VelocitySpec& vel = scene.velocities[k];
+    const Vec3d linear(vel.linear[0], vel.linear[1], vel.linear[2]), angular(vel.angular[0], vel.angular[1], vel.angular[2]),
+        center(vel.center[0], vel.center[1], vel.center[2]);
+    for (Index i : selected_nodes(vel.where, assembly, model, scene.file, "velocities[" + std::to_string(k) + "].where")) {
+      Vec3d v = linear + angular.cross(model.rest_position(i) - center);
+      // a velocity on a fixed axis would make it kinematic: fixed stays fixed
+      for (int a = 0; a < 3; ++a)
+        if ((model.nodes().fixed(i) >> a) & 1u) v[a] = 0;
+      model.nodes().set_velocity(i, v);
+    }
+  }
+}
+
+}  // namespace
+
+namespace detail {
+
+Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum) {
+  Bodies b;
+  b.assembly = assemble(scene);
+  Assembly& assembly = b.assembly;
+  if (scene.model == "mixed") sum.connections = connections_line(assembly);
+  std::vector<physics::MaterialParams> materials = material_params(scene, assembly);
+  apply_rod_sections(scene, assembly.mesh, assembly.model_of_cell, assembly.group_of_cell, materials, assembly.material_of_cell);
+  b.model = std::make_unique<physics::MssModel<3>>(assembly.mesh, materials, assembly.material_of_cell, model_options(scene));
+  physics::MssModel<3>& model = *b.model;
+  add_obstacles(model.system(), scene.obstacles);
+  sum.clamped_cells = static_cast<std::uint64_t>(
+      std::count_if(model.elements().begin(), model.elements().end(), [](const auto& e) { return e.alive && e.clamped; }));
+  sum.split_cells = assembly.split_cells;
+  if (!quiet) warn_elongation_policies(sum, assembly);
+
+  // The continuum models (solids, shells, rods) and the volume term join or replace the springs.
+  if (scene.model != "mass-spring")
+    b.continuum = build_continuum(scene, materials, assembly.mesh, assembly.model_of_cell, assembly.group_of_cell, model);
+  add_volume_term(scene, assembly.material_names, model);
+
+  set_initial_state(scene, assembly, model);
+  if (scene.refinement.enabled) b.refinement = std::make_unique<RefinementRun>(scene, model);
+  return b;
+}
+
+}  // namespace detail
+
+}  // namespace sewn::app

@@ -1,0 +1,38 @@
+#pragma once
+// The runner's first phase: from a scene to the bodies it simulates — the meshes assembled, the
+// mass-spring model with its continuum terms, obstacles and volume term, the fixed particles
+// and initial velocities, and the refinement driver if the scene refines.
+
+#include <memory>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "sewn/apps/continuum.hpp"
+#include "sewn/apps/refine_keys.hpp"
+#include "sewn/apps/runner.hpp"
+#include "sewn/apps/scene.hpp"
+#include "sewn/physics/mss_model.hpp"
+
+namespace sewn::app::detail {
+
+/// Everything a run steps, built from its scene.
+struct Bodies {
+  Assembly assembly;
+  std::unique_ptr<physics::MssModel<3>> model;
+  ContinuumParts continuum;
+  std::unique_ptr<RefinementRun> refinement;  ///< null if the scene refines nothing
+};
+
+/// Builds the scene's bodies at rest with their initial motion. Fills the summary's
+/// connections line (model `mixed`) and the counts of cells the elongation policies altered,
+/// and warns of those on stderr unless `quiet`. Throws SceneError / io errors /
+/// physics::InputError for bad input, each naming the key or file. O(mesh).
+[[nodiscard]] Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum);
+
+/// Does selector `s` pick cell `c` of `m` (by centroid, tag, or all its points)?
+[[nodiscard]] bool selects_cell(const Selector& s, const IndexedMesh& m, std::uint32_t c);
+
+[[nodiscard]] inline Vec3 to_vec3(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
+
+}  // namespace sewn::app::detail
