@@ -172,6 +172,22 @@ def load_derived(path):
     return rows, sections
 
 
+def machine_load(ctx):
+    """The 1-minute load average at the benchmarks' start (Google Benchmark's context) and now,
+    as text; "" where neither is known."""
+    start = ctx.get("load_avg") or []
+    now = None
+    try:
+        with open("/proc/loadavg", encoding="utf-8") as f:
+            now = float(f.read().split()[0])
+    except (OSError, ValueError, IndexError):
+        pass
+    if not start and now is None:
+        return ""
+    fmt_load = lambda v: "unknown" if v is None else f"{v:.2f}"
+    return f"{fmt_load(start[0] if start else None)} / {fmt_load(now)}"
+
+
 def markdown(suite, header, rows, reps, scale, date, plots, written, sections=(), notes=None):
     out = [f"# {suite} benchmarks" + ("" if scale == "full" else f" ({scale} sizes)"), ""]
     if written:
@@ -179,6 +195,10 @@ def markdown(suite, header, rows, reps, scale, date, plots, written, sections=()
     out.append(f"- CPU: {header['cpu']}")
     out.append(f"- Compiler: {header['compiler']}")
     out.append(f"- Date: {date}")
+    if header.get("load"):
+        out.append(f"- Machine load (1-minute average) when the benchmarks started / when the report was written: "
+                   f"{header['load']}. Above the CPU count other work shared the machine: absolute times are "
+                   "inflated, ratios within the run less so.")
     out.append(f"- Each value is the median of {reps} repetitions, ours and the peer interleaved at random in one "
                "run; times are CPU time of the benchmark thread.")
     out.append("- ours/peer and ours/published below 1 favour ours, except for metrics marked "
@@ -240,6 +260,7 @@ def main():
         "suite": args.suite,
         "cpu": f"{cpu_model()} ({cpus} logical CPUs)",
         "compiler": ctx.get("sewn_build", "unknown compiler"),
+        "load": machine_load(ctx),
     }
     reps = max(len(r["time"]) for r in runs.values())
     date = ctx.get("date") or datetime.now().isoformat(timespec="seconds")
