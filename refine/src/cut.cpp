@@ -152,6 +152,21 @@ bool inside(const MssModel<D>& m, const RestFacet& r, const Facet& g) {
   return in_box(c) && detail::bilinear_inside(r.corner, c, s, t, 1e-9);
 }
 
+// Can the vertex of `s` leave a copy no element weighs, or (3D) a T-junction on separated sides?
+// Only if some element around it does not have it as a corner, or (3D) has it on an edge finer
+// than itself: the darts orphan_holders would report. O(vertex degree).
+template <int D>
+bool holds_t_junction(const MssModel<D>& m, Dart s) {
+  for (Dart x : m.map().template cell<0>(s)) {
+    const Index e = m.element_of(x);
+    if (e == invalid_index) continue;
+    if (!m.is_corner_dart(x)) return true;
+    if constexpr (D == 3)
+      if (detail::edge_level(m, x) > m.elements()[e].level) return true;
+  }
+  return false;
+}
+
 // The elements to refine so that a cut of `facets` leaves no particle with no mass, nor (3D) a
 // T-junction on sides whose corners it separated. Unsewing splits each vertex of the
 // facets into one particle per group of darts around it that stay joined once the facets' links
@@ -163,18 +178,30 @@ bool inside(const MssModel<D>& m, const RestFacet& r, const Facet& g) {
 template <int D>
 std::vector<Index> orphan_holders(const MssModel<D>& m, std::span<const Facet> facets) {
   const auto& map = m.map();
-  std::set<std::uint32_t> unsewn;  // darts whose β_D link the cut removes
-  std::vector<Dart> starts;
+  std::vector<Dart> cut_darts, starts;  // the darts whose β_D link the cut removes; those to group
+  // per particle: 0 not looked at, 1 nothing to group, 2 holds a T-junction (each vertex is
+  // walked once, though every facet around it names it)
+  std::vector<std::uint8_t> vertex(m.nodes().size(), 0);
+  auto needs_grouping = [&](Dart x) {
+    std::uint8_t& v = vertex[m.node_of(x)];
+    if (v == 0) v = holds_t_junction(m, x) ? 2 : 1;
+    return v == 2;
+  };
   for (const Facet& f : facets) {
     if (f.index != D) continue;
     for (Dart x : facet_darts(m, f))
       if (const Dart y = map.beta(x, D); !y.is_null()) {
-        unsewn.insert(x.index());
-        unsewn.insert(y.index());
-        starts.push_back(x);
-        starts.push_back(y);
+        cut_darts.push_back(x);
+        cut_darts.push_back(y);
+        // only vertices with a hierarchical dart can leave an orphan (a cut of an unrefined
+        // model, the common case, ends here without grouping any vertex)
+        if (needs_grouping(x)) starts.push_back(x);
+        if (needs_grouping(y)) starts.push_back(y);
       }
   }
+  if (starts.empty()) return {};
+  std::set<std::uint32_t> unsewn;
+  for (Dart x : cut_darts) unsewn.insert(x.index());
   auto link = [&](Dart x, int j) { return j == D && unsewn.count(x.index()) ? Dart{} : map.beta(x, j); };
   std::set<std::uint32_t> seen;
   std::vector<Index> out;
