@@ -84,15 +84,20 @@ void SlaveNodes::expand(std::span<double> z) const {
 }
 
 std::vector<double> SlaveNodes::lumped_masses(const NodeTable& nodes) const {
+  std::vector<double> lumped;
+  lump(nodes, lumped);
+  return lumped;
+}
+
+void SlaveNodes::lump(const NodeTable& nodes, std::vector<double>& lumped) const {
   const auto m = nodes.masses();
-  std::vector<double> lumped(m.begin(), m.end());
-  if (treatment_ != SlaveTreatment::reduction) return lumped;
+  lumped.assign(m.begin(), m.end());
+  if (treatment_ != SlaveTreatment::reduction) return;
   for (std::size_t i = slaves_.size(); i-- > 0;) {
     const SlaveNode& s = slaves_[i];
     for (int k = 0; k < s.masters; ++k) lumped[s.master[k]] += s.weight[k] * lumped[s.node];
     lumped[s.node] = 0;
   }
-  return lumped;
 }
 
 SlaveExpansion SlaveNodes::expansion(Index nodes) const {
@@ -130,12 +135,14 @@ SlaveExpansion SlaveNodes::expansion(Index nodes) const {
 
 std::span<const double> SlaveNodes::inverse_mass_dof(const NodeTable& nodes) {
   if (treatment_ != SlaveTreatment::reduction) return nodes.inverse_mass_dof();
-  const std::vector<double> lumped = lumped_masses(nodes);
+  // every step of the semi-implicit integrator comes here: member buffers, no allocation
+  lump(nodes, lumped_);
   const auto own = nodes.inverse_mass_dof();
-  inv_mass_.assign(own.begin(), own.end());
-  for (std::size_t i = 0; i < lumped.size(); ++i)
-    for (int a = 0; a < 3; ++a)
-      if (own[3 * i + a] != 0) inv_mass_[3 * i + a] = lumped[i] > 0 ? 1 / lumped[i] : 0;  // fixed axes stay 0
+  inv_mass_.resize(own.size());
+  for (std::size_t i = 0; i < lumped_.size(); ++i) {
+    const double inv = lumped_[i] > 0 ? 1 / lumped_[i] : 0;
+    for (std::size_t a = 3 * i; a < 3 * i + 3; ++a) inv_mass_[a] = own[a] != 0 ? inv : 0;  // fixed axes stay 0
+  }
   for (const SlaveNode& s : slaves_)
     for (int a = 0; a < 3; ++a) inv_mass_[3 * s.node + a] = 0;
   return inv_mass_;

@@ -106,7 +106,9 @@ class SlaveNodes {
   std::vector<SlaveNode> slaves_;
   std::vector<std::vector<std::pair<Index, double>>> shares_;
   SlaveTreatment treatment_ = SlaveTreatment::reduction;
-  std::vector<double> inv_mass_, r_, z_, p_, q_, ap_, free_;
+  void lump(const NodeTable& nodes, std::vector<double>& lumped) const;  // lumped_masses into a buffer
+
+  std::vector<double> inv_mass_, lumped_, r_, z_, p_, q_, ap_, free_;
 };
 
 }  // namespace sewn::physics
