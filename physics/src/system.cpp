@@ -10,7 +10,8 @@ namespace sewn::physics {
 
 // ------------------------------------------------------------------ StabilityRows
 
-StabilityRows::StabilityRows(std::span<const double> mass, std::span<const AxisMask> fixed) : mass_(mass), fixed_(fixed) {
+StabilityRows::StabilityRows(std::span<const double> mass, std::span<const AxisMask> fixed, const SlaveExpansion* fold)
+    : mass_(mass), fold_(fold), fixed_(fixed) {
   for (int w = 0; w < 2; ++w) {
     diag_[w].assign(9 * mass.size(), 0.0);
     off_[w].assign(3 * mass.size(), 0.0);
@@ -18,12 +19,45 @@ StabilityRows::StabilityRows(std::span<const double> mass, std::span<const AxisM
 }
 
 void StabilityRows::add_diagonal(Which w, Index i, const Eigen::Matrix3d& B) {
+  if (fold_ == nullptr || !fold_->is_slave(i)) {
+    diagonal_block(w, i, B);
+    return;
+  }
+  // (WᵀKW)_ab += w_a w_b B over the slave's masters: their diagonal and the pairs between them
+  const auto t = fold_->of(i);
+  for (std::size_t a = 0; a < t.size(); ++a) {
+    diagonal_block(w, t[a].node, t[a].weight * t[a].weight * B);
+    for (std::size_t b = a + 1; b < t.size(); ++b) offdiagonal_block(w, t[a].node, t[b].node, t[a].weight * t[b].weight * B);
+  }
+}
+
+void StabilityRows::add_offdiagonal(Which w, Index i, Index j, const Eigen::Matrix3d& B) {
+  const bool si = fold_ != nullptr && fold_->is_slave(i), sj = fold_ != nullptr && fold_->is_slave(j);
+  if (!si && !sj) {
+    offdiagonal_block(w, i, j, B);
+    return;
+  }
+  const SlaveExpansion::Term own_i{i, 1.0}, own_j{j, 1.0};
+  const auto ti = si ? fold_->of(i) : std::span<const SlaveExpansion::Term>(&own_i, 1);
+  const auto tj = sj ? fold_->of(j) : std::span<const SlaveExpansion::Term>(&own_j, 1);
+  for (const auto& a : ti)
+    for (const auto& b : tj) {
+      // a particle reached from both ends (a slave tied to its own master) gets B + Bᵀ on its
+      // diagonal, signed: that is where a spring from a slave to its master loses stiffness
+      if (a.node == b.node)
+        diagonal_block(w, a.node, a.weight * b.weight * (B + B.transpose()));
+      else
+        offdiagonal_block(w, a.node, b.node, a.weight * b.weight * B);
+    }
+}
+
+void StabilityRows::diagonal_block(Which w, Index i, const Eigen::Matrix3d& B) {
   double* d = diag_[w].data() + 9 * std::size_t{i};
   for (int c = 0; c < 3; ++c)
     for (int r = 0; r < 3; ++r) d[3 * c + r] += B(r, c);
 }
 
-void StabilityRows::add_offdiagonal(Which w, Index i, Index j, const Eigen::Matrix3d& B) {
+void StabilityRows::offdiagonal_block(Which w, Index i, Index j, const Eigen::Matrix3d& B) {
   const double mi = mass_[i], mj = mass_[j];
   if (!(mi > 0 && mj > 0)) return;  // removed node: no row, no column
   const double scale = 1.0 / std::sqrt(mi * mj);
@@ -167,7 +201,13 @@ double System::energy_scale() const {
 
 StableStep System::stable_step() {
   refresh();
-  StabilityRows rows(nodes_.masses(), nodes_.fixed_masks());
+  // With T-junctions reduced, the semi-implicit step moves only the masters, with the slaves'
+  // masses lumped onto them and the slaves' springs seen through W: the bound is that reduced
+  // system's. A slave's own row (little mass, a coarse side's springs) would understate h.
+  const bool reduced = slaves_.reduces();
+  const std::vector<double> lumped = reduced ? slaves_.lumped_masses(nodes_) : std::vector<double>{};
+  const SlaveExpansion fold = reduced ? slaves_.expansion(nodes_.size()) : SlaveExpansion{};
+  StabilityRows rows(reduced ? std::span<const double>(lumped) : nodes_.masses(), nodes_.fixed_masks(), reduced ? &fold : nullptr);
   const StateView s = state();
   for (const auto& t : terms_) t->add_stability_rows(s, rows);
   const auto k = rows.bound(StabilityRows::stiffness);

@@ -1,5 +1,6 @@
 #include "sewn/physics/constraints/slave_nodes.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -82,20 +83,66 @@ void SlaveNodes::expand(std::span<double> z) const {
   }
 }
 
-std::span<const double> SlaveNodes::inverse_mass_dof(const NodeTable& nodes) {
-  if (treatment_ != SlaveTreatment::reduction) return nodes.inverse_mass_dof();
+std::vector<double> SlaveNodes::lumped_masses(const NodeTable& nodes) const {
+  std::vector<double> lumped;
+  lump(nodes, lumped);
+  return lumped;
+}
+
+void SlaveNodes::lump(const NodeTable& nodes, std::vector<double>& lumped) const {
   const auto m = nodes.masses();
-  std::vector<double> lumped(m.begin(), m.end());
+  lumped.assign(m.begin(), m.end());
+  if (treatment_ != SlaveTreatment::reduction) return;
   for (std::size_t i = slaves_.size(); i-- > 0;) {
     const SlaveNode& s = slaves_[i];
     for (int k = 0; k < s.masters; ++k) lumped[s.master[k]] += s.weight[k] * lumped[s.node];
     lumped[s.node] = 0;
   }
+}
+
+SlaveExpansion SlaveNodes::expansion(Index nodes) const {
+  SlaveExpansion e;
+  e.slot_.assign(nodes, -1);
+  e.first_.reserve(slaves_.size() + 1);
+  e.first_.push_back(0);
+  std::vector<SlaveExpansion::Term> row;
+  for (std::size_t i = 0; i < slaves_.size(); ++i) {  // coarse to fine: a slave master is expanded first
+    const SlaveNode& s = slaves_[i];
+    row.clear();
+    for (int k = 0; k < s.masters; ++k) {
+      const Index c = s.master[k];
+      if (e.is_slave(c)) {
+        for (const auto& t : e.of(c)) row.push_back({t.node, s.weight[k] * t.weight});
+      } else {
+        row.push_back({c, s.weight[k]});
+      }
+    }
+    // two paths to one particle (masters sharing a master) become one term
+    std::sort(row.begin(), row.end(), [](const auto& a, const auto& b) { return a.node < b.node; });
+    const std::size_t start = e.terms_.size();
+    for (const auto& t : row) {
+      if (e.terms_.size() > start && e.terms_.back().node == t.node)
+        e.terms_.back().weight += t.weight;
+      else
+        e.terms_.push_back(t);
+    }
+    e.first_.push_back(e.terms_.size());  // slave i's terms end here (and slave i + 1's start)
+    if (s.node >= nodes) throw InputError("SlaveNodes::expansion: slave node " + std::to_string(s.node) + " is beyond the " + std::to_string(nodes) + " particles");
+    e.slot_[s.node] = static_cast<std::int32_t>(i);
+  }
+  return e;
+}
+
+std::span<const double> SlaveNodes::inverse_mass_dof(const NodeTable& nodes) {
+  if (treatment_ != SlaveTreatment::reduction) return nodes.inverse_mass_dof();
+  // every step of the semi-implicit integrator comes here: member buffers, no allocation
+  lump(nodes, lumped_);
   const auto own = nodes.inverse_mass_dof();
-  inv_mass_.assign(own.begin(), own.end());
-  for (std::size_t i = 0; i < lumped.size(); ++i)
-    for (int a = 0; a < 3; ++a)
-      if (own[3 * i + a] != 0) inv_mass_[3 * i + a] = lumped[i] > 0 ? 1 / lumped[i] : 0;  // fixed axes stay 0
+  inv_mass_.resize(own.size());
+  for (std::size_t i = 0; i < lumped_.size(); ++i) {
+    const double inv = lumped_[i] > 0 ? 1 / lumped_[i] : 0;
+    for (std::size_t a = 3 * i; a < 3 * i + 3; ++a) inv_mass_[a] = own[a] != 0 ? inv : 0;  // fixed axes stay 0
+  }
   for (const SlaveNode& s : slaves_)
     for (int a = 0; a < 3; ++a) inv_mass_[3 * s.node + a] = 0;
   return inv_mass_;

@@ -96,6 +96,7 @@ Index VolumePreservation::add(const std::array<Index, 4>& nodes, const CornerPos
 void VolumePreservation::follow(const MssModel<3>& model) {
   Index last = invalid_index;
   std::vector<Index> corners;
+  std::vector<char> covered(model.elements().size(), 0);  // live elements that keep live stencils
   for (Index e = 0; e < size(); ++e) {
     const Source& src = source_[e];
     if (src.element == invalid_index || !is_alive(e)) continue;
@@ -103,14 +104,39 @@ void VolumePreservation::follow(const MssModel<3>& model) {
       throw InputError(std::string(name()) + " element " + std::to_string(e) + ": its model element " + std::to_string(src.element) +
                        " does not exist (" + std::to_string(model.elements().size()) + " elements)");
     if (!model.elements()[src.element].alive) {
-      retire_element(e);  // the material is gone (pierced away): nothing left to keep
+      retire_element(e);  // pierced away, or refined (its children carry the volume now)
       continue;
     }
+    covered[src.element] = 1;
     if (src.element != last) {  // a hexahedron's 8 stencils are consecutive: one read for them
       corners = model.element_nodes(src.element);
       last = src.element;
     }
     set_element_nodes(e, {corners[src.corners[0]], corners[src.corners[1]], corners[src.corners[2]], corners[src.corners[3]]});
+  }
+  if (kappa_of_material_.empty()) return;
+  for (Index el = 0; el < model.elements().size(); ++el) {
+    const Element& m = model.elements()[el];
+    if (m.alive && !covered[el] && m.material < kappa_of_material_.size() && kappa_of_material_[m.material] > 0)
+      add_element(model, el, kappa_of_material_[m.material]);
+  }
+}
+
+void VolumePreservation::add_element(const MssModel<3>& model, Index el, double kappa) {
+  const Element& m = model.elements()[el];
+  if (m.kind != ElementKind::tetrahedron && m.kind != ElementKind::hexahedron) return;
+  const std::vector<Index> v = model.element_nodes(el);
+  const auto corner = [&](std::uint8_t o, std::uint8_t a, std::uint8_t b, std::uint8_t c, double weight) {
+    CornerPositions X;
+    const std::array<Index, 4> nodes{v[o], v[a], v[b], v[c]};
+    for (int k = 0; k < 4; ++k) X.col(k) = model.rest_position(nodes[k]);
+    set_source(add(nodes, X, kappa, weight), {el, {o, a, b, c}});
+  };
+  if (m.kind == ElementKind::tetrahedron) {
+    corner(0, 1, 2, 3, m.measure);
+  } else {
+    for (std::uint8_t c = 0; c < 8; ++c)
+      corner(c, detail::hex_corners[c][0], detail::hex_corners[c][1], detail::hex_corners[c][2], m.measure / 8);
   }
 }
 
@@ -127,28 +153,13 @@ VolumePreservation* add_volume_preservation(MssModel<3>& model, std::span<const 
   }
   if (!any) return nullptr;
   auto& term = model.system().add<VolumePreservation>();
-  Index element = 0;
-  const auto add_corner = [&](const std::vector<Index>& v, std::uint8_t o, std::uint8_t a, std::uint8_t b, std::uint8_t c,
-                              double kappa, double weight) {
-    CornerPositions X;
-    const std::array<Index, 4> nodes{v[o], v[a], v[b], v[c]};
-    for (int k = 0; k < 4; ++k) X.col(k) = model.rest_position(nodes[k]);
-    term.set_source(term.add(nodes, X, kappa, weight), {element, {o, a, b, c}});
-  };
   for (Index e = 0; e < model.elements().size(); ++e) {
     const Element& el = model.elements()[e];
-    const double kappa = kappa_of_material[el.material];
-    if (!el.alive || kappa == 0.0) continue;
-    element = e;
-    if (el.kind == ElementKind::tetrahedron) {
-      add_corner(model.element_nodes(e), 0, 1, 2, 3, kappa, el.measure);
-    } else if (el.kind == ElementKind::hexahedron) {
-      const std::vector<Index> v = model.element_nodes(e);
-      for (std::uint8_t c = 0; c < 8; ++c)
-        add_corner(v, c, detail::hex_corners[c][0], detail::hex_corners[c][1], detail::hex_corners[c][2], kappa, el.measure / 8);
-    }
+    if (el.alive && kappa_of_material[el.material] > 0) term.add_element(model, e, kappa_of_material[el.material]);
   }
-  // a cut duplicates particles: each stencil then takes its element's copies
+  term.set_materials({kappa_of_material.begin(), kappa_of_material.end()});
+  // a cut duplicates particles: each stencil then takes its element's copies; refinement and
+  // coarsening change which elements are alive: the live ones get stencils
   model.after_edits([&model, &term] { term.follow(model); });
   return &term;
 }

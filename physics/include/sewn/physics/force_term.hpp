@@ -58,6 +58,13 @@ struct JacobianRequest {
 /// C are the positive-semidefinite stiffness and damping matrices (K = -∂F/∂x with compression
 /// clamped, C = -∂F/∂v). Rows and columns of fixed axes are left out: the bound is for the
 /// free system. Terms call add_diagonal / add_offdiagonal with their 3×3 blocks.
+///
+/// With slaves folded (`fold`, and `mass` the lumped masses of the reduced system), the rows are
+/// those of the reduced system WᵀKW that the semi-implicit step integrates: a block on a slave
+/// is passed to its masters with their weights (w_a w_b B), and the slaves' own rows are left
+/// out (lumped mass 0). Off-diagonal parts are summed in absolute value as they arrive, which
+/// can only raise a row: the bound stays an upper bound.
+class SlaveExpansion;
 class StabilityRows {
  public:
   enum Which { stiffness = 0, damping = 1 };
@@ -65,7 +72,7 @@ class StabilityRows {
     double value = 0.0;          ///< upper bound on λmax(M^{-1}K) (or M^{-1}C), 1/s² (or 1/s)
     Index node = invalid_index;  ///< node whose row gives the bound
   };
-  StabilityRows(std::span<const double> mass, std::span<const AxisMask> fixed);
+  StabilityRows(std::span<const double> mass, std::span<const AxisMask> fixed, const SlaveExpansion* fold = nullptr);
   /// Block (i,i) of K or C receives +B.
   void add_diagonal(Which w, Index i, const Eigen::Matrix3d& B);
   /// Blocks (i,j) = B and (j,i) = Bᵀ (sign irrelevant: absolute values are summed).
@@ -74,7 +81,10 @@ class StabilityRows {
   [[nodiscard]] Bound bound(Which w) const;
 
  private:
+  void diagonal_block(Which w, Index i, const Eigen::Matrix3d& B);
+  void offdiagonal_block(Which w, Index i, Index j, const Eigen::Matrix3d& B);
   std::span<const double> mass_;
+  const SlaveExpansion* fold_ = nullptr;
   std::span<const AxisMask> fixed_;
   std::vector<double> diag_[2];  // 9 per node, column-major
   std::vector<double> off_[2];   // 3 per node, already scaled by 1/sqrt(mi mj)

@@ -29,6 +29,8 @@ namespace sewn::physics {
 /// (proportional or not). It is an upper bound on ω only, so h_max is conservative (the
 /// Baudet grid's true limit is ~1.3× higher undamped). Not covered: the non-symmetric
 /// ∂F^v/∂P, and stiffening once the state moves far from where the bound was taken.
+/// With slave nodes under the reduction (T-junctions), M, K and C are the reduced system's that
+/// the step integrates: lumped masses, WᵀKW and WᵀCW; no slave's row sets the bound.
 struct StableStep {
   double h_max = 0.0;                  ///< +inf when nothing bounds the step
   double stiffness_bound = 0.0;        ///< λ_K, 1/s² (ω_max ≤ √λ_K)

@@ -36,6 +36,29 @@ enum class SlaveTreatment : std::uint8_t {
   paper_projection,  ///< the 2014 paper: equal force shares, then orthogonal projection
 };
 
+/// The rows of W for the slaves: each slave written in particles that are not slaves,
+/// x_v = Σ w_c x_c, nesting resolved (a slave master replaced by its own masters) and repeated
+/// masters merged. What the stable-step bound folds slave rows with (StabilityRows).
+class SlaveExpansion {
+ public:
+  struct Term {
+    Index node = invalid_index;
+    double weight = 0.0;
+  };
+  [[nodiscard]] bool is_slave(Index node) const { return node < slot_.size() && slot_[node] >= 0; }
+  /// A slave's terms (weights summing to 1); call only when is_slave(node). O(1).
+  [[nodiscard]] std::span<const Term> of(Index node) const {
+    const auto k = static_cast<std::size_t>(slot_[node]);
+    return std::span<const Term>(terms_).subspan(first_[k], first_[k + 1] - first_[k]);
+  }
+
+ private:
+  friend class SlaveNodes;
+  std::vector<std::int32_t> slot_;   // node -> slave's position in the list, -1 for others
+  std::vector<std::size_t> first_;   // per slave, where its terms start (one past the end last)
+  std::vector<Term> terms_;
+};
+
 class SlaveNodes {
  public:
   /// Replaces the set. Slaves must come coarse to fine: a master that is itself a slave is
@@ -57,6 +80,12 @@ class SlaveNodes {
   /// Inverse masses per axis for the semi-implicit step: reduction: the masters' lumped masses
   /// m_c + Σ w m_v (fine to coarse), 0 on slaves; paper: the nodes' own. O(n).
   [[nodiscard]] std::span<const double> inverse_mass_dof(const NodeTable& nodes);
+  /// The reduced system's lumped masses (row sums of WᵀMW): each master's own mass plus Σ w m_v
+  /// of its slaves (fine to coarse, so nested slaves reach the particles that move), 0 on
+  /// slaves; under the paper's treatment the nodes' own masses. O(n).
+  [[nodiscard]] std::vector<double> lumped_masses(const NodeTable& nodes) const;
+  /// W's slave rows over `nodes` particles (see SlaveExpansion). O(slaves · masters).
+  [[nodiscard]] SlaveExpansion expansion(Index nodes) const;
   /// After a step: reduction: x_v and v_v interpolated coarse to fine; paper: x_v projected. O(slaves).
   void after_step(NodeTable& nodes) const;
   /// y ← Wᵀ y in place (3 per node): y_c += w y_v fine to coarse, y_v = 0. O(slaves).
@@ -77,7 +106,9 @@ class SlaveNodes {
   std::vector<SlaveNode> slaves_;
   std::vector<std::vector<std::pair<Index, double>>> shares_;
   SlaveTreatment treatment_ = SlaveTreatment::reduction;
-  std::vector<double> inv_mass_, r_, z_, p_, q_, ap_, free_;
+  void lump(const NodeTable& nodes, std::vector<double>& lumped) const;  // lumped_masses into a buffer
+
+  std::vector<double> inv_mass_, lumped_, r_, z_, p_, q_, ap_, free_;
 };
 
 }  // namespace sewn::physics

@@ -64,9 +64,17 @@ class VolumePreservation final : public elements::StencilTerm<4> {
   [[nodiscard]] const Source& source(Index e) const { return source_[e]; }
   /// Re-reads every sourced stencil's nodes from the model's element corners, as they are after
   /// an edit (a cut hands an element the copy of a duplicated particle), and retires the
-  /// stencils of removed elements. Elements added later (refinement's children) get none.
-  /// O(elements).
+  /// stencils of elements no longer alive (pierced away, or refined: the children stand for
+  /// them). With per-material stiffnesses set (set_materials), every live hexahedron or
+  /// tetrahedron whose material has one and that has no live stencil gets its stencils from its
+  /// rest corners: refinement's children, and a parent coarsening revived (its old stencils
+  /// stay retired). O(elements).
   void follow(const MssModel<3>& model);
+  /// The bulk stiffness per model material that follow() gives new elements (0: none).
+  void set_materials(std::vector<double> kappa_of_material) { kappa_of_material_ = std::move(kappa_of_material); }
+  /// Adds the stencils of model element e (a hexahedron's 8 corners, each w = V̄/8, or a
+  /// tetrahedron's one) at bulk stiffness kappa, sourced to e. Other kinds get none. O(1).
+  void add_element(const MssModel<3>& model, Index e, double kappa);
 
   [[nodiscard]] double element_energy(Index e, const Positions& x) const override { return volume_energy(x, rest_[e]); }
   [[nodiscard]] Gradient element_gradient(Index e, const Positions& x) const override { return volume_gradient(x, rest_[e]); }
@@ -75,6 +83,7 @@ class VolumePreservation final : public elements::StencilTerm<4> {
  private:
   std::vector<VolumeStencil> rest_;
   std::vector<Source> source_;
+  std::vector<double> kappa_of_material_;
 };
 
 /// Adds a VolumePreservation term over the live hexahedra and tetrahedra of `model`, each with
