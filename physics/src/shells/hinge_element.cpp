@@ -8,6 +8,7 @@
 #include <unsupported/Eigen/AutoDiff>
 
 #include "sewn/physics/errors.hpp"
+#include "sewn/physics/shells/material_check.hpp"
 
 namespace sewn::physics::shells {
 
@@ -57,13 +58,7 @@ double wrap_angle(double d) {
 }
 
 double hinge_stiffness(double young, double poisson, double thickness) {
-  if (!std::isfinite(young) || young <= 0.0 || !std::isfinite(poisson) || poisson <= -1.0 || poisson >= 0.5 ||
-      !std::isfinite(thickness) || thickness <= 0.0) {
-    std::ostringstream s;
-    s << "hinge bending: need E > 0, -1 < nu < 0.5 and thickness > 0, got E = " << young << " Pa, nu = " << poisson
-      << ", thickness = " << thickness << " m";
-    throw InputError(s.str());
-  }
+  check_shell_material("hinge bending", young, poisson, thickness);
   const double D = young * thickness * thickness * thickness / (12.0 * (1.0 - poisson * poisson));
   return D / 6.0;
 }

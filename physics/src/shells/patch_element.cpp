@@ -10,6 +10,7 @@
 
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/shells/hinge_element.hpp"
+#include "sewn/physics/shells/material_check.hpp"
 
 namespace sewn::physics::shells {
 
@@ -51,13 +52,7 @@ std::string describe(const std::array<std::uint8_t, 3>& edges, int count) {
 }  // namespace
 
 PlateMaterial plate_material(double young, double poisson, double thickness) {
-  if (!std::isfinite(young) || young <= 0.0 || !std::isfinite(poisson) || poisson <= -1.0 || poisson >= 0.5 ||
-      !std::isfinite(thickness) || thickness <= 0.0) {
-    std::ostringstream s;
-    s << "patch bending: need E > 0, -1 < nu < 0.5 and thickness > 0, got E = " << young << " Pa, nu = " << poisson
-      << ", thickness = " << thickness << " m";
-    throw InputError(s.str());
-  }
+  check_shell_material("patch bending", young, poisson, thickness);
   return {young * thickness * thickness * thickness / (12.0 * (1.0 - poisson * poisson)), poisson};
 }
 
