@@ -24,6 +24,12 @@ void check_cuts(const Scene& scene, const std::vector<CellModel>& models) {
     throw SceneError(scene.file, "cuts",
                      "cutting is supported on solid tetrahedra and shells only, and this scene has " + std::to_string(rods) +
                          " rod segments (a rod's stencils and twist angles cannot follow a cut yet)");
+  const auto shells = std::count(models.begin(), models.end(), CellModel::shell);
+  if (shells > 0 && scene.bending == "patch")
+    throw SceneError(scene.file, "model.bending",
+                     "this scene cuts " + std::to_string(shells) +
+                         " shell triangles, which \"patch\" bending cannot follow yet (a triangle's patch holds its "
+                         "neighbours' nodes): use \"hinge\"");
 }
 
 // Checks what a continuum model cannot take and removes the springs it replaces.
@@ -168,6 +174,7 @@ void add_shells(const std::vector<physics::MaterialParams>& materials, const Ind
                 physics::MssModel<3>& model, const Scene& scene, ContinuumParts& parts) {
   std::vector<std::array<Index, 3>> triangles;
   std::vector<double> k_b;
+  std::vector<physics::shells::PlateMaterial> plates;
   for (Index e = 0; e < model.elements().size(); ++e) {
     const auto& el = model.elements()[e];
     if (!el.alive || models[el.mesh_cell] != CellModel::shell) continue;
@@ -179,10 +186,15 @@ void add_shells(const std::vector<physics::MaterialParams>& materials, const Ind
     parts.element_of_membrane.push_back(e);
     triangles.push_back(nodes);
     k_b.push_back(physics::shells::hinge_stiffness(mat.young, mat.poisson, mat.thickness));
+    plates.push_back(physics::shells::plate_material(mat.young, mat.poisson, mat.thickness));
   }
   if (triangles.empty()) return;
-  parts.hinges = &model.system().add<physics::shells::Hinges>();
   try {
+    if (scene.bending == "patch") {
+      parts.patches = physics::shells::add_patch_bending(model.system(), triangles, rest_state(model), plates);
+      return;
+    }
+    parts.hinges = &model.system().add<physics::shells::Hinges>();
     parts.hinges->add_interior_edges(triangles, rest_state(model), k_b);
   } catch (const physics::InputError& e) {
     throw SceneError(scene.file, "meshes", e.what());

@@ -208,9 +208,11 @@ Field build_schema() {
   model.doc("What the bodies' elasticity is made of (docs/elastic.md, docs/mixed.md). In every model, a triangle that is a face of a tetrahedron (a segment that is an edge of a triangle or tetrahedron) is a boundary label, not simulated, unless `groups` says otherwise: mesh generators list such faces (tetgen's face list, Gmsh's boundary groups) to name boundaries.")
       .fallback(nlohmann::json::object())
       .members({field("type", Kind::string).one_of({"mass-spring", "solid", "shell", "mixed"}).fallback("mass-spring")
-                    .doc("`mass-spring`: the 2013 paper's springs on the map's edges; `solid`: finite-element tetrahedra (tetrahedral meshes only); `shell`: CST membranes with Green strain plus hinge bending with k_B = D/6 on the interior edges, thickness from the material (triangle meshes only); `mixed`: each cell by its dimension (tetrahedra solid, triangles shell, segments rod), components touching at points or curves sharing their nodes. `solid` and `shell` cells follow plane, faces and particles cuts and `pierce` (a hinge on a cut edge, and every element pierced away, is removed); scenes with rod cells take no cuts yet. The damping of `solid`, `shell` and `mixed` comes from `rayleigh` α or `environment`, as spring damping does not apply."),
+                    .doc("`mass-spring`: the 2013 paper's springs on the map's edges; `solid`: finite-element tetrahedra (tetrahedral meshes only); `shell`: CST membranes with Green strain plus bending (`bending`), thickness from the material (triangle meshes only); `mixed`: each cell by its dimension (tetrahedra solid, triangles shell, segments rod), components touching at points or curves sharing their nodes. `solid` cells, and `shell` cells with `\"bending\": \"hinge\"`, follow plane, faces and particles cuts and `pierce` (a hinge on a cut edge, and every element pierced away, is removed); scenes with rod cells take no cuts yet. The damping of `solid`, `shell` and `mixed` comes from `rayleigh` α or `environment`, as spring damping does not apply."),
                 field("law", Kind::string).one_of({"stvk", "stable_neo_hookean"}).fallback("stable_neo_hookean")
                     .doc("`solid` cells: St. Venant–Kirchhoff, or the inversion-safe stable neo-Hookean (Smith et al. 2018)."),
+                field("bending", Kind::string).one_of({"patch", "hinge"}).fallback("patch")
+                    .doc("Shell cells' bending: `patch`, the plate energy of the quadratic fitted to each triangle and its neighbours (converges at second order on structured meshes of either diagonal orientation, not yet on irregular ones; held nodes clamp half a cell outside them; no cuts yet), or `hinge`, hinges on the interior edges with k_B = D/6 (up to 2x too soft on meshes whose diagonals run one way; follows cuts). docs/elastic.md has the measured tables."),
                 field("groups", Kind::array).of(group).items(0, 4096).fallback(nlohmann::json::array())
                     .doc("Per mesh tag, what its cells are (later entries win). With `mass-spring`, only `label` is accepted.")});
 
@@ -561,6 +563,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     Reader m(r["model"], *schema.member("model"));
     s.model = m.string("type");
     s.law = m.string("law");
+    s.bending = m.string("bending");
     const Field& group_schema = *schema.member("model")->member("groups")->element_;
     for (std::size_t k = 0; k < m["groups"].size(); ++k) {
       const auto& gj = m["groups"][k];

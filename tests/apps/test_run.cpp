@@ -481,7 +481,7 @@ TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped b
   SUBCASE("hexahedra") {
     expect_run_error<SceneError>(scene("hex_grid", rayleigh, ""), "needs tetrahedra only");
   }
-  SUBCASE("shell: membranes and hinges on a triangle mesh; a volume mesh is refused") {
+  SUBCASE("shell: membranes and patch bending on a triangle mesh; a volume mesh is refused") {
     std::string text = scene("tri_grid", rayleigh, "");
     text.replace(text.find(R"("solid", "law": "stvk")"), 22, R"("shell")");
     text.replace(text.find(R"("cells": [4, 1, 1], "size": [0.4, 0.1, 0.1])"), 43, R"("cells": [4, 1], "size": [0.4, 0.1])");
@@ -511,8 +511,11 @@ TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped b
     CHECK(pierced["elements"] == 18.0);
     CHECK(pierced["particles"] == 16.0);  // the 4 corner points at x = 0.4 went with them
     std::string shell = scene("tri_grid", rayleigh, R"(, "cuts": [{"type": "plane", "time": 0.05, "point": [0.2, 0, 0], "normal": [1, 0, 0]}])");
-    shell.replace(shell.find(R"("solid", "law": "stvk")"), 22, R"("shell")");
     shell.replace(shell.find(R"("cells": [4, 1, 1], "size": [0.4, 0.1, 0.1])"), 43, R"("cells": [4, 1], "size": [0.4, 0.1])");
+    std::string patch_shell = shell;
+    patch_shell.replace(patch_shell.find(R"("solid", "law": "stvk")"), 22, R"("shell")");
+    expect_run_error<SceneError>(patch_shell, "model.bending: this scene cuts 8 shell triangles, which \"patch\" bending cannot follow yet");
+    shell.replace(shell.find(R"("solid", "law": "stvk")"), 22, R"("shell", "bending": "hinge")");
     const LastFrame cut_shell = run_text(shell, "shell_cut");  // the membranes and hinges follow the cut
     CHECK(cut_shell.sum.cuts == 1);
     CHECK(cut_shell["particles"] == 12.0);  // the 2 points at x = 0.2 duplicated

@@ -150,5 +150,7 @@ void StencilTerm<N>::remap_nodes(std::span<const Index> old_to_new) {
 
 template class StencilTerm<3>;
 template class StencilTerm<4>;
+template class StencilTerm<5>;
+template class StencilTerm<6>;
 
 }  // namespace sewn::physics::elements

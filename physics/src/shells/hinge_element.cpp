@@ -8,6 +8,7 @@
 #include <unsupported/Eigen/AutoDiff>
 
 #include "sewn/physics/errors.hpp"
+#include "sewn/physics/shells/material_check.hpp"
 
 namespace sewn::physics::shells {
 
@@ -47,23 +48,17 @@ Eigen::Matrix<T, 12, 1> angle_gradient(const Eigen::Matrix<T, 3, 4>& x) {
   return g;
 }
 
-double wrapped(double d) {
+}  // namespace
+
+double wrap_angle(double d) {
   constexpr double pi = std::numbers::pi;
   while (d > pi) d -= 2.0 * pi;
   while (d <= -pi) d += 2.0 * pi;
   return d;
 }
 
-}  // namespace
-
 double hinge_stiffness(double young, double poisson, double thickness) {
-  if (!std::isfinite(young) || young <= 0.0 || !std::isfinite(poisson) || poisson <= -1.0 || poisson >= 0.5 ||
-      !std::isfinite(thickness) || thickness <= 0.0) {
-    std::ostringstream s;
-    s << "hinge bending: need E > 0, -1 < nu < 0.5 and thickness > 0, got E = " << young << " Pa, nu = " << poisson
-      << ", thickness = " << thickness << " m";
-    throw InputError(s.str());
-  }
+  check_shell_material("hinge bending", young, poisson, thickness);
   const double D = young * thickness * thickness * thickness / (12.0 * (1.0 - poisson * poisson));
   return D / 6.0;
 }
@@ -97,31 +92,32 @@ Vec12 dihedral_gradient(const HingePositions& x) {
 }
 
 double hinge_energy(const HingePositions& x, const HingeRest& rest, double k_b) {
-  const double d = wrapped(dihedral_angle(x) - rest.theta);
+  const double d = wrap_angle(dihedral_angle(x) - rest.theta);
   return k_b * rest.weight * d * d;
 }
 
 Vec12 hinge_gradient(const HingePositions& x, const HingeRest& rest, double k_b) {
-  const double d = wrapped(dihedral_angle(x) - rest.theta);
+  const double d = wrap_angle(dihedral_angle(x) - rest.theta);
   return (2.0 * k_b * rest.weight * d) * dihedral_gradient(x);
 }
 
-Mat12 hinge_hessian(const HingePositions& x, const HingeRest& rest, double k_b) {
+Mat12 dihedral_hessian(const HingePositions& x) {
   if (!well_shaped(x)) return Mat12::Zero();
   using Dual = Eigen::AutoDiffScalar<Vec12>;
   Eigen::Matrix<Dual, 3, 4> xd;
   for (int j = 0; j < 4; ++j)
     for (int a = 0; a < 3; ++a) xd(a, j) = Dual(x(a, j), 12, 3 * j + a);
   const Eigen::Matrix<Dual, 12, 1> gd = angle_gradient<Dual>(xd);
-  Vec12 g;
   Mat12 ddtheta;
-  for (int r = 0; r < 12; ++r) {
-    g[r] = gd[r].value();
-    ddtheta.row(r) = gd[r].derivatives().transpose();
-  }
-  const double d = wrapped(dihedral_angle(x) - rest.theta);
-  Mat12 H = 2.0 * k_b * rest.weight * (g * g.transpose() + d * ddtheta);
-  return 0.5 * (H + H.transpose());
+  for (int r = 0; r < 12; ++r) ddtheta.row(r) = gd[r].derivatives().transpose();
+  return 0.5 * (ddtheta + ddtheta.transpose());
+}
+
+Mat12 hinge_hessian(const HingePositions& x, const HingeRest& rest, double k_b) {
+  if (!well_shaped(x)) return Mat12::Zero();
+  const Vec12 g = angle_gradient<double>(x);
+  const double d = wrap_angle(dihedral_angle(x) - rest.theta);
+  return 2.0 * k_b * rest.weight * (g * g.transpose() + d * dihedral_hessian(x));
 }
 
 }  // namespace sewn::physics::shells

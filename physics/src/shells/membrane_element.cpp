@@ -1,4 +1,5 @@
 #include "sewn/physics/shells/membrane_element.hpp"
+#include "sewn/physics/shells/material_check.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -14,14 +15,18 @@ namespace {
 using Mat32 = Eigen::Matrix<double, 3, 2>;
 }  // namespace
 
-MembraneMaterial membrane_material(double young, double poisson, double thickness) {
+void check_shell_material(std::string_view model, double young, double poisson, double thickness) {
   if (!std::isfinite(young) || young <= 0.0 || !std::isfinite(poisson) || poisson <= -1.0 || poisson >= 0.5 ||
       !std::isfinite(thickness) || thickness <= 0.0) {
     std::ostringstream s;
-    s << "membrane material: need E > 0, -1 < nu < 0.5 and thickness > 0, got E = " << young << " Pa, nu = " << poisson
+    s << model << ": need E > 0, -1 < nu < 0.5 and thickness > 0, got E = " << young << " Pa, nu = " << poisson
       << ", thickness = " << thickness << " m";
     throw InputError(s.str());
   }
+}
+
+MembraneMaterial membrane_material(double young, double poisson, double thickness) {
+  check_shell_material("membrane material", young, poisson, thickness);
   return {young / (2.0 * (1.0 + poisson)), young * poisson / (1.0 - poisson * poisson), thickness};
 }
 

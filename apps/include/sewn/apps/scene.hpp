@@ -132,6 +132,7 @@ struct Scene {
   std::vector<VelocitySpec> velocities;  // later entries win
   Vec3 gravity{0, 0, -9.81};
   std::string model = "mass-spring", law = "stable_neo_hookean";  // model.type, model.law
+  std::string bending = "patch";                                     // model.bending (shells)
   std::vector<ModelGroup> model_groups;                             // model.groups
   std::string damping = "viscous";
   double rayleigh_alpha = 0, rayleigh_beta = 0, environment_damping = 0;

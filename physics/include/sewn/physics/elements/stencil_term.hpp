@@ -1,8 +1,9 @@
 #pragma once
 // StencilTerm<N>: the bookkeeping shared by force terms whose elements each couple a fixed
 // set of N nodes through a potential energy (tetrahedra: 4, membrane triangles: 3, hinges:
-// 4). A derived term supplies the element's energy, gradient and Hessian over its stencil
-// (DOF order [x0 y0 z0 x1 ...]); this class turns them into the ForceTerm interface:
+// 4, patch bending: 4 to 6). A derived term supplies the element's energy, gradient and
+// Hessian over its stencil (DOF order [x0 y0 z0 x1 ...]); this class turns them into the
+// ForceTerm interface:
 //   forces = -gradient, ∂F/∂x = -Hessian (PSD-projected per element when
 //   JacobianOptions::project_element_hessians is set), no velocity dependence,
 //   stability rows from the projected Hessian, pattern pairs, slot caching, node checks and
@@ -79,5 +80,7 @@ class StencilTerm : public ForceTerm {
 
 extern template class StencilTerm<3>;
 extern template class StencilTerm<4>;
+extern template class StencilTerm<5>;
+extern template class StencilTerm<6>;
 
 }  // namespace sewn::physics::elements

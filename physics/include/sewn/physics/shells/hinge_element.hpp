@@ -40,6 +40,10 @@ struct HingeRest {
 [[nodiscard]] double dihedral_angle(const HingePositions& x);
 /// ∇θ (12); zero where undefined (see above).
 [[nodiscard]] Vec12 dihedral_gradient(const HingePositions& x);
+/// ∇²θ (12×12, symmetric); zero where ∇θ is undefined.
+[[nodiscard]] Mat12 dihedral_hessian(const HingePositions& x);
+/// d wrapped into (-π, π]: the change of an angle from its rest value without a 2π jump.
+[[nodiscard]] double wrap_angle(double d);
 
 [[nodiscard]] double hinge_energy(const HingePositions& x, const HingeRest& rest, double k_b);
 [[nodiscard]] Vec12 hinge_gradient(const HingePositions& x, const HingeRest& rest, double k_b);

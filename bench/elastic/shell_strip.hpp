@@ -1,0 +1,149 @@
+#pragma once
+// The plate strip cantilever of PHYSICS_NOTES §4 shells (b), shared by bench_elastic's
+// convergence rows and test_elastic_shells' order checks: L = 1 m, b = 0.1 m, t = 0.01 m,
+// E = 200 GPa, ν = 0, ρ = 1000 kg/m³, g = 9.81 m/s², clamped at x = 0 (the columns x = 0 and
+// x = -L/nx held, which fixes the slope there) and loaded by its own weight (lumped masses, a
+// third of each triangle per corner); CST membranes plus a bending model (patch bending with
+// the held cells as clamps); one quasi-static
+// Newton step (LDLT, |p|∞ < 1e-13 m). The answer is Euler–Bernoulli's δ = qL⁴/(8EI) (ν = 0:
+// no anticlastic coupling, so narrow and wide strips share it). Tip = mean z of the x = L nodes.
+// Meshes (nx cells along, ny across, two triangles per cell):
+//   square    ny = nx/10, every diagonal from (i, j) to (i+1, j+1);
+//   flipped   the same with every diagonal from (i+1, j) to (i, j+1);
+//   row       ny = 1 (triangles of aspect nx/10), diagonals as `square`;
+//   jittered  ny = nx/10, inner nodes moved by up to a quarter cell in x and y and each
+//             cell's diagonal drawn at random (seeded: the same mesh every run).
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "sewn/physics/basic_terms.hpp"
+#include "sewn/physics/integrate/newton_euler.hpp"
+#include "sewn/physics/shells/patch_terms.hpp"
+#include "sewn/physics/shells/shell_terms.hpp"
+
+namespace sewn::shell_strip {
+
+enum class Mesh { square, flipped, row, jittered };
+enum class Bending { patch, hinge };
+
+inline const char* mesh_name(Mesh m) {
+  switch (m) {
+    case Mesh::square: return "square";
+    case Mesh::flipped: return "flipped";
+    case Mesh::row: return "row";
+    case Mesh::jittered: return "jittered";
+  }
+  return "?";
+}
+
+inline constexpr double young = 2e11, rho = 1000.0, gravity = 9.81, length = 1.0, width = 0.1, thickness = 0.01;
+
+/// Euler–Bernoulli's tip under the weight q = ρ g b t, EI = E b t³/12, in m.
+inline double euler_bernoulli_m() {
+  const double q = rho * gravity * width * thickness, EI = young * width * thickness * thickness * thickness / 12;
+  return q * length * length * length * length / (8 * EI);
+}
+
+struct Result {
+  double tip_m = 0.0;
+  int newton = 0;
+  std::size_t triangles = 0;
+};
+
+struct Strip {
+  std::vector<double> rest;  // 3 per node
+  std::vector<std::array<physics::Index, 3>> triangles;
+};
+
+inline Strip strip_mesh(Mesh mesh, int nx) {
+  const int ny = mesh == Mesh::row ? 1 : std::max(1, nx / 10);
+  const double a = length / nx, c = width / ny;
+  const int cols = nx + 2;  // x = -a, 0, a, ..., L
+  auto id = [&](int i, int j) { return static_cast<physics::Index>(i + cols * j); };
+  std::mt19937 rng(12345u + static_cast<unsigned>(nx));
+  std::uniform_real_distribution<double> jitter(-0.25, 0.25);
+  Strip s;
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i < cols; ++i) {
+      double x = a * (i - 1), y = c * j;
+      if (mesh == Mesh::jittered) {
+        if (i >= 2 && i <= nx) x += a * jitter(rng);  // the clamp's columns and the tip stay put
+        if (j >= 1 && j < ny) y += c * jitter(rng);
+      }
+      s.rest.insert(s.rest.end(), {x, y, 0.0});
+    }
+  std::bernoulli_distribution coin(0.5);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i + 1 < cols; ++i) {
+      const auto p = id(i, j), q = id(i + 1, j), r = id(i + 1, j + 1), u = id(i, j + 1);
+      const bool other = mesh == Mesh::flipped || (mesh == Mesh::jittered && coin(rng));
+      if (other) {
+        s.triangles.push_back({p, q, u});
+        s.triangles.push_back({q, r, u});
+      } else {
+        s.triangles.push_back({p, q, r});
+        s.triangles.push_back({p, r, u});
+      }
+    }
+  return s;
+}
+
+/// Builds the strip with `bending`, solves it and returns the tip deflection (positive down).
+/// Throws what Newton throws.
+inline Result solve(Mesh mesh, Bending bending, int nx) {
+  using physics::Index;
+  const Strip s = strip_mesh(mesh, nx);
+  physics::System sys;
+  const Index n = static_cast<Index>(s.rest.size() / 3);
+  std::vector<double> mass(n, 0.0);
+  auto at = [&](Index i) { return Eigen::Vector3d(s.rest[3 * i], s.rest[3 * i + 1], s.rest[3 * i + 2]); };
+  for (const auto& tr : s.triangles) {
+    const double area = 0.5 * (at(tr[1]) - at(tr[0])).cross(at(tr[2]) - at(tr[0])).norm();
+    for (Index v : tr) mass[v] += rho * thickness * area / 3.0;
+  }
+  for (Index i = 0; i < n; ++i) sys.nodes().add(at(i), Eigen::Vector3d::Zero(), mass[i]);
+  auto& membranes = sys.add<physics::shells::Membranes>();
+  for (const auto& tr : s.triangles) {
+    physics::shells::TriPositions X;
+    for (int k = 0; k < 3; ++k) X.col(k) = at(tr[static_cast<std::size_t>(k)]);
+    membranes.add(tr, X, young, 0.0, thickness);
+  }
+  if (bending == Bending::hinge) {
+    sys.add<physics::shells::Hinges>().add_interior_edges(s.triangles, s.rest,
+                                                           physics::shells::hinge_stiffness(young, 0.0, thickness));
+  } else {
+    const std::vector<physics::shells::PlateMaterial> mat(s.triangles.size(),
+                                                          physics::shells::plate_material(young, 0.0, thickness));
+    std::vector<std::uint8_t> clamp(s.triangles.size(), 0);  // the cells behind x = 0 are held
+    for (std::size_t t = 0; t < s.triangles.size(); ++t)
+      clamp[t] = s.rest[3 * std::size_t{s.triangles[t][0]}] <= 1e-12 && s.rest[3 * std::size_t{s.triangles[t][1]}] <= 1e-12 &&
+                 s.rest[3 * std::size_t{s.triangles[t][2]}] <= 1e-12;
+    (void)physics::shells::add_patch_bending(sys, s.triangles, s.rest, mat, clamp);
+  }
+  sys.add<physics::Gravity>(Eigen::Vector3d(0, 0, -gravity));
+  std::vector<Index> tip;
+  for (Index i = 0; i < n; ++i) {
+    if (s.rest[3 * i] <= 1e-12) sys.nodes().fix(i);
+    if (std::abs(s.rest[3 * i] - length) < 1e-12) tip.push_back(i);
+  }
+  const double h = 1e3;  // inertia M/h² ~1e-12 of the bending stiffness
+  physics::integrate::NewtonEulerOptions opt;
+  opt.solver = physics::integrate::LinearSolver::ldlt;
+  opt.velocity_tolerance = 1e-13 / h;  // |p|∞ below 1e-13 m
+  physics::integrate::NewtonEuler newton(opt);
+  Result r;
+  r.newton = newton.step(sys, h).iterations;
+  double z = 0;
+  for (Index i : tip) z += sys.nodes().position(i).z();
+  r.tip_m = -z / static_cast<double>(tip.size());
+  r.triangles = s.triangles.size();
+  return r;
+}
+
+}  // namespace sewn::shell_strip

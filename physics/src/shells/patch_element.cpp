@@ -1,0 +1,211 @@
+#include "sewn/physics/shells/patch_element.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include "sewn/physics/errors.hpp"
+#include "sewn/physics/shells/hinge_element.hpp"
+#include "sewn/physics/shells/material_check.hpp"
+
+namespace sewn::physics::shells {
+
+namespace {
+
+// Neighbour k's hinge in hinge_element.hpp's order: T's corner opposite the edge (face A is then
+// a cyclic turn of T, so its normal is T's), the edge's two corners, the neighbour's node.
+template <int N>
+std::array<int, 4> hinge_columns(const PatchRest& rest, int k) {
+  const int i = rest.edge[static_cast<std::size_t>(k)];
+  return {i, (i + 1) % 3, (i + 2) % 3, 3 + k};
+}
+
+template <int N>
+HingePositions hinge_of(const PatchPositions<N>& x, const std::array<int, 4>& cols) {
+  HingePositions h;
+  for (int c = 0; c < 4; ++c) h.col(c) = x.col(cols[static_cast<std::size_t>(c)]);
+  return h;
+}
+
+// d_k = ℓ_k (θ_k - θ̄_k): to first order the neighbour's height above T's plane (up to one sign
+// shared by all k, which the quadratic energy does not see).
+template <int N>
+Eigen::Vector3d heights(const PatchPositions<N>& x, const PatchRest& rest) {
+  Eigen::Vector3d d = Eigen::Vector3d::Zero();
+  for (int k = 0; k < rest.count; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    d[k] = rest.lever[kk] * wrap_angle(dihedral_angle(hinge_of<N>(x, hinge_columns<N>(rest, k))) - rest.theta[kk]);
+  }
+  return d;
+}
+
+std::string describe(const std::array<std::uint8_t, 3>& edges, int count) {
+  std::ostringstream s;
+  for (int k = 0; k < count; ++k) s << (k ? ", " : "") << int{edges[static_cast<std::size_t>(k)]};
+  return s.str();
+}
+
+}  // namespace
+
+PlateMaterial plate_material(double young, double poisson, double thickness) {
+  check_shell_material("patch bending", young, poisson, thickness);
+  return {young * thickness * thickness * thickness / (12.0 * (1.0 - poisson * poisson)), poisson};
+}
+
+template <int N>
+PatchRest patch_rest(const PatchPositions<N>& X, const std::array<std::uint8_t, N - 3>& edges,
+                     const std::array<std::uint8_t, N - 3>& clamped, const PlateMaterial& m) {
+  constexpr int K = N - 3;
+  PatchRest r;
+  r.count = K;
+  for (int k = 0; k < K; ++k) {
+    r.edge[static_cast<std::size_t>(k)] = edges[static_cast<std::size_t>(k)];
+    r.clamped[static_cast<std::size_t>(k)] = clamped[static_cast<std::size_t>(k)] != 0 ? 1 : 0;
+  }
+  for (int k = 0; k < K; ++k)
+    for (int j = 0; j < k; ++j)
+      if (edges[static_cast<std::size_t>(k)] > 2 || edges[static_cast<std::size_t>(k)] == edges[static_cast<std::size_t>(j)])
+        throw InputError("patch bending: neighbour edges " + describe(r.edge, K) + " must be distinct corners 0, 1, 2");
+  if (edges[0] > 2) throw InputError("patch bending: neighbour edges " + describe(r.edge, K) + " must be corners 0, 1, 2");
+  // T in an orthonormal frame of its rest plane
+  const Eigen::Vector3d e1 = X.col(1) - X.col(0), e2 = X.col(2) - X.col(0);
+  const Eigen::Vector3d n = e1.cross(e2);
+  const double area = 0.5 * n.norm();
+  const double longest2 = std::max({e1.squaredNorm(), e2.squaredNorm(), (X.col(2) - X.col(1)).squaredNorm()});
+  if (!std::isfinite(area) || !(area > 1e-12 * longest2)) {
+    std::ostringstream s;
+    s << "patch bending: degenerate rest triangle (area " << area << " m^2)";
+    throw InputError(s.str());
+  }
+  const Eigen::Vector3d u = e1.normalized(), v = n.normalized().cross(u);
+  Eigen::Matrix<double, 2, 3> p;  // corners in the frame
+  for (int a = 0; a < 3; ++a) p.col(a) << (X.col(a) - X.col(0)).dot(u), (X.col(a) - X.col(0)).dot(v);
+  Eigen::Matrix2d Dm;
+  Dm << p.col(1) - p.col(0), p.col(2) - p.col(0);
+  const Eigen::Matrix2d Dm_inv = Dm.inverse();
+  Eigen::Matrix<double, 2, 3> grad;  // column a: ∇λ_a
+  grad.col(1) = Dm_inv.row(0).transpose();
+  grad.col(2) = Dm_inv.row(1).transpose();
+  grad.col(0) = -grad.col(1) - grad.col(2);
+  auto bary = [&](const Eigen::Vector2d& q) {
+    const Eigen::Vector2d l = Dm_inv * (q - p.col(0));
+    return Eigen::Vector3d(1.0 - l[0] - l[1], l[0], l[1]);
+  };
+  // Hessians of the bubbles b_m = λ_{m+1} λ_{m+2}, and the energy's matrix Q in β
+  std::array<Eigen::Matrix2d, 3> B;
+  for (int m = 0; m < 3; ++m) {
+    const Eigen::Vector2d ga = grad.col((m + 1) % 3), gb = grad.col((m + 2) % 3);
+    B[static_cast<std::size_t>(m)] = ga * gb.transpose() + gb * ga.transpose();
+  }
+  Eigen::Matrix3d Q;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) {
+      const auto& Ba = B[static_cast<std::size_t>(a)];
+      const auto& Bb = B[static_cast<std::size_t>(b)];
+      Q(a, b) = area * m.stiffness * ((1.0 - m.poisson) * (Ba * Bb).trace() + m.poisson * Ba.trace() * Bb.trace());
+    }
+  // each neighbour unfolded into T's plane across its edge: its lever ℓ and bubble values
+  Eigen::Matrix<double, K, 3> C;
+  for (int k = 0; k < K; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    const auto cols = hinge_columns<N>(r, k);
+    const HingePositions h = hinge_of<N>(X, cols);
+    const Eigen::Vector3d P = h.col(1), ehat = (h.col(2) - h.col(1)).normalized();
+    const double s = (h.col(3) - P).dot(ehat);
+    const double lever = ((h.col(3) - P) - s * ehat).norm();
+    const double edge_len = (h.col(2) - h.col(1)).norm();
+    if (!std::isfinite(lever) || !(lever > 1e-6 * edge_len)) {
+      std::ostringstream msg;
+      msg << "patch bending: the neighbour across edge " << cols[0] << " lies on the edge's line (distance " << lever << " m)";
+      throw InputError(msg.str());
+    }
+    const Eigen::Vector2d pP = p.col(cols[1]), e2d = (p.col(cols[2]) - pP).normalized();
+    Eigen::Vector2d t(e2d.y(), -e2d.x());
+    if (t.dot(p.col(cols[0]) - pP) > 0.0) t = -t;  // away from T
+    if (r.clamped[kk] != 0) {
+      // the bubbles' outward slope at the edge's midpoint, where λ = ½ on the edge's corners
+      for (int mm = 0; mm < 3; ++mm) {
+        const auto bary_mid = [&](int a) { return a == cols[0] ? 0.0 : 0.5; };
+        const int a = (mm + 1) % 3, b = (mm + 2) % 3;
+        C(k, mm) = t.dot(bary_mid(a) * grad.col(b) + bary_mid(b) * grad.col(a));
+      }
+      r.lever[kk] = 1.0;
+    } else {
+      const Eigen::Vector3d l = bary(pP + s * e2d + lever * t);
+      for (int mm = 0; mm < 3; ++mm) C(k, mm) = l[(mm + 1) % 3] * l[(mm + 2) % 3];
+      r.lever[kk] = lever;
+    }
+    r.theta[kk] = dihedral_angle(h);
+  }
+  // E = min_β ½βᵀQβ subject to Cβ = d  =  ½ dᵀ (C Q⁻¹ Cᵀ)⁻¹ d
+  const Eigen::Matrix<double, K, K> M = C * Q.ldlt().solve(C.transpose());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, K, K>> eig(M);
+  const double lo = eig.eigenvalues().minCoeff(), hi = eig.eigenvalues().maxCoeff();
+  if (!std::isfinite(lo + hi) || !(lo > 1e-10 * hi)) {
+    std::ostringstream s;
+    s << "patch bending: the triangle and its neighbours across edges " << describe(r.edge, K)
+      << " lie on a conic, so no single quadratic fits them (condition " << lo / hi << ")";
+    throw InputError(s.str());
+  }
+  const Eigen::Matrix<double, K, K> S = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() *
+                                        eig.eigenvectors().transpose();
+  r.stiffness.template topLeftCorner<K, K>() = 0.5 * (S + S.transpose());
+  return r;
+}
+
+template <int N>
+double patch_energy(const PatchPositions<N>& x, const PatchRest& rest) {
+  const Eigen::Vector3d d = heights<N>(x, rest);
+  return 0.5 * d.dot(rest.stiffness * d);
+}
+
+template <int N>
+elements::Vec<3 * N> patch_gradient(const PatchPositions<N>& x, const PatchRest& rest) {
+  const Eigen::Vector3d Sd = rest.stiffness * heights<N>(x, rest);
+  elements::Vec<3 * N> g = elements::Vec<3 * N>::Zero();
+  for (int k = 0; k < rest.count; ++k) {
+    const auto cols = hinge_columns<N>(rest, k);
+    const Vec12 gk = dihedral_gradient(hinge_of<N>(x, cols)) * (Sd[k] * rest.lever[static_cast<std::size_t>(k)]);
+    for (int c = 0; c < 4; ++c) g.template segment<3>(3 * cols[static_cast<std::size_t>(c)]) += gk.segment<3>(3 * c);
+  }
+  return g;
+}
+
+template <int N>
+elements::Mat<3 * N> patch_hessian(const PatchPositions<N>& x, const PatchRest& rest) {
+  const Eigen::Vector3d Sd = rest.stiffness * heights<N>(x, rest);
+  // J: row k is ∂d_k/∂x = ℓ_k ∇θ_k; H = Jᵀ S J + Σ_k (S d)_k ℓ_k ∇²θ_k
+  Eigen::Matrix<double, 3, 3 * N> J = Eigen::Matrix<double, 3, 3 * N>::Zero();
+  elements::Mat<3 * N> H = elements::Mat<3 * N>::Zero();
+  for (int k = 0; k < rest.count; ++k) {
+    const auto cols = hinge_columns<N>(rest, k);
+    const HingePositions h = hinge_of<N>(x, cols);
+    const double lever = rest.lever[static_cast<std::size_t>(k)];
+    const Vec12 gk = dihedral_gradient(h) * lever;
+    const Mat12 hk = dihedral_hessian(h) * (Sd[k] * lever);
+    for (int a = 0; a < 4; ++a) {
+      const int A = cols[static_cast<std::size_t>(a)];
+      J.row(k).template segment<3>(3 * A) += gk.segment<3>(3 * a).transpose();
+      for (int b = 0; b < 4; ++b) H.template block<3, 3>(3 * A, 3 * cols[static_cast<std::size_t>(b)]) += hk.block<3, 3>(3 * a, 3 * b);
+    }
+  }
+  H += J.transpose() * rest.stiffness * J;
+  return 0.5 * (H + H.transpose());
+}
+
+#define SEWN_PATCH_INSTANTIATE(N)                                                                                       \
+  template PatchRest patch_rest<N>(const PatchPositions<N>&, const std::array<std::uint8_t, N - 3>&,                  \
+                                   const std::array<std::uint8_t, N - 3>&, const PlateMaterial&);                     \
+  template double patch_energy<N>(const PatchPositions<N>&, const PatchRest&);                                         \
+  template elements::Vec<3 * N> patch_gradient<N>(const PatchPositions<N>&, const PatchRest&);                          \
+  template elements::Mat<3 * N> patch_hessian<N>(const PatchPositions<N>&, const PatchRest&);
+SEWN_PATCH_INSTANTIATE(4)
+SEWN_PATCH_INSTANTIATE(5)
+SEWN_PATCH_INSTANTIATE(6)
+#undef SEWN_PATCH_INSTANTIATE
+
+}  // namespace sewn::physics::shells
