@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "sewn/physics/elements/element_math.hpp"
+#include "history.hpp"
 
 namespace sewn::connect {
 
@@ -108,5 +109,9 @@ void CurveConnections::remap_nodes(std::span<const Index> old_to_new) {
   }
   touch_topology();
 }
+
+std::vector<double> CurveConnections::history() const { return detail::items_history(items_); }
+
+void CurveConnections::restore(std::span<const double> h) { detail::restore_items(items_, h, std::string(name())); }
 
 }  // namespace sewn::connect

@@ -7,6 +7,7 @@
 
 #include "sewn/physics/elements/element_math.hpp"
 #include "sewn/physics/nodes.hpp"
+#include "history.hpp"
 
 namespace sewn::connect {
 
@@ -132,5 +133,9 @@ void PointConnections::remap_nodes(std::span<const Index> old_to_new) {
   }
   touch_topology();
 }
+
+std::vector<double> PointConnections::history() const { return detail::items_history(items_); }
+
+void PointConnections::restore(std::span<const double> h) { detail::restore_items(items_, h, std::string(name())); }
 
 }  // namespace sewn::connect

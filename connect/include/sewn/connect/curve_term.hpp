@@ -32,6 +32,12 @@ class CurveConnections final : public physics::ForceTerm {
   Index add(const std::string& name, Index a, Index b, const EdgeSideRef& m, const EdgeSideRef& n, double k_per_length,
             const physics::StateView& s);
   [[nodiscard]] Index size() const { return static_cast<Index>(items_.size()); }
+  /// Every connection's history (ConnectionHistory, point.hpp), history_size values each, in
+  /// order: what step_accepted() moves on, for checkpoints. O(connections).
+  [[nodiscard]] std::vector<double> history() const;
+  /// Takes up history() of a term built the same way. Throws physics::InputError (nothing
+  /// changed) if the size does not fit or a connection refuses its part. O(connections).
+  void restore(std::span<const double> h);
   /// The rule when nodes go (a cut or a refinement removing them): a connection with a removed
   /// node in its stencil is removed with it (one of its sides no longer exists there), every
   /// other one is kept as it is; so none is left dangling. Call it after removing nodes and before
