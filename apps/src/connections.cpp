@@ -83,6 +83,7 @@ constexpr double square_torsion = 0.1406;
 struct PointSide {
   connect::SideRef ref;
   SideStiffness k;
+  std::uint32_t cell = 0;  // the mesh cell its frame is built on
 };
 
 double mean_edge(const Around& a, std::span<const std::uint32_t> pts) {
@@ -164,7 +165,7 @@ PointSide solid_point_side(const Around& a, std::uint32_t comp, std::uint32_t p,
   side.rest_axis = normal;
   const auto& m = a.material(best);
   const double l = mean_edge(a, c);
-  return {side, {shear_modulus(m) * square_torsion * l * l * l, m.young * l * l * l / 12}};
+  return {side, {shear_modulus(m) * square_torsion * l * l * l, m.young * l * l * l / 12}, best};
 }
 
 PointSide point_side(const Around& a, std::uint32_t comp, std::uint32_t p, const Vec3d& toward, const std::string& who,
@@ -177,7 +178,7 @@ PointSide point_side(const Around& a, std::uint32_t comp, std::uint32_t p, const
       const auto [r, edge] = a.parts.rod_edge_of_element[a.element[c]];
       const auto& rod = a.parts.rods->rod(r);
       const double l = rod.rest_length(edge);
-      return {connect::RodEdgeRef{r, edge}, {rod.section().GJ / l, std::min(rod.section().EI1, rod.section().EI2) / l}};
+      return {connect::RodEdgeRef{r, edge}, {rod.section().GJ / l, std::min(rod.section().EI1, rod.section().EI2) / l}, c};
     }
     case connect::Body::shell: {
       // the corner of the first incident triangle: a frame carried rigidly by that triangle
@@ -185,7 +186,7 @@ PointSide point_side(const Around& a, std::uint32_t comp, std::uint32_t p, const
       connect::TriangleSide side;
       for (int v = 0; v < 3; ++v) side.nodes[static_cast<std::size_t>(v)] = a.node(cp[static_cast<std::size_t>(v)]);
       const auto& m = a.material(c);
-      return {side, {shear_modulus(m) * std::pow(m.thickness, 3) / 3, plate_bending(m)}};
+      return {side, {shear_modulus(m) * std::pow(m.thickness, 3) / 3, plate_bending(m)}, c};
     }
     case connect::Body::solid: return solid_point_side(a, comp, p, toward, who, file, key);
   }
@@ -209,7 +210,8 @@ Vec3d cells_centroid(const Around& a, std::uint32_t comp, std::uint32_t p) {
 
 struct EdgeSides {
   std::vector<connect::EdgeSideRef> refs;
-  double k = 0;  // auto, per unit length
+  std::vector<std::vector<std::uint32_t>> cells;  // per ref, the mesh cells its frame is built on
+  double k = 0;                                   // auto, per unit length
 };
 
 // Height of the triangle (a, b, c) over the edge (a, b).
@@ -234,6 +236,7 @@ EdgeSides edge_sides(const Around& a, std::uint32_t comp, std::uint32_t p, std::
       const auto [r, edge] = a.parts.rod_edge_of_element[a.element[cells.front()]];
       const double l = a.parts.rods->rod(r).rest_length(edge);
       out.refs.emplace_back(connect::RodEdgeRef{r, edge});
+      out.cells.push_back({cells.front()});
       out.k = a.parts.rods->rod(r).section().GJ / (l * l);
       break;
     }
@@ -243,27 +246,37 @@ EdgeSides edge_sides(const Around& a, std::uint32_t comp, std::uint32_t p, std::
       for (std::uint32_t c : cells) w += height(a, p, q, apex(a, c, p, q)) / static_cast<double>(cells.size());
       if (cells.size() == 1) out.refs.emplace_back(connect::FaceSide{a.node(apex(a, cells[0], p, q))});
       else out.refs.emplace_back(connect::HingeSide{a.node(apex(a, cells[0], p, q)), a.node(apex(a, cells[1], p, q))});
+      out.cells.push_back(cells);
       out.k = plate_bending(m) / w;
       break;
     }
     case connect::Body::solid: {
       // the faces around the edge; a surface curve (two boundary faces) is framed by their mean
       // normal, an edge inside the solid by every face around it (one energy each)
-      std::map<std::uint32_t, int> faces;  // apex -> tets holding the face (p, q, apex)
+      std::map<std::uint32_t, std::pair<int, std::uint32_t>> faces;  // apex -> (tets holding the face (p, q, apex), the first)
       for (std::uint32_t c : cells)
         for (std::uint32_t v : a.mesh.cell(c))
-          if (v != p && v != q) ++faces[v];
+          if (v != p && v != q) {
+            auto& f = faces.try_emplace(v, 0, c).first->second;
+            ++f.first;
+          }
       std::vector<std::uint32_t> boundary, all;
-      for (const auto& [v, count] : faces) {
+      for (const auto& [v, held] : faces) {
         all.push_back(v);
-        if (count == 1) boundary.push_back(v);
+        if (held.first == 1) boundary.push_back(v);
       }
       double w = 0;
       const auto& used = boundary.size() == 2 ? boundary : all;
       for (std::uint32_t v : used) w += height(a, p, q, v) / static_cast<double>(used.size());
-      if (boundary.size() == 2) out.refs.emplace_back(connect::HingeSide{a.node(boundary[0]), a.node(boundary[1])});
-      else
-        for (std::uint32_t v : all) out.refs.emplace_back(connect::FaceSide{a.node(v)});
+      if (boundary.size() == 2) {
+        out.refs.emplace_back(connect::HingeSide{a.node(boundary[0]), a.node(boundary[1])});
+        out.cells.push_back({faces.at(boundary[0]).second, faces.at(boundary[1]).second});
+      } else {
+        for (std::uint32_t v : all) {
+          out.refs.emplace_back(connect::FaceSide{a.node(v)});
+          out.cells.push_back({faces.at(v).second});
+        }
+      }
       out.k = m.young * w * w / (12 * (1 - m.poisson * m.poisson));
       break;
     }
@@ -349,6 +362,20 @@ std::string connection_name(const Around& a, const Choice& ch, std::size_t c) {
          " at mesh point" + (f.points.size() > 1 ? "s " : " ") + pts + ")";
 }
 
+// The sources of a connection's stencil nodes (`stencil`, in slot order): every corner of the
+// cells' model elements that is one of them.
+std::vector<JointSource> sources_of(const Around& a, const std::vector<Index>& stencil, std::span<const std::uint32_t> cells) {
+  std::vector<JointSource> out;
+  for (std::uint32_t c : cells) {
+    const Index e = a.element[c];
+    const std::vector<Index> nodes = a.model.element_nodes(e);
+    for (std::uint32_t k = 0; k < nodes.size(); ++k)
+      for (std::uint32_t slot = 0; slot < stencil.size(); ++slot)
+        if (stencil[slot] == nodes[k]) out.push_back({e, k, slot});
+  }
+  return out;
+}
+
 bool has_rod_side(const Around& a, const connect::FoundConnection& f) {
   return a.found.component_body[f.components[0]] == connect::Body::rod || a.found.component_body[f.components[1]] == connect::Body::rod;
 }
@@ -373,10 +400,9 @@ ConnectionParts build_connections(const Scene& scene, const IndexedMesh& mesh, c
   ConnectionParts out;
   const ConnectionsSpec& spec = scene.connections;
   if (!spec.enabled) return out;
-  if (!scene.cuts.empty())
-    throw SceneError(scene.file, "cuts", "a scene with model.connections takes no cuts yet (the rule for a connection whose sides a cut separates is not wired)");
   if (scene.refinement.enabled)
     throw SceneError(scene.file, "refinement", "a scene with model.connections cannot be refined (the connections' stencils would not follow the new elements)");
+  out.sources = std::make_shared<JointSources>();
   const Around a = gather(mesh, models, materials, parts, model, scene.file);
   const std::vector<std::optional<Choice>> chosen = choose(a, spec, scene.file);
   const double rigid = spec.rigid_factor;
@@ -407,7 +433,9 @@ ConnectionParts build_connections(const Scene& scene, const IndexedMesh& mesh, c
         const connect::PointStiffness k{ch.twisting.value_or(factor * std::min(m.k.twist, n.k.twist)),
                                         ch.bending.value_or(factor * std::min(m.k.bend, n.k.bend))};
         if (!out.points) out.points = &sys.add<connect::PointConnections>(parts.rods, update);
-        (void)out.points->add(name, m.ref, n.ref, k, sys.state());
+        const Index added = out.points->add(name, m.ref, n.ref, k, sys.state());
+        const std::uint32_t cells[2] = {m.cell, n.cell};
+        out.sources->points.push_back(sources_of(a, out.points->connection(added).position_nodes(), cells));
         ++out.point_joints;
       } else {
         const std::uint32_t p = f.points[0], q = f.points[1];
@@ -416,10 +444,13 @@ ConnectionParts build_connections(const Scene& scene, const IndexedMesh& mesh, c
         const double k = ch.stiffness.value_or(factor * std::min(m.k, n.k)) / pairs;
         if (!out.curves) out.curves = &sys.add<connect::CurveConnections>(parts.rods, update);
         int i = 0;
-        for (const auto& sm : m.refs)
-          for (const auto& sn : n.refs) {
-            (void)out.curves->add(pairs > 1 ? name + " face pair " + std::to_string(i++) : name, a.node(p), a.node(q), sm, sn, k,
-                                  sys.state());
+        for (std::size_t im = 0; im < m.refs.size(); ++im)
+          for (std::size_t in = 0; in < n.refs.size(); ++in, ++i) {
+            const Index added = out.curves->add(pairs > 1 ? name + " face pair " + std::to_string(i) : name, a.node(p), a.node(q),
+                                                m.refs[im], n.refs[in], k, sys.state());
+            std::vector<std::uint32_t> cells = m.cells[im];
+            cells.insert(cells.end(), n.cells[in].begin(), n.cells[in].end());
+            out.sources->curves.push_back(sources_of(a, out.curves->connection(added).stencil_nodes(), cells));
             ++out.curve_elements;
           }
         ++out.curve_joints;
@@ -428,7 +459,43 @@ ConnectionParts build_connections(const Scene& scene, const IndexedMesh& mesh, c
       throw SceneError(scene.file, ch.key, e.what());
     }
   }
+  // every edit of the model (a cut, a piercing) is followed by the rule, before a piercing
+  // compacts the particles; the listener shares the sources with the returned parts
+  if (out.points || out.curves) model.after_edits([out, &model] { follow_connections(out, model); });
   return out;
+}
+
+namespace {
+
+// The rule for one term: per connection, its sources' current nodes against its own.
+template <class Term, class Nodes>
+void follow_term(Term* term, std::vector<std::vector<JointSource>>& sources, const physics::MssModel<3>& model, const Nodes& nodes_of) {
+  if (!term) return;
+  const std::vector<bool> kept = term->follow_nodes(model.nodes().size(), [&](Index c, std::vector<std::pair<Index, Index>>& renames) {
+    const std::vector<Index>& stencil = nodes_of(term->connection(c));
+    std::map<Index, Index> to;  // the connection's node -> the node its elements have now
+    for (const JointSource& s : sources[c]) {
+      if (!model.elements()[s.element].alive) return false;  // a side was pierced away
+      const Index now = model.element_nodes(s.element)[s.corner];
+      const auto it = to.emplace(stencil[s.slot], now).first;
+      if (it->second != now) return false;  // the sides no longer share this node: the cut separated them
+    }
+    for (const auto& r : to)
+      if (r.first != r.second) renames.emplace_back(r.first, r.second);
+    return true;
+  });
+  std::vector<std::vector<JointSource>> left;
+  for (std::size_t c = 0; c < kept.size(); ++c)
+    if (kept[c]) left.push_back(std::move(sources[c]));
+  sources = std::move(left);
+}
+
+}  // namespace
+
+void follow_connections(const ConnectionParts& joints, const physics::MssModel<3>& model) {
+  if (!joints.sources) return;
+  follow_term(joints.points, joints.sources->points, model, [](const connect::PointConnection& c) -> const std::vector<Index>& { return c.position_nodes(); });
+  follow_term(joints.curves, joints.sources->curves, model, [](const connect::EdgeConnection& c) -> const std::vector<Index>& { return c.stencil_nodes(); });
 }
 
 std::string connection_energies_text(const ConnectionParts& c) {

@@ -114,4 +114,10 @@ std::vector<double> CurveConnections::history() const { return detail::items_his
 
 void CurveConnections::restore(std::span<const double> h) { detail::restore_items(items_, h, std::string(name())); }
 
+std::vector<bool> CurveConnections::follow_nodes(Index num_nodes, const NodeDecision& decide) {
+  std::vector<bool> kept = detail::follow_items(items_, num_nodes, decide);
+  touch_topology();
+  return kept;
+}
+
 }  // namespace sewn::connect

@@ -138,4 +138,10 @@ std::vector<double> PointConnections::history() const { return detail::items_his
 
 void PointConnections::restore(std::span<const double> h) { detail::restore_items(items_, h, std::string(name())); }
 
+std::vector<bool> PointConnections::follow_nodes(Index num_nodes, const NodeDecision& decide) {
+  std::vector<bool> kept = detail::follow_items(items_, num_nodes, decide);
+  touch_topology();
+  return kept;
+}
+
 }  // namespace sewn::connect

@@ -249,6 +249,28 @@ TEST_CASE("cuts of finite-element tetrahedra resume to the same bytes") {
   SUBCASE("the cut after the checkpoint") { check_continuation("solid_after", solid_beam("solid_after", "0.05"), 2, {1}); }
 }
 
+// The fin of scenes/mixed_fin.json without its mast (a label), its connections on, cut at
+// `cut_time` across the fin and the block (x = 0.2): the cut's rule removes or renames the
+// fin's curve connections, and a resumed run replays the cut through the same rule.
+std::string cut_fin(const std::string& name, const std::string& cut_time) {
+  const std::string mesh = (fs::path(SEWN_SOURCE_DIR) / "scenes" / "meshes" / "fin.msh").string();
+  return R"({"name": ")" + name + R"(", "materials": {"rubber": {"young": 2e6, "poisson": 0.4, "density": 1100},
+      "sheet": {"young": 5e8, "poisson": 0.35, "density": 1200, "thickness": 0.004}},
+    "meshes": [{"type": "file", "path": ")" + mesh + R"(", "material": "rubber",
+                "regions": [{"where": {"type": "tag", "tag": 2}, "material": "sheet"}]}],
+    "fixed": [{"where": {"type": "tag", "tag": 4}}],
+    "velocities": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, -0.001]}, "linear": [0, 0.3, 0]}],
+    "model": {"type": "mixed", "groups": [{"name": "mast", "as": "label"}], "connections": {}},
+    "damping": {"model": "rayleigh", "alpha": 1.0}, "integrator": {"type": "newton", "step": 0.005},
+    "cuts": [{"type": "plane", "time": )" + cut_time + R"(, "point": [0.2, 0, 0], "normal": [1, 0, 0]}],
+    "duration": 0.04, "output": {"frames": 4}})";
+}
+
+TEST_CASE("connections under a cut resume to the same bytes: the cut is replayed through the connections' rule") {
+  SUBCASE("the cut before the checkpoint") { check_continuation("cut_fin_before", cut_fin("cut_fin_before", "0.012"), 2, {1}); }
+  SUBCASE("the cut after the checkpoint") { check_continuation("cut_fin_after", cut_fin("cut_fin_after", "0.025"), 2, {1}); }
+}
+
 TEST_CASE("the CHOLMOD backends resume to the same bytes: cholmod-pcg's kept factorization is in the checkpoint") {
   if (!have_cholmod()) {
     MESSAGE("skipped: this build has no CHOLMOD backends");

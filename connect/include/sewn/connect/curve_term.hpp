@@ -44,6 +44,13 @@ class CurveConnections final : public physics::ForceTerm {
   /// System::compact_nodes(), whose node check otherwise refuses the connection by name. Returns
   /// how many were removed. O(connections).
   Index remove_dangling(const physics::NodeTable& nodes);
+  /// The rule under cuts (the scene layer decides, apps/connections.hpp): each connection c is
+  /// removed if `decide` says so, or kept with its nodes renamed (its DOF table and its own
+  /// ids; rest data, history and energy at the current state unchanged). `num_nodes`: the node
+  /// table's size (renamed ids must be below it). Returns per connection, as numbered before,
+  /// whether it was kept. Throws physics::InputError naming the connection for an id out of
+  /// range (nothing changed). O(connections + renames).
+  std::vector<bool> follow_nodes(Index num_nodes, const NodeDecision& decide);
   [[nodiscard]] const EdgeConnection& connection(Index c) const { return items_.at(c).connection; }
   /// Values of connection c at state s. O(1).
   [[nodiscard]] EdgeEval evaluate(Index c, const physics::StateView& s) const;
