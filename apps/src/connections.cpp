@@ -168,6 +168,69 @@ PointSide solid_point_side(const Around& a, std::uint32_t comp, std::uint32_t p,
   return {side, {shear_modulus(m) * square_torsion * l * l * l, m.young * l * l * l / 12}, best};
 }
 
+// A shell's side at point p. At a boundary vertex (its fan runs from one boundary edge to
+// another) the axis is the rest bisector of the fan's whole angle, carried by the triangle it
+// lies in (PHYSICS_NOTES §3.5); elsewhere (an interior vertex, or a vertex where fans pinch) the
+// corner bisector of the first triangle: a frame carried rigidly by that triangle, not the
+// vertex normal the notes suggest for interior vertices (not built yet).
+PointSide shell_point_side(const Around& a, const std::vector<std::uint32_t>& tris, std::uint32_t p) {
+  auto others = [&](std::uint32_t t) {
+    std::array<std::uint32_t, 2> o{};
+    int n = 0;
+    for (std::uint32_t v : a.mesh.cell(t))
+      if (v != p) o[static_cast<std::size_t>(n++)] = v;
+    return o;
+  };
+  auto side_on = [&](std::uint32_t t, std::optional<Vec3d> axis) {
+    connect::TriangleSide side;
+    const auto cp = a.mesh.cell(t);
+    for (int v = 0; v < 3; ++v) side.nodes[static_cast<std::size_t>(v)] = a.node(cp[static_cast<std::size_t>(v)]);
+    side.rest_axis = axis;
+    return PointSide{side, {}, t};
+  };
+  std::map<std::uint32_t, int> uses;  // the far end of each edge from p -> triangles using it
+  for (std::uint32_t t : tris)
+    for (std::uint32_t v : others(t)) ++uses[v];
+  std::vector<std::uint32_t> ends;
+  for (const auto& u : uses)
+    if (u.second == 1) ends.push_back(u.first);
+  if (ends.size() != 2) return side_on(tris.front(), std::nullopt);
+  // walk the fan from one boundary edge to the other: (triangle, from, to, angle at p)
+  struct Wedge {
+    std::uint32_t tri, from, to;
+    double angle;
+  };
+  std::vector<Wedge> fan;
+  std::vector<bool> used(tris.size(), false);
+  double total = 0;
+  for (std::uint32_t from = ends[0]; fan.size() < tris.size();) {
+    std::size_t k = 0;
+    while (k < tris.size() && (used[k] || (others(tris[k])[0] != from && others(tris[k])[1] != from))) ++k;
+    if (k == tris.size()) break;
+    used[k] = true;
+    const auto o = others(tris[k]);
+    const std::uint32_t to = o[0] == from ? o[1] : o[0];
+    const Vec3d e1 = a.x(from) - a.x(p), e2 = a.x(to) - a.x(p);
+    fan.push_back({tris[k], from, to, std::atan2(e1.cross(e2).norm(), e1.dot(e2))});
+    total += fan.back().angle;
+    from = to;
+  }
+  if (fan.size() != tris.size() || fan.back().to != ends[1]) return side_on(tris.front(), std::nullopt);
+  double before = 0;
+  for (const Wedge& w : fan) {
+    if (before + w.angle >= total / 2 || &w == &fan.back()) {
+      // the bisector, turned from this wedge's first edge by what is left of half the fan
+      const double r = std::clamp(total / 2 - before, 1e-6 * w.angle, (1 - 1e-6) * w.angle);
+      const Vec3d e1 = (a.x(w.from) - a.x(p)).normalized();
+      const Vec3d e2 = a.x(w.to) - a.x(p);
+      const Vec3d u = (e2 - e2.dot(e1) * e1).normalized();
+      return side_on(w.tri, Vec3d(std::cos(r) * e1 + std::sin(r) * u));
+    }
+    before += w.angle;
+  }
+  return side_on(tris.front(), std::nullopt);
+}
+
 PointSide point_side(const Around& a, std::uint32_t comp, std::uint32_t p, const Vec3d& toward, const std::string& who,
                      const std::string& file, const std::string& key) {
   const std::uint32_t pp[1] = {p};
@@ -181,12 +244,10 @@ PointSide point_side(const Around& a, std::uint32_t comp, std::uint32_t p, const
       return {connect::RodEdgeRef{r, edge}, {rod.section().GJ / l, std::min(rod.section().EI1, rod.section().EI2) / l}, c};
     }
     case connect::Body::shell: {
-      // the corner of the first incident triangle: a frame carried rigidly by that triangle
-      const auto cp = a.mesh.cell(c);
-      connect::TriangleSide side;
-      for (int v = 0; v < 3; ++v) side.nodes[static_cast<std::size_t>(v)] = a.node(cp[static_cast<std::size_t>(v)]);
       const auto& m = a.material(c);
-      return {side, {shear_modulus(m) * std::pow(m.thickness, 3) / 3, plate_bending(m)}, c};
+      PointSide side = shell_point_side(a, cells, p);
+      side.k = {shear_modulus(m) * std::pow(m.thickness, 3) / 3, plate_bending(m)};
+      return side;
     }
     case connect::Body::solid: return solid_point_side(a, comp, p, toward, who, file, key);
   }

@@ -72,6 +72,11 @@ PointEval PointConnections::evaluate(Index c, const StateView& s) const {
   return it.connection.evaluate(it.dofs.gather(s, it.owner()), update_, false);
 }
 
+std::array<Vec3, 4> PointConnections::frames(Index c, const StateView& s) const {
+  const Item& it = items_.at(c);
+  return it.connection.frames(it.dofs.gather(s, it.owner()));
+}
+
 double PointConnections::guarded_energy(const Item& it, const PointEval& e) const {
   const bool aliasing = update_ != TwistUpdate::direct && std::abs(e.twist - it.connection.accepted_twist()) > max_twist_increment;
   return (e.singular() || aliasing) ? std::numeric_limits<double>::infinity() : e.energy;

@@ -98,6 +98,12 @@ TEST_CASE("the fin scene's joints get energies: one rod-shell point, four shell-
   REQUIRE(f->joints.curves != nullptr);
   CHECK(f->continuum.rods->has_angle_dofs());
   CHECK(sewn::app::connection_energies_text(f->joints) == "  energies: 1 point, 4 curve (4 edge terms)\n");
+  // the mast hangs from a node of the fin's straight bottom edge: the shell side's axis is the
+  // bisector of the fan's whole 180° there, straight up into the fin (one triangle's corner
+  // bisector would lean by half that corner's asymmetry), and the rod's is along the mast
+  const auto frames = f->joints.points->frames(0, f->model->system().state());
+  CHECK(std::abs(std::abs(frames[1].z()) - 1) < 1e-9);
+  CHECK(std::abs(std::abs(frames[3].z()) - 1) < 1e-9);
   // at rest no energy and no force from the joints
   const auto s = f->model->system().state();
   CHECK(std::abs(f->joints.points->potential_energy(s)) < 1e-20);

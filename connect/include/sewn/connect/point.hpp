@@ -159,6 +159,9 @@ class PointConnection {
   void accept(const Eigen::VectorXd& q, TwistUpdate update);
   /// Renames every node id (sides, joint, layout; old → new) after the node table was compacted.
   void remap_nodes(std::span<const Index> old_to_new);
+  /// Both sides' frames at q (stencil order), signs of the orientation rule applied:
+  /// {m1, m3, n1, n3}. Throws as evaluate() does for a q of the wrong size. O(1).
+  [[nodiscard]] std::array<Vec3, 4> frames(const Eigen::VectorXd& q) const;
   /// The history accept() moves on (see ConnectionHistory). O(1).
   [[nodiscard]] ConnectionHistory history() const;
   /// Takes up history() of a connection built the same way. Throws physics::InputError naming

@@ -91,6 +91,8 @@ class PointConnections final : public physics::ForceTerm {
   [[nodiscard]] const PointConnection& connection(Index c) const { return items_.at(c).connection; }
   /// Values of connection c at state s (energy, angles, flags). O(1).
   [[nodiscard]] PointEval evaluate(Index c, const physics::StateView& s) const;
+  /// Connection c's frames at state s ({m1, m3, n1, n3}, PointConnection::frames). O(1).
+  [[nodiscard]] std::array<Vec3, 4> frames(Index c, const physics::StateView& s) const;
 
   [[nodiscard]] std::string_view name() const override { return "point connections"; }
   void add_forces(const physics::StateView& s, std::span<double> f) const override;
