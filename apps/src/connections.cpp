@@ -54,7 +54,13 @@ struct Around {
 Around gather(const IndexedMesh& mesh, const std::vector<CellModel>& models, const std::vector<physics::MaterialParams>& materials,
               const ContinuumParts& parts, const physics::MssModel<3>& model, const std::string& file) {
   Around a{mesh, model, materials, parts, {}, {}, {}, {}};
-  MeshConnections mc = mesh_connections(mesh, models);
+  // rods as the Rods term chained them (split by group and material): two rods meeting at a
+  // node are two components, joined by a rod–rod point connection
+  std::vector<std::uint32_t> chain(mesh.num_cells(), 0);
+  for (Index e = 0; e < parts.rod_edge_of_element.size(); ++e)
+    if (parts.rod_edge_of_element[e].first != physics::invalid_index)
+      chain[model.elements()[e].mesh_cell] = static_cast<std::uint32_t>(parts.rod_edge_of_element[e].first + 1);
+  MeshConnections mc = mesh_connections(mesh, models, chain);
   if (!mc.skipped.empty()) throw SceneError(file, "model.connections", "connections cannot be found in this mesh: " + mc.skipped);
   a.found = std::move(mc.found);
   a.component.assign(mesh.num_cells(), -1);

@@ -6,12 +6,14 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <random>
 #include <string>
 
 #include "sewn/apps/connections.hpp"
 #include "sewn/apps/continuum.hpp"
 #include "sewn/apps/runner.hpp"
 #include "sewn/apps/scene.hpp"
+#include "sewn/io/cleanup.hpp"
 #include "sewn/physics/integrate/newton_euler.hpp"
 
 namespace test_connection_keys {
@@ -169,6 +171,78 @@ TEST_CASE("connections: bad keys and places are refused, naming the key") {
   CHECK(parse(R"({"type": "mixed", "connections": {"explicit": [{"kind": "surface", "at": [0,0,0]}]}})").find("model.connections.explicit[0].kind") == 0);
   CHECK(parse(R"({"type": "mixed", "connections": {"twisting": -1}})").find("model.connections.twisting") == 0);
   CHECK(parse(R"({"type": "mixed", "connections": {"detect": true, "rigid": true, "twisting": 2, "bending": 3, "curve_stiffness": 4}})") == "accepted");
+}
+
+// A block of two cubes (tetrahedra), rod A along its bottom front edge (segments on tet edges,
+// a rod by its group), rod B continuing from the block's corner outward: rod–solid curve edges,
+// a rod–solid point and a rod–rod point at the corner.
+TEST_CASE("rods on and from a solid: curve and point connections with rod sides, forces the energy's gradient") {
+  sewn::GridSpec g;
+  g.spacing = {0.1, 0.1, 0.1};
+  sewn::IndexedMesh m = sewn::tet_grid(2, 1, 1, sewn::TetSplit::kuhn6, g);
+  m.add_cell(sewn::CellType::segment, {0, 1}, 3);
+  m.add_cell(sewn::CellType::segment, {1, 2}, 3);
+  const std::uint32_t r = m.num_points();
+  m.points.push_back({0.3, 0.0, 0.02});
+  m.points.push_back({0.4, 0.0, 0.03});
+  m.add_cell(sewn::CellType::segment, {2, r}, 4);
+  m.add_cell(sewn::CellType::segment, {r, r + 1}, 4);
+  Scene s;
+  s.file = "rods.json";
+  s.model = "mixed";
+  s.damping = "none";
+  s.integrator = "newton";
+  s.model_groups = {{3, "", "rod", {0.004, 0.004}}};
+  s.connections.enabled = true;
+  std::vector<sewn::physics::MaterialParams> materials{{1e7, 0.3, 1000, 0.002, 5e-5, sewn::physics::ElongatedPolicy::refuse}};
+  sewn::physics::MssOptions mo;
+  mo.gravity.setZero();
+  mo.damping = sewn::physics::DampingModel::none;
+  sewn::physics::MssModel<3> model(m, materials, std::vector<std::uint32_t>{}, mo);
+  const auto groups = std::vector<int>{-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 0, -1, -1};
+  REQUIRE(groups.size() == m.num_cells());
+  const auto models = sewn::app::cell_models(m, sewn::io::embedded_cells(m), s, "m", groups);
+  const auto parts = sewn::app::build_continuum(s, materials, m, models, groups, model);
+  const auto joints = sewn::app::build_connections(s, m, models, materials, parts, model);
+  // two rods (split by group where they meet); detection chains segments by the same rule
+  REQUIRE(parts.rods != nullptr);
+  CHECK(parts.rods->num_rods() == 2);
+  CHECK(joints.point_joints == 2);    // rod B on the block's corner, rod A to rod B there
+  CHECK(joints.curve_joints == 2);    // rod A along the two tet edges
+  CHECK(joints.curve_elements == 2);  // a boundary edge of the block: its two faces as one hinge side
+  REQUIRE(joints.points != nullptr);
+  REQUIRE(joints.curves != nullptr);
+  sewn::physics::System& sys = model.system();
+  CHECK(std::abs(sys.potential_energy()) < 1e-12);
+  // a deformed state, positions and twist angles: forces and torques are −∂E/∂q
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.004, 0.004);
+  for (Index i = 0; i < model.nodes().size(); ++i)
+    model.nodes().set_position(i, model.nodes().position(i) + Eigen::Vector3d(u(rng), u(rng), u(rng)));
+  for (double& a : sys.angles().values()) a += 50 * u(rng);
+  sys.compute_forces();
+  const double connected = joints.points->potential_energy(sys.state()) + joints.curves->potential_energy(sys.state());
+  CHECK(connected > 0);
+  double worst = 0, scale = 0;
+  const double step = 1e-7;
+  for (Index i = 0; i < model.nodes().size(); ++i)
+    for (int a = 0; a < 3; ++a) {
+      const Eigen::Vector3d x = model.nodes().position(i);
+      Eigen::Vector3d xp = x, xm = x;
+      xp[a] += step;
+      xm[a] -= step;
+      model.nodes().set_position(i, xp);
+      const double ep = sys.potential_energy();
+      model.nodes().set_position(i, xm);
+      const double em = sys.potential_energy();
+      model.nodes().set_position(i, x);
+      worst = std::max(worst, std::abs(-(ep - em) / (2 * step) - model.nodes().force(i)[a]));
+      scale = std::max(scale, std::abs(model.nodes().force(i)[a]));
+    }
+  CAPTURE(worst);
+  CAPTURE(scale);
+  CHECK(scale > 0);
+  CHECK(worst < 1e-6 * scale);
 }
 
 }  // namespace
