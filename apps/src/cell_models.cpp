@@ -176,7 +176,7 @@ SimulatedComplex simulated_complex(const IndexedMesh& mesh, const std::vector<Ce
   return out;
 }
 
-MeshConnections mesh_connections(const IndexedMesh& mesh, const std::vector<CellModel>& models) {
+MeshConnections mesh_connections(const IndexedMesh& mesh, const std::vector<CellModel>& models, const std::vector<std::uint32_t>& chain) {
   MeshConnections out;
   connect::CellList cells;
   for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
@@ -187,7 +187,7 @@ MeshConnections mesh_connections(const IndexedMesh& mesh, const std::vector<Cell
       return out;
     }
     cells.add(t == CellType::segment ? connect::Body::rod : t == CellType::triangle ? connect::Body::shell : connect::Body::solid,
-              mesh.cell(c));
+              mesh.cell(c), chain.empty() ? 0 : chain[c]);
   }
   out.found = connect::detect_connections(cells);
   return out;

@@ -339,6 +339,10 @@ Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum) {
   // The continuum models (solids, shells, rods) and the volume term join or replace the springs.
   if (scene.model != "mass-spring")
     b.continuum = build_continuum(scene, materials, assembly.mesh, assembly.model_of_cell, assembly.group_of_cell, model);
+  // the rotational energies where the bodies meet (model.connections), on the rest state
+  if (scene.model != "mass-spring")
+    b.joints = build_connections(scene, assembly.mesh, assembly.model_of_cell, materials, b.continuum, model);
+  sum.connection_energies = connection_energies_text(b.joints);
   add_volume_term(scene, assembly.material_names, model);
 
   set_initial_state(scene, assembly, model);

@@ -1,6 +1,6 @@
 #pragma once
 // The runner's first phase: from a scene to the bodies it simulates — the meshes assembled, the
-// mass-spring model with its continuum terms, obstacles and volume term, the fixed particles
+// mass-spring model with its continuum terms, connection energies, obstacles and volume term, the fixed particles
 // and initial velocities, and the refinement driver if the scene refines.
 
 #include <memory>
@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include "sewn/apps/connections.hpp"
 #include "sewn/apps/continuum.hpp"
 #include "sewn/apps/refine_keys.hpp"
 #include "sewn/apps/runner.hpp"
@@ -21,6 +22,7 @@ struct Bodies {
   Assembly assembly;
   std::unique_ptr<physics::MssModel<3>> model;
   ContinuumParts continuum;
+  ConnectionParts joints;  ///< the rotational energies where the bodies meet (model.connections)
   std::unique_ptr<RefinementRun> refinement;  ///< null if the scene refines nothing
 };
 

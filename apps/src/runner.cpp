@@ -245,7 +245,7 @@ void RunLoop::resume() {
   if (ck_.run_hash != run_id_)
     throw CheckpointError(file, "written by another scene (" + scene_.file + " or its mesh files differ from the run's)");
   next_cut_ = detail::check_cut_schedule(ck_, cuts_, file);
-  detail::restore_model(model_, b_.continuum, b_.refinement.get(), ck_, file);
+  detail::restore_model(model_, b_.continuum, b_.joints, b_.refinement.get(), ck_, file);
   if (ck_.frame_times.size() != (scene_.write_vtu ? ck_.frame : 0) ||
       std::size_t{ck_.csv_columns} * ck_.frame != (scene_.write_csv ? ck_.csv_rows.size() : 0))
     throw CheckpointError(file, "its output record does not match its " + std::to_string(ck_.frame) + " frames");
@@ -375,6 +375,11 @@ void RunLoop::save_checkpoint(double wall) {
   c.ledger = ledger_.state();
   if (b_.refinement) c.refinement = b_.refinement->state();
   if (b_.continuum.rods) c.rods = b_.continuum.rods->history();
+  const physics::AngleTable& angles = model_.system().angles();
+  c.angles.assign(angles.values().begin(), angles.values().end());
+  c.angle_rates.assign(angles.rates().begin(), angles.rates().end());
+  if (b_.joints.points) c.point_connections = b_.joints.points->history();
+  if (b_.joints.curves) c.curve_connections = b_.joints.curves->history();
   c.frame_times = frame_times_;
   c.csv_columns = csv_ ? static_cast<std::uint32_t>(csv_->columns()) : 0;
   c.csv_rows = csv_rows_;

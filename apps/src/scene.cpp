@@ -214,7 +214,8 @@ Field build_schema() {
                 field("bending", Kind::string).one_of({"patch", "hinge"}).fallback("patch")
                     .doc("Shell cells' bending: `patch`, the plate energy of the quadratic fitted to each triangle and its neighbours (converges at second order on structured meshes of either diagonal orientation, not yet on irregular ones; held nodes clamp half a cell outside them; no cuts yet), or `hinge`, hinges on the interior edges with k_B = D/6 (up to 2x too soft on meshes whose diagonals run one way; follows cuts). docs/elastic.md has the measured tables."),
                 field("groups", Kind::array).of(group).items(0, 4096).fallback(nlohmann::json::array())
-                    .doc("Per mesh tag, what its cells are (later entries win). With `mass-spring`, only `label` is accepted.")});
+                    .doc("Per mesh tag, what its cells are (later entries win). With `mass-spring`, only `label` is accepted."),
+                connections_schema()});
 
   Field integrator = field("integrator", Kind::object);
   integrator.doc("Time integration.")
@@ -588,6 +589,10 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
       if (s.model == "mass-spring" && mg.as != "label")
         throw SceneError(file, gpath + ".as", "\"" + mg.as + "\" cannot be combined with model.type \"mass-spring\" (use \"mixed\", or \"label\")");
       s.model_groups.push_back(mg);
+    }
+    if (m.has("connections")) {
+      if (s.model == "mass-spring") throw SceneError(file, "model.connections", "connections join continuum bodies (model.type solid, shell or mixed), not springs");
+      s.connections = read_connections(m["connections"], *schema.member("model")->member("connections"), file);
     }
   }
   {

@@ -65,7 +65,8 @@ std::vector<std::uint32_t> components(const CellList& cells, std::uint32_t& coun
   };
   join_pairs(solid_faces);
   join_pairs(shell_edges);
-  join_pairs(rod_points);
+  for (const auto& [point, list] : rod_points)
+    if (list.size() == 2 && cells.chain[list[0]] == cells.chain[list[1]]) uf.join(list[0], list[1]);
   std::vector<std::uint32_t> label(cells.size(), ~0u), out(cells.size());
   count = 0;
   for (std::uint32_t c = 0; c < cells.size(); ++c) {
@@ -119,7 +120,7 @@ const char* body_pair_name(int pair) {
   return names[pair];
 }
 
-void CellList::add(Body b, std::span<const std::uint32_t> cell_points) {
+void CellList::add(Body b, std::span<const std::uint32_t> cell_points, std::uint32_t chain_key) {
   const std::size_t want = b == Body::rod ? 2 : b == Body::shell ? 3 : 4;
   if (cell_points.size() != want)
     throw std::invalid_argument(std::string("connect::CellList: a ") + to_string(b) + " cell has " + std::to_string(want) +
@@ -130,6 +131,7 @@ void CellList::add(Body b, std::span<const std::uint32_t> cell_points) {
         throw std::invalid_argument("connect::CellList: cell " + std::to_string(size()) + " repeats point " +
                                     std::to_string(cell_points[i]));
   body.push_back(b);
+  chain.push_back(chain_key);
   points.insert(points.end(), cell_points.begin(), cell_points.end());
   offsets.push_back(static_cast<std::uint32_t>(points.size()));
 }

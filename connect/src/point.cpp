@@ -6,6 +6,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "history.hpp"
 #include "jet.hpp"
 #include "sewn/physics/rods/stencils.hpp"
 
@@ -426,6 +427,21 @@ void PointConnection::remap_nodes(std::span<const Index> old_to_new) {
       for (Index& i : std::get<TetSide>(*s).nodes) map(i);
     }
   }
+}
+
+std::array<Vec3, 4> PointConnection::frames(const Eigen::VectorXd& q) const {
+  (void)evaluate(q, TwistUpdate::direct, false);  // the size and finiteness checks, naming the connection
+  const Eigen::VectorXd qm = q.head(dofs_m_), qn = q.tail(dofs_n_);
+  const auto fm = build_frame<double>(m_, qm, 0, sign_m_, coef_m_);
+  const auto fn = build_frame<double>(n_, qn, 0, sign_n_, coef_n_);
+  auto vec = [](const auto& v) { return Vec3(v.x, v.y, v.z); };
+  return {vec(fm.m1), vec(fm.m3), vec(fn.m1), vec(fn.m3)};
+}
+
+ConnectionHistory PointConnection::history() const { return detail::make_history(accepted_twist_, m_, n_); }
+
+void PointConnection::restore(const ConnectionHistory& h) {
+  accepted_twist_ = detail::take_history(h, m_, n_, "point connection '" + name_ + "'");
 }
 
 }  // namespace sewn::connect

@@ -7,6 +7,7 @@
 
 #include "sewn/physics/elements/element_math.hpp"
 #include "sewn/physics/nodes.hpp"
+#include "history.hpp"
 
 namespace sewn::connect {
 
@@ -71,6 +72,11 @@ PointEval PointConnections::evaluate(Index c, const StateView& s) const {
   return it.connection.evaluate(it.dofs.gather(s, it.owner()), update_, false);
 }
 
+std::array<Vec3, 4> PointConnections::frames(Index c, const StateView& s) const {
+  const Item& it = items_.at(c);
+  return it.connection.frames(it.dofs.gather(s, it.owner()));
+}
+
 double PointConnections::guarded_energy(const Item& it, const PointEval& e) const {
   const bool aliasing = update_ != TwistUpdate::direct && std::abs(e.twist - it.connection.accepted_twist()) > max_twist_increment;
   return (e.singular() || aliasing) ? std::numeric_limits<double>::infinity() : e.energy;
@@ -131,6 +137,16 @@ void PointConnections::remap_nodes(std::span<const Index> old_to_new) {
     it.connection.remap_nodes(old_to_new);
   }
   touch_topology();
+}
+
+std::vector<double> PointConnections::history() const { return detail::items_history(items_); }
+
+void PointConnections::restore(std::span<const double> h) { detail::restore_items(items_, h, std::string(name())); }
+
+std::vector<bool> PointConnections::follow_nodes(Index num_nodes, const NodeDecision& decide) {
+  std::vector<bool> kept = detail::follow_items(items_, num_nodes, decide);
+  touch_topology();
+  return kept;
 }
 
 }  // namespace sewn::connect

@@ -109,6 +109,22 @@ TEST_CASE("detect: solids touching along an edge or at a point") {
   CHECK(sewn::connect::connections_text(detect_connections(none)) == "  none: the components share no point\n");
 }
 
+TEST_CASE("detect: chain keys split a rod where a model splits it, giving a rod-rod point there") {
+  // one straight line of three segments; keyed 1, 1, 2 (two groups in a scene): two rods
+  CellList one, two;
+  for (std::uint32_t k = 0; k < 3; ++k) {
+    one.add(Body::rod, {k, k + 1});
+    two.add(Body::rod, {k, k + 1}, k < 2 ? 1u : 2u);
+  }
+  const FoundConnections f1 = detect_connections(one), f2 = detect_connections(two);
+  CHECK(f1.component_body.size() == 1);
+  CHECK(f1.total() == 0);
+  CHECK(f2.component_body.size() == 2);
+  CHECK(count(f2, ConnectionKind::point, Body::rod, Body::rod) == 1);
+  REQUIRE(f2.total() == 1);
+  CHECK(f2.connections[0].points == std::vector<std::uint32_t>{2});
+}
+
 TEST_CASE("detect: bad cells are refused with what and where") {
   CellList c;
   CHECK_THROWS_WITH_AS(c.add(Body::shell, {0, 1}), "connect::CellList: a shell cell has 3 points, got 2 (cell 0)", std::invalid_argument);

@@ -91,7 +91,9 @@ struct MeshConnections {
   connect::FoundConnections found;
   std::string skipped;
 };
-MeshConnections mesh_connections(const IndexedMesh& mesh, const std::vector<CellModel>& models);
+/// `chain`: per mesh cell a rod segment's chain key (connect::CellList::chain), empty: none.
+MeshConnections mesh_connections(const IndexedMesh& mesh, const std::vector<CellModel>& models,
+                                 const std::vector<std::uint32_t>& chain = {});
 
 /// {"point": {"rod-shell": n, ...}, "curve": {...}, "surface": {...}, "components": n} with the
 /// nonzero counts only, or {"skipped": why}.

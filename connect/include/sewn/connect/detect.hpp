@@ -4,7 +4,8 @@
 // points, as the map is built from them). Components first: solid tetrahedra joined through
 // shared faces, shell triangles through edges exactly two of them share (an edge of three or
 // more is a non-manifold junction: the triangles around it stay separate components), rod
-// segments through points exactly two of them share (a rod's chain). Then, for each pair of
+// segments through points exactly two of them share (a rod's chain; with chain keys, two of
+// one key: CellList::chain). Then, for each pair of
 // components meeting somewhere, the rule — the highest-dimensional contact wins at each place:
 //   - a face of both (a shell triangle that is a tet's face, or two solids sharing a face):
 //     one surface connection per face;
@@ -33,12 +34,18 @@ const char* to_string(Body b);
 /// The simulated cells: rods are segments (2 points), shells triangles (3), solids tetrahedra (4).
 struct CellList {
   std::vector<Body> body;
+  /// Per cell, which chain a rod segment may join (0 unless given): two segments sharing a
+  /// point chain into one rod component only with equal keys, as a model that splits its rods
+  /// by group or material does (apps: the Rods term's rod of each segment).
+  std::vector<std::uint32_t> chain;
   std::vector<std::uint32_t> offsets{0};
   std::vector<std::uint32_t> points;
   /// Appends a cell; throws std::invalid_argument if the point count does not match the body
   /// or a point repeats.
-  void add(Body b, std::span<const std::uint32_t> cell_points);
-  void add(Body b, std::initializer_list<std::uint32_t> cell_points) { add(b, std::span(cell_points.begin(), cell_points.size())); }
+  void add(Body b, std::span<const std::uint32_t> cell_points, std::uint32_t chain_key = 0);
+  void add(Body b, std::initializer_list<std::uint32_t> cell_points, std::uint32_t chain_key = 0) {
+    add(b, std::span(cell_points.begin(), cell_points.size()), chain_key);
+  }
   [[nodiscard]] std::uint32_t size() const { return static_cast<std::uint32_t>(body.size()); }
   [[nodiscard]] std::span<const std::uint32_t> cell(std::uint32_t c) const {
     return {points.data() + offsets[c], points.data() + offsets[c + 1]};
