@@ -543,7 +543,8 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   physics::SymplecticEulerOptions so;
   so.enforce_stable_step = !scene.allow_unstable;
   physics::ImplicitEulerOptions io_opt;
-  io_opt.solver = physics::solve::parse_backend(scene.solver);
+  // "ldlt" is Newton's own direct solve (scene.cpp refuses it with the other integrators)
+  io_opt.solver = scene.solver == "ldlt" ? physics::solve::Backend::automatic : physics::solve::parse_backend(scene.solver);
   io_opt.cg_tolerance = scene.tolerance;
   io_opt.cg_absolute_tolerance = scene.absolute_tolerance;
   io_opt.cg_max_iterations = static_cast<int>(scene.max_iterations);
@@ -559,6 +560,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   no.max_iterations = static_cast<int>(scene.newton_iterations);
   no.cg_tolerance = scene.tolerance;
   no.cg_max_iterations = static_cast<int>(scene.max_iterations);
+  if (scene.solver == "ldlt") no.solver = physics::integrate::LinearSolver::ldlt;
   physics::integrate::NewtonEuler newton(no);
   const bool use_newton = scene.integrator == "newton";
   const bool bar = !options.quiet && options.progress && isatty(STDERR_FILENO);
@@ -670,11 +672,15 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
       }
     } else if (use_implicit)
       cg = implicit.step(model->system(), h).cg_iterations;
-    else if (use_newton)
-      cg = newton.step(model->system(), h).linear_iterations;
-    else
+    else if (use_newton) {
+      const auto rep = newton.step(model->system(), h);
+      cg = rep.linear_iterations;
+      sum.newton_iterations += static_cast<std::uint64_t>(rep.iterations);
+    } else
       step_semi_implicit(semi, model->system(), h, t, scene);
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    sum.stepping += ms / 1e3;
+    sum.linear_iterations += static_cast<std::uint64_t>(cg);
     frame_ms += ms;
     frame_cg_sum += cg;
     frame_cg_max = std::max(frame_cg_max, cg);
