@@ -204,6 +204,10 @@ std::string encode_payload(const Checkpoint& c) {
   e.put(l.rises);
   e.put(l.peak_ratio);
   put_rods(e, c.rods);
+  e.put(c.angles);
+  e.put(c.angle_rates);
+  e.put(c.point_connections);
+  e.put(c.curve_connections);
   e.put(c.refinement.refined);
   e.put(c.refinement.coarsened);
   e.put(c.refinement.dissipated);
@@ -274,6 +278,12 @@ Checkpoint decode_payload(Decoder& d) {
   l.rises = d.get<std::uint64_t>("energy rises");
   l.peak_ratio = d.get<double>("energy peak ratio");
   c.rods = get_rods(d);
+  d.get(c.angles, "angles");
+  d.get(c.angle_rates, "angle rates");
+  if (c.angles.size() != c.angle_rates.size())
+    d.fail(std::to_string(c.angles.size()) + " angles but " + std::to_string(c.angle_rates.size()) + " angle rates");
+  d.get(c.point_connections, "point connection history");
+  d.get(c.curve_connections, "curve connection history");
   c.refinement.refined = d.get<std::uint64_t>("refinements");
   c.refinement.coarsened = d.get<std::uint64_t>("coarsenings");
   c.refinement.dissipated = d.get<double>("coarsening dissipation");

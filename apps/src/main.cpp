@@ -174,9 +174,14 @@ int cmd_run(const std::vector<std::string>& args) {
     if (!s.checkpoint.empty()) std::printf("; checkpoint: %s", s.checkpoint.string().c_str());
     if (s.stopped) std::printf("; stopped after the checkpoint (continue with --resume)");
     std::printf("\n");
-    if (!s.connections.empty())
-      std::printf("connections found between the bodies (positions shared; no rotational energies in the scene yet):\n%s",
-                  s.connections.c_str());
+    if (!s.connections.empty()) {
+      if (s.connection_energies.empty())
+        std::printf("connections found between the bodies (positions shared; no rotational energies: model.connections not given):\n%s",
+                    s.connections.c_str());
+      else
+        std::printf("connections found between the bodies, with rotational energies (model.connections):\n%s%s", s.connections.c_str(),
+                    s.connection_energies.c_str());
+    }
   }
   return ok;
 }

@@ -131,8 +131,33 @@ std::size_t check_cut_schedule(const Checkpoint& c, std::span<const std::pair<do
   return done;
 }
 
-void restore_model(physics::MssModel<3>& model, const ContinuumParts& continuum, RefinementRun* refinement, const Checkpoint& c,
-                   const std::string& file) {
+namespace {
+
+// The angle DOFs (values and rates) and each connection term's history.
+void restore_angles_and_joints(physics::AngleTable& angles, const ConnectionParts& joints, const Checkpoint& c, const std::string& file) {
+  if (c.angles.size() != angles.size())
+    throw CheckpointError(file, "holds " + std::to_string(c.angles.size()) + " angle DOFs for a model of " + std::to_string(angles.size()));
+  std::copy(c.angles.begin(), c.angles.end(), angles.values().begin());
+  std::copy(c.angle_rates.begin(), c.angle_rates.end(), angles.rates().begin());
+  auto restore = [&](auto* term, const std::vector<double>& h, const char* what) {
+    if (!term) {
+      if (!h.empty()) throw CheckpointError(file, std::string("holds ") + what + " history, and the scene's model has none");
+      return;
+    }
+    try {
+      term->restore(h);
+    } catch (const physics::InputError& e) {
+      throw CheckpointError(file, std::string("its ") + what + " history does not fit the scene's: " + e.what());
+    }
+  };
+  restore(joints.points, c.point_connections, "point connection");
+  restore(joints.curves, c.curve_connections, "curve connection");
+}
+
+}  // namespace
+
+void restore_model(physics::MssModel<3>& model, const ContinuumParts& continuum, const ConnectionParts& joints, RefinementRun* refinement,
+                   const Checkpoint& c, const std::string& file) {
   replay_cuts(model, refinement, c, file);
   if (refinement) {
     if (c.refinement.calm.size() > model.elements().size())
@@ -149,6 +174,7 @@ void restore_model(physics::MssModel<3>& model, const ContinuumParts& continuum,
     throw CheckpointError(file, "holds " + std::to_string(c.x.size() / 3) + " particles for a model of " + std::to_string(nodes.size()));
   std::copy(c.x.begin(), c.x.end(), nodes.x().begin());
   std::copy(c.v.begin(), c.v.end(), nodes.v().begin());
+  restore_angles_and_joints(model.system().angles(), joints, c, file);
   if (!continuum.rods) {
     if (!c.rods.empty()) throw CheckpointError(file, "holds " + std::to_string(c.rods.size()) + " rods, and the scene's model has none");
     return;

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "sewn/apps/checkpoint.hpp"
+#include "sewn/apps/connections.hpp"
 #include "sewn/apps/continuum.hpp"
 #include "sewn/apps/scene.hpp"
 #include "sewn/physics/mss_model.hpp"
@@ -40,9 +41,10 @@ void replay_cuts(physics::MssModel<3>& model, const RefinementRun* refinement, c
 
 /// Brings a model (and its continuum terms) freshly built from the checkpoint's scene to the
 /// checkpoint's state: the recorded edits applied again (replay_cuts) and followed by the
-/// tetrahedra, the positions and velocities, the rods' own state, the refinement's counters.
-/// Throws CheckpointError (naming `file`) for anything that does not fit the model. O(model).
-void restore_model(physics::MssModel<3>& model, const ContinuumParts& continuum, RefinementRun* refinement, const Checkpoint& c,
-                   const std::string& file);
+/// tetrahedra, the positions and velocities, the angle DOFs, the rods' own state, the
+/// connections' histories, the refinement's counters. Throws CheckpointError (naming `file`)
+/// for anything that does not fit the model. O(model).
+void restore_model(physics::MssModel<3>& model, const ContinuumParts& continuum, const ConnectionParts& joints, RefinementRun* refinement,
+                   const Checkpoint& c, const std::string& file);
 
 }  // namespace sewn::app::detail

@@ -12,6 +12,7 @@
 
 #include <Eigen/Geometry>
 
+#include "sewn/apps/connections.hpp"
 #include "sewn/apps/continuum.hpp"
 #include "sewn/io/cleanup.hpp"
 #include "sewn/io/geometry.hpp"
@@ -362,6 +363,10 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   const IndexedMesh& mesh = assembly.mesh;
   ContinuumParts continuum;
   if (scene.model != "mass-spring") continuum = build_continuum(scene, materials, mesh, assembly.model_of_cell, assembly.group_of_cell, *model);
+  // the rotational energies where the bodies meet (model.connections), on the rest state
+  ConnectionParts joints;
+  if (scene.model != "mass-spring") joints = build_connections(scene, mesh, assembly.model_of_cell, materials, continuum, *model);
+  sum.connection_energies = connection_energies_text(joints);
 
   add_volume_term(scene, assembly.material_names, *model);
 
@@ -415,7 +420,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     if (ck.run_hash != run_id)
       throw CheckpointError(file, "written by another scene (" + scene.file + " or its mesh files differ from the run's)");
     next_cut = detail::check_cut_schedule(ck, cuts, file);
-    detail::restore_model(*model, continuum, refinement.get(), ck, file);
+    detail::restore_model(*model, continuum, joints, refinement.get(), ck, file);
     if (ck.frame_times.size() != (scene.write_vtu ? ck.frame : 0) ||
         std::size_t{ck.csv_columns} * ck.frame != (scene.write_csv ? ck.csv_rows.size() : 0))
       throw CheckpointError(file, "its output record does not match its " + std::to_string(ck.frame) + " frames");
@@ -597,6 +602,11 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
     c.ledger = ledger.state();
     if (refinement) c.refinement = refinement->state();
     if (continuum.rods) c.rods = continuum.rods->history();
+    const physics::AngleTable& angles = model->system().angles();
+    c.angles.assign(angles.values().begin(), angles.values().end());
+    c.angle_rates.assign(angles.rates().begin(), angles.rates().end());
+    if (joints.points) c.point_connections = joints.points->history();
+    if (joints.curves) c.curve_connections = joints.curves->history();
     c.frame_times = frame_times;
     c.csv_columns = csv ? static_cast<std::uint32_t>(csv->columns()) : 0;
     c.csv_rows = csv_rows;

@@ -212,7 +212,8 @@ Field build_schema() {
                 field("law", Kind::string).one_of({"stvk", "stable_neo_hookean"}).fallback("stable_neo_hookean")
                     .doc("`solid` cells: St. Venant–Kirchhoff, or the inversion-safe stable neo-Hookean (Smith et al. 2018)."),
                 field("groups", Kind::array).of(group).items(0, 4096).fallback(nlohmann::json::array())
-                    .doc("Per mesh tag, what its cells are (later entries win). With `mass-spring`, only `label` is accepted.")});
+                    .doc("Per mesh tag, what its cells are (later entries win). With `mass-spring`, only `label` is accepted."),
+                connections_schema()});
 
   Field integrator = field("integrator", Kind::object);
   integrator.doc("Time integration.")
@@ -585,6 +586,10 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
       if (s.model == "mass-spring" && mg.as != "label")
         throw SceneError(file, gpath + ".as", "\"" + mg.as + "\" cannot be combined with model.type \"mass-spring\" (use \"mixed\", or \"label\")");
       s.model_groups.push_back(mg);
+    }
+    if (m.has("connections")) {
+      if (s.model == "mass-spring") throw SceneError(file, "model.connections", "connections join continuum bodies (model.type solid, shell or mixed), not springs");
+      s.connections = read_connections(m["connections"], *schema.member("model")->member("connections"), file);
     }
   }
   {

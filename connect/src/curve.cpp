@@ -3,6 +3,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "history.hpp"
 #include "jet.hpp"
 
 namespace sewn::connect {
@@ -238,6 +239,12 @@ void EdgeConnection::remap_nodes(std::span<const Index> old_to_new) {
       map(h.right);
     }
   }
+}
+
+ConnectionHistory EdgeConnection::history() const { return detail::make_history(accepted_twist_, m_, n_); }
+
+void EdgeConnection::restore(const ConnectionHistory& h) {
+  accepted_twist_ = detail::take_history(h, m_, n_, "curve connection '" + name_ + "'");
 }
 
 }  // namespace sewn::connect

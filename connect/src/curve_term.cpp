@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "sewn/physics/elements/element_math.hpp"
+#include "history.hpp"
 
 namespace sewn::connect {
 
@@ -107,6 +108,16 @@ void CurveConnections::remap_nodes(std::span<const Index> old_to_new) {
     it.connection.remap_nodes(old_to_new);
   }
   touch_topology();
+}
+
+std::vector<double> CurveConnections::history() const { return detail::items_history(items_); }
+
+void CurveConnections::restore(std::span<const double> h) { detail::restore_items(items_, h, std::string(name())); }
+
+std::vector<bool> CurveConnections::follow_nodes(Index num_nodes, const NodeDecision& decide) {
+  std::vector<bool> kept = detail::follow_items(items_, num_nodes, decide);
+  touch_topology();
+  return kept;
 }
 
 }  // namespace sewn::connect

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "history.hpp"
 #include "jet.hpp"
 #include "sewn/physics/rods/stencils.hpp"
 
@@ -426,6 +427,12 @@ void PointConnection::remap_nodes(std::span<const Index> old_to_new) {
       for (Index& i : std::get<TetSide>(*s).nodes) map(i);
     }
   }
+}
+
+ConnectionHistory PointConnection::history() const { return detail::make_history(accepted_twist_, m_, n_); }
+
+void PointConnection::restore(const ConnectionHistory& h) {
+  accepted_twist_ = detail::take_history(h, m_, n_, "point connection '" + name_ + "'");
 }
 
 }  // namespace sewn::connect

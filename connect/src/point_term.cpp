@@ -7,6 +7,7 @@
 
 #include "sewn/physics/elements/element_math.hpp"
 #include "sewn/physics/nodes.hpp"
+#include "history.hpp"
 
 namespace sewn::connect {
 
@@ -131,6 +132,16 @@ void PointConnections::remap_nodes(std::span<const Index> old_to_new) {
     it.connection.remap_nodes(old_to_new);
   }
   touch_topology();
+}
+
+std::vector<double> PointConnections::history() const { return detail::items_history(items_); }
+
+void PointConnections::restore(std::span<const double> h) { detail::restore_items(items_, h, std::string(name())); }
+
+std::vector<bool> PointConnections::follow_nodes(Index num_nodes, const NodeDecision& decide) {
+  std::vector<bool> kept = detail::follow_items(items_, num_nodes, decide);
+  touch_topology();
+  return kept;
 }
 
 }  // namespace sewn::connect

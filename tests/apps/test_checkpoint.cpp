@@ -237,7 +237,9 @@ TEST_CASE("a resumed run writes the same bytes as the run that never stopped") {
 
 TEST_CASE("rods resume to the same bytes: their angles, frames and reference twists are in the checkpoint") {
   SUBCASE("a helix, stopped twice") { check_continuation("helix", helix_rod(), 2, {1, 2}); }
-  SUBCASE("the mixed scene: tetrahedra, a shell fin and a rod on one map") {
+  // with its connections (model.connections): the rods' θ are angle DOFs, and each connection's
+  // accepted twist and rod frame are in the checkpoint
+  SUBCASE("the mixed scene: tetrahedra, a shell fin and a rod on one map, joined by connections") {
     check_continuation_of("mixed_fin", fs::path(SEWN_SOURCE_DIR) / "scenes" / "mixed_fin.json", 2, {1}, "--until 0.06 --frames 6");
   }
 }
@@ -245,6 +247,28 @@ TEST_CASE("rods resume to the same bytes: their angles, frames and reference twi
 TEST_CASE("cuts of finite-element tetrahedra resume to the same bytes") {
   SUBCASE("the cut before the checkpoint") { check_continuation("solid_before", solid_beam("solid_before", "0.03"), 5, {1}); }
   SUBCASE("the cut after the checkpoint") { check_continuation("solid_after", solid_beam("solid_after", "0.05"), 2, {1}); }
+}
+
+// The fin of scenes/mixed_fin.json without its mast (a label), its connections on, cut at
+// `cut_time` across the fin and the block (x = 0.2): the cut's rule removes or renames the
+// fin's curve connections, and a resumed run replays the cut through the same rule.
+std::string cut_fin(const std::string& name, const std::string& cut_time) {
+  const std::string mesh = (fs::path(SEWN_SOURCE_DIR) / "scenes" / "meshes" / "fin.msh").string();
+  return R"({"name": ")" + name + R"(", "materials": {"rubber": {"young": 2e6, "poisson": 0.4, "density": 1100},
+      "sheet": {"young": 5e8, "poisson": 0.35, "density": 1200, "thickness": 0.004}},
+    "meshes": [{"type": "file", "path": ")" + mesh + R"(", "material": "rubber",
+                "regions": [{"where": {"type": "tag", "tag": 2}, "material": "sheet"}]}],
+    "fixed": [{"where": {"type": "tag", "tag": 4}}],
+    "velocities": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, -0.001]}, "linear": [0, 0.3, 0]}],
+    "model": {"type": "mixed", "groups": [{"name": "mast", "as": "label"}], "connections": {}},
+    "damping": {"model": "rayleigh", "alpha": 1.0}, "integrator": {"type": "newton", "step": 0.005},
+    "cuts": [{"type": "plane", "time": )" + cut_time + R"(, "point": [0.2, 0, 0], "normal": [1, 0, 0]}],
+    "duration": 0.04, "output": {"frames": 4}})";
+}
+
+TEST_CASE("connections under a cut resume to the same bytes: the cut is replayed through the connections' rule") {
+  SUBCASE("the cut before the checkpoint") { check_continuation("cut_fin_before", cut_fin("cut_fin_before", "0.012"), 2, {1}); }
+  SUBCASE("the cut after the checkpoint") { check_continuation("cut_fin_after", cut_fin("cut_fin_after", "0.025"), 2, {1}); }
 }
 
 TEST_CASE("the CHOLMOD backends resume to the same bytes: cholmod-pcg's kept factorization is in the checkpoint") {
@@ -305,9 +329,11 @@ TEST_CASE("a checkpoint that is not this run's, or not whole, is refused with ex
   SUBCASE("another format version") {
     std::string bad = bytes;
     bad[8] = 1;  // the format before rods, solver state and the energy-ratio peak
-    check_refused(saved, put("v1.checkpoint", bad), "format version 1, but this sewn reads version 2 only");
-    bad[8] = 3;
-    check_refused(saved, put("v3.checkpoint", bad), "format version 3, but this sewn reads version 2 only");
+    check_refused(saved, put("v1.checkpoint", bad), "format version 1, but this sewn reads version 3 only");
+    bad[8] = 2;  // the format before angle DOFs and connection histories
+    check_refused(saved, put("v2.checkpoint", bad), "format version 2, but this sewn reads version 3 only");
+    bad[8] = 4;
+    check_refused(saved, put("v4.checkpoint", bad), "format version 4, but this sewn reads version 3 only");
   }
   SUBCASE("not a checkpoint") { check_refused(saved, saved.scene, "not a Sewn checkpoint"); }
   SUBCASE("missing") { check_refused(saved, scratch("nowhere.checkpoint"), "cannot be opened: No such file or directory"); }
@@ -395,6 +421,10 @@ TEST_CASE("the checkpoint format: every field comes back, and every shorter file
   rod.rod.reference_twist = {0.3};
   rod.solved_at = {0, 0, 0, 1, 0, 0, 1, 1, 0};
   c.rods = {rod, {}};
+  c.angles = {0.4, 0.5};
+  c.angle_rates = {0.6, -0.7};
+  c.point_connections = {1.5, 1, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0};
+  c.curve_connections = {-2.5, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 1, 0};
   c.refinement = {39, 40, 0.75, {0, 3, 1}};
   c.frame_times = {0, 0.5};
   c.csv_columns = 2;
@@ -429,6 +459,10 @@ TEST_CASE("the checkpoint format: every field comes back, and every shorter file
   CHECK(d.rods[0].rod.reference_twist == rod.rod.reference_twist);
   CHECK(d.rods[0].solved_at == rod.solved_at);
   CHECK(d.rods[1].rod.theta.empty());
+  CHECK(d.angles == c.angles);
+  CHECK(d.angle_rates == c.angle_rates);
+  CHECK(d.point_connections == c.point_connections);
+  CHECK(d.curve_connections == c.curve_connections);
   CHECK(d.semi.watchdog.internal0 == 8);
   CHECK(d.midpoint.steps == 34);
   CHECK(d.midpoint.watchdog.peak_speed == 38);

@@ -18,6 +18,9 @@
 //     rule; Newton's backward Euler keeps none) and the energy ledger;
 //   - the rods' own state: material angles θ, time-parallel reference frames, tracked
 //     reference twists, and the positions θ was last solved at;
+//   - the system's angle DOFs and their rates (the rods' θ, when connections make them DOFs),
+//     and each connection's incremental history: its accepted twist and its rod sides'
+//     reference frames (connect/, ConnectionHistory);
 //   - the refinement's counters and the adapter's per-element hysteresis (calm) counters;
 //   - the time line: steps and frames done, the next scheduled cut, the frames listed in the
 //     .pvd and the rows of frames.csv, and the run summary's running figures.
@@ -72,7 +75,7 @@ struct AppliedCut {
 };
 
 struct Checkpoint {
-  static constexpr std::uint32_t format_version = 2;
+  static constexpr std::uint32_t format_version = 3;
 
   std::uint64_t run_hash = 0;    ///< the scene's text, its built model, steps and frames
   std::uint64_t model_hash = 0;  ///< the model's tables after the cuts below
@@ -89,6 +92,8 @@ struct Checkpoint {
   physics::ImplicitMidpoint::History midpoint;
   physics::EnergyLedger::State ledger;
   std::vector<physics::rods::Rods::RodHistory> rods;  ///< per rod of the scene, in build order
+  std::vector<double> angles, angle_rates;  ///< the system's angle DOFs (rods' θ when connections hold them)
+  std::vector<double> point_connections, curve_connections;  ///< each connection term's history(), empty if none
   RefinementRun::State refinement;  ///< the refinement's counters and hysteresis counters
 
   std::vector<double> frame_times;  ///< of the frames listed in the .pvd

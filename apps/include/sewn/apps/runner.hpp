@@ -104,6 +104,7 @@ struct RunSummary {
   std::uint64_t resumed_at = 0;      ///< the step the run resumed at (0: started afresh)
   bool stopped = false;              ///< stopped after a checkpoint (stop_after_checkpoints)
   std::string connections;           ///< model `mixed`: where its bodies meet (connections_text), else ""
+  std::string connection_energies;    ///< model.connections: the energies built (connection_energies_text), else ""
 };
 
 /// Runs the scene to its end. Throws SceneError / io errors / physics::InputError / OutputPathError

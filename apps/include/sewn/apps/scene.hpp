@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "sewn/apps/connection_keys.hpp"
 #include "sewn/apps/obstacle_keys.hpp"
 #include "sewn/apps/schema.hpp"
 #include "sewn/physics/solve/linear_solver.hpp"
@@ -133,6 +134,7 @@ struct Scene {
   Vec3 gravity{0, 0, -9.81};
   std::string model = "mass-spring", law = "stable_neo_hookean";  // model.type, model.law
   std::vector<ModelGroup> model_groups;                             // model.groups
+  ConnectionsSpec connections;                                      // model.connections
   std::string damping = "viscous";
   double rayleigh_alpha = 0, rayleigh_beta = 0, environment_damping = 0;
   std::string integrator = "implicit";

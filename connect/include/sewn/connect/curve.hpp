@@ -89,6 +89,10 @@ class EdgeConnection {
   void accept(const Eigen::VectorXd& q, TwistUpdate update);
   /// Renames every node id (old → new) after the node table was compacted.
   void remap_nodes(std::span<const Index> old_to_new);
+  /// The history accept() moves on (ConnectionHistory, point.hpp). O(1).
+  [[nodiscard]] ConnectionHistory history() const;
+  /// Takes up history() of a connection built the same way; throws as PointConnection::restore.
+  void restore(const ConnectionHistory& h);
 
  private:
   std::string name_;

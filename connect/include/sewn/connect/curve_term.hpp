@@ -32,12 +32,25 @@ class CurveConnections final : public physics::ForceTerm {
   Index add(const std::string& name, Index a, Index b, const EdgeSideRef& m, const EdgeSideRef& n, double k_per_length,
             const physics::StateView& s);
   [[nodiscard]] Index size() const { return static_cast<Index>(items_.size()); }
+  /// Every connection's history (ConnectionHistory, point.hpp), history_size values each, in
+  /// order: what step_accepted() moves on, for checkpoints. O(connections).
+  [[nodiscard]] std::vector<double> history() const;
+  /// Takes up history() of a term built the same way. Throws physics::InputError (nothing
+  /// changed) if the size does not fit or a connection refuses its part. O(connections).
+  void restore(std::span<const double> h);
   /// The rule when nodes go (a cut or a refinement removing them): a connection with a removed
   /// node in its stencil is removed with it (one of its sides no longer exists there), every
   /// other one is kept as it is; so none is left dangling. Call it after removing nodes and before
   /// System::compact_nodes(), whose node check otherwise refuses the connection by name. Returns
   /// how many were removed. O(connections).
   Index remove_dangling(const physics::NodeTable& nodes);
+  /// The rule under cuts (the scene layer decides, apps/connections.hpp): each connection c is
+  /// removed if `decide` says so, or kept with its nodes renamed (its DOF table and its own
+  /// ids; rest data, history and energy at the current state unchanged). `num_nodes`: the node
+  /// table's size (renamed ids must be below it). Returns per connection, as numbered before,
+  /// whether it was kept. Throws physics::InputError naming the connection for an id out of
+  /// range (nothing changed). O(connections + renames).
+  std::vector<bool> follow_nodes(Index num_nodes, const NodeDecision& decide);
   [[nodiscard]] const EdgeConnection& connection(Index c) const { return items_.at(c).connection; }
   /// Values of connection c at state s. O(1).
   [[nodiscard]] EdgeEval evaluate(Index c, const physics::StateView& s) const;

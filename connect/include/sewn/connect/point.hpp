@@ -87,6 +87,12 @@ enum class TwistUpdate {
   incremental_ii,  ///< last δ + the signed angle left after turning m1 by it about m3
 };
 
+/// What one connection carries from one step to the next (checkpoints), flat: the accepted
+/// twist, then per side (m, n) a rod side's frame history — tangent t̄ (3) and director ā1 (3),
+/// zeros for other sides.
+inline constexpr int history_size = 13;
+using ConnectionHistory = std::array<double, history_size>;
+
 /// Stiffnesses of one connection, per point and independent of resolution: k_t, k_b in N·m/rad.
 struct PointStiffness {
   double twist = 0, bend = 0;
@@ -153,6 +159,12 @@ class PointConnection {
   void accept(const Eigen::VectorXd& q, TwistUpdate update);
   /// Renames every node id (sides, joint, layout; old → new) after the node table was compacted.
   void remap_nodes(std::span<const Index> old_to_new);
+  /// The history accept() moves on (see ConnectionHistory). O(1).
+  [[nodiscard]] ConnectionHistory history() const;
+  /// Takes up history() of a connection built the same way. Throws physics::InputError naming
+  /// the connection (nothing changed) if a value is not finite or a rod side's frame is not
+  /// orthonormal (to 1e-9), or a non-rod side's slots are not zero. O(1).
+  void restore(const ConnectionHistory& h);
 
  private:
   std::string name_;

@@ -4,7 +4,9 @@
 // (angles in the rows AngleLayout gives them), its node pairs, its node checks and renumbering.
 // PointConnections and CurveConnections each hold one StencilDofs per element.
 
+#include <functional>
 #include <span>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -13,6 +15,11 @@
 #include "sewn/physics/force_term.hpp"
 
 namespace sewn::connect {
+
+/// The rule under topology edits, asked per connection c (in order) by a term's follow_nodes():
+/// return false to remove it, or true after filling `renames` with (old node, new node) pairs
+/// (each old node to one new node) for the nodes it now has.
+using NodeDecision = std::function<bool(physics::Index c, std::vector<std::pair<physics::Index, physics::Index>>& renames)>;
 
 class StencilDofs {
  public:

@@ -1,0 +1,169 @@
+// model.connections: the detected and named joints of a mixed scene become point and curve
+// connection energies (apps/connections.hpp), with stiffnesses from the materials; the fin scene
+// (scenes/mixed_fin.json) then holds a moment at the mast's joint, which a pinned joint cannot.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "sewn/apps/connections.hpp"
+#include "sewn/apps/continuum.hpp"
+#include "sewn/apps/runner.hpp"
+#include "sewn/apps/scene.hpp"
+#include "sewn/physics/integrate/newton_euler.hpp"
+
+namespace test_connection_keys {
+namespace {
+
+using sewn::app::Scene;
+using sewn::app::SceneError;
+using sewn::physics::Index;
+
+const std::string fin_path = std::string(SEWN_SOURCE_DIR) + "/scenes/mixed_fin.json";
+
+// The fin scene's model as the runner builds it (bodies, continuum, connections), held by its
+// top face (the tag-4 label), at rest.
+struct FinModel {
+  sewn::app::Assembly assembly;
+  std::vector<sewn::physics::MaterialParams> materials;
+  std::unique_ptr<sewn::physics::MssModel<3>> model;
+  sewn::app::ContinuumParts continuum;
+  sewn::app::ConnectionParts joints;
+};
+
+std::unique_ptr<FinModel> build_fin(const Scene& scene) {
+  auto f = std::make_unique<FinModel>();
+  f->assembly = sewn::app::assemble(scene);
+  for (const auto& name : f->assembly.material_names) {
+    const auto& m = scene.materials.at(name);
+    f->materials.push_back({m.young, m.poisson, m.density, m.thickness, m.area, sewn::physics::ElongatedPolicy::refuse});
+  }
+  sewn::app::apply_rod_sections(scene, f->assembly.mesh, f->assembly.model_of_cell, f->assembly.group_of_cell, f->materials,
+                                f->assembly.material_of_cell);
+  sewn::physics::MssOptions mo;
+  mo.gravity = Eigen::Vector3d(scene.gravity[0], scene.gravity[1], scene.gravity[2]);
+  mo.damping = sewn::physics::DampingModel::rayleigh;
+  mo.rayleigh_alpha = scene.rayleigh_alpha;
+  f->model = std::make_unique<sewn::physics::MssModel<3>>(f->assembly.mesh, f->materials, f->assembly.material_of_cell, mo);
+  f->continuum = sewn::app::build_continuum(scene, f->materials, f->assembly.mesh, f->assembly.model_of_cell, f->assembly.group_of_cell,
+                                            *f->model);
+  f->joints = sewn::app::build_connections(scene, f->assembly.mesh, f->assembly.model_of_cell, f->materials, f->continuum, *f->model);
+  const auto& labels = f->assembly.labels;
+  for (std::uint32_t c = 0; c < labels.num_cells(); ++c)
+    if (labels.tags[c] == 4)
+      for (std::uint32_t p : labels.cell(c)) f->model->nodes().fix(f->model->node_of_point(p), sewn::physics::all_axes);
+  return f;
+}
+
+std::string reason_of(const std::function<void()>& fn) {
+  try {
+    fn();
+  } catch (const SceneError& e) {
+    return e.path() + ": " + e.reason();
+  }
+  return "accepted";
+}
+
+// The mast's tilt from the fin's own turn: the angle between the mast's chord (top to tip) now
+// and at rest, after `steps` backward Euler steps under a sideways pull of gravity in the fin's
+// plane (+x), which a pinned mast swings along and a clamped one resists with a moment.
+double mast_tilt(bool connections, int steps) {
+  Scene scene = sewn::app::load_scene(fin_path);
+  scene.gravity = {9.81, 0, -9.81};
+  scene.connections.enabled = connections;
+  const auto f = build_fin(scene);
+  REQUIRE(f->continuum.rods != nullptr);
+  const auto nodes = f->continuum.rods->rod_nodes(0);
+  auto chord = [&] {
+    const Eigen::Vector3d a = f->model->nodes().position(nodes.front()), b = f->model->nodes().position(nodes.back());
+    return Eigen::Vector3d(a.z() > b.z() ? b - a : a - b);  // from the top (the joint) down to the tip
+  };
+  const Eigen::Vector3d rest = chord();
+  sewn::physics::integrate::NewtonEuler newton;
+  for (int s = 0; s < steps; ++s) (void)newton.step(f->model->system(), 0.01);
+  const Eigen::Vector3d now = chord();
+  return std::atan2(rest.cross(now).norm(), rest.dot(now));
+}
+
+TEST_CASE("the fin scene's joints get energies: one rod-shell point, four shell-solid curve edges") {
+  const Scene scene = sewn::app::load_scene(fin_path);
+  REQUIRE(scene.connections.enabled);
+  const auto f = build_fin(scene);
+  CHECK(f->joints.point_joints == 1);
+  CHECK(f->joints.curve_joints == 4);
+  CHECK(f->joints.curve_elements == 4);  // the fin's top line is on the block's bottom face: one hinge frame per edge
+  REQUIRE(f->joints.points != nullptr);
+  REQUIRE(f->joints.curves != nullptr);
+  CHECK(f->continuum.rods->has_angle_dofs());
+  CHECK(sewn::app::connection_energies_text(f->joints) == "  energies: 1 point, 4 curve (4 edge terms)\n");
+  // at rest no energy and no force from the joints
+  const auto s = f->model->system().state();
+  CHECK(std::abs(f->joints.points->potential_energy(s)) < 1e-20);
+  CHECK(std::abs(f->joints.curves->potential_energy(s)) < 1e-20);
+}
+
+TEST_CASE("the fin scene with connections holds a moment at the mast's joint; pinned, the mast swings") {
+  // 40 steps of 10 ms under g = (9.81, 0, −9.81), Rayleigh α = 1/s: a pinned mast (a pendulum of
+  // 0.2 m, period ~0.75 s) swings toward the pull's 45° and past it (1.18 rad measured); the
+  // clamped one is a cantilever (r = 3 mm, E = 2 GPa: EI = 0.127 N·m²) whose chord turns by
+  // its slope qL³/(6EI) ≈ 0.004 rad plus the joint's M/k_b ≈ 0.003 rad (k_b = EI/l̄ of a
+  // 0.05 m edge), less the fin's own give (5.1e-3 rad measured).
+  const double clamped = mast_tilt(true, 40), pinned = mast_tilt(false, 40);
+  CAPTURE(clamped);
+  CAPTURE(pinned);
+  CHECK(pinned > 0.3);
+  CHECK(clamped < 0.03);
+}
+
+TEST_CASE("explicit connections: only the named joints, at the mesh point named") {
+  Scene scene = sewn::app::load_scene(fin_path);
+  scene.connections.detect = false;
+  scene.connections.explicit_connections = {{"point", {0.2, 0.1, -0.15}, std::nullopt, 5.0, std::nullopt, std::nullopt}};
+  auto f = build_fin(scene);
+  CHECK(f->joints.point_joints == 1);
+  CHECK(f->joints.curve_joints == 0);
+  CHECK(f->joints.points->connection(0).name().find("explicit[0] point connection") == 0);
+  // a curve named by one of its points takes the whole curve
+  scene.connections.explicit_connections = {{"curve", {0.2, 0.1, 0.0}, std::nullopt, std::nullopt, 2.0, std::nullopt}};
+  f = build_fin(scene);
+  CHECK(f->joints.point_joints == 0);
+  CHECK(f->joints.curve_joints == 4);
+}
+
+TEST_CASE("connections: bad keys and places are refused, naming the key") {
+  Scene scene = sewn::app::load_scene(fin_path);
+  scene.connections.detect = false;
+  // no mesh point there
+  scene.connections.explicit_connections = {{"point", {5, 5, 5}, std::nullopt, std::nullopt, std::nullopt, std::nullopt}};
+  CHECK(reason_of([&] { (void)build_fin(scene); }).find("model.connections.explicit[0].at: no mesh point is there: the nearest is mesh point") == 0);
+  // a mesh point where no two bodies meet in a point connection (a node of the block's corner)
+  scene.connections.explicit_connections = {{"point", {0, 0, 0}, std::nullopt, std::nullopt, std::nullopt, std::nullopt}};
+  CHECK(reason_of([&] { (void)build_fin(scene); }).find("model.connections.explicit[0]: no two bodies meet in a point connection at mesh point") == 0);
+  // the fin's top line is a curve, not points
+  scene.connections.explicit_connections = {{"point", {0.2, 0.1, 0.0}, std::nullopt, std::nullopt, std::nullopt, std::nullopt}};
+  CHECK(reason_of([&] { (void)build_fin(scene); }).find("model.connections.explicit[0]: no two bodies meet in a point connection") == 0);
+  // rods' twist angles as DOFs need the newton integrator
+  scene = sewn::app::load_scene(fin_path);
+  scene.integrator = "implicit";
+  CHECK(reason_of([&] { (void)build_fin(scene); }).find("model.connections: a connection with a rod side turns the rods' twist angles into degrees of freedom") == 0);
+
+  // scene files: a point's stiffness per length, springs, a kind the schema does not know
+  auto parse = [](const std::string& model) {
+    const std::string text = R"({"name": "c", "materials": {"m": {"young": 1e6, "poisson": 0.3, "density": 1000}},
+      "meshes": [{"type": "tet_grid", "material": "m", "cells": [1, 1, 1], "size": [1, 1, 1]}], "model": )" + model + "}";
+    return reason_of([&] { (void)sewn::app::parse_scene(nlohmann::json::parse(text), "c.json"); });
+  };
+  CHECK(parse(R"({"type": "mixed", "connections": {"explicit": [{"kind": "point", "at": [0,0,0], "stiffness": 1}]}})") ==
+        "model.connections.explicit[0].stiffness: a point connection has `twisting` and `bending`, not a stiffness per length");
+  CHECK(parse(R"({"type": "mixed", "connections": {"explicit": [{"kind": "curve", "at": [0,0,0], "bending": 1}]}})") ==
+        "model.connections.explicit[0].bending: a curve connection has one `stiffness` per length, not twisting and bending");
+  CHECK(parse(R"({"connections": {}})").find("model.connections: connections join continuum bodies") == 0);
+  CHECK(parse(R"({"type": "mixed", "connections": {"explicit": [{"kind": "surface", "at": [0,0,0]}]}})").find("model.connections.explicit[0].kind") == 0);
+  CHECK(parse(R"({"type": "mixed", "connections": {"twisting": -1}})").find("model.connections.twisting") == 0);
+  CHECK(parse(R"({"type": "mixed", "connections": {"detect": true, "rigid": true, "twisting": 2, "bending": 3, "curve_stiffness": 4}})") == "accepted");
+}
+
+}  // namespace
+}  // namespace test_connection_keys
