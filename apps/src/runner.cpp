@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -631,6 +632,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
   for (std::uint64_t s = ck.step; s < steps; ++s) {
     const double t = static_cast<double>(s) * h;
     const auto t0 = Clock::now();
+    const std::clock_t c0 = std::clock();
     for (; next_cut < cuts.size() && cuts[next_cut].first <= t + 1e-12 * h; ++next_cut) {
       const std::size_t k = cuts[next_cut].second;
       const CutSpec& c = scene.cuts[k];
@@ -690,6 +692,7 @@ RunSummary run(const Scene& scene, const RunOptions& options) {
       step_semi_implicit(semi, model->system(), h, t, scene);
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     sum.stepping += ms / 1e3;
+    sum.stepping_cpu += static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
     sum.linear_iterations += static_cast<std::uint64_t>(cg);
     frame_ms += ms;
     frame_cg_sum += cg;

@@ -3,8 +3,9 @@
 // and on 2 threads.
 //
 //   connect/scenes/<scene>/ours            1 thread: counters "s/frame" (the steps' wall time
-//                                           per 1/30 s of simulated time), "h (ms)", the Newton
-//                                           and CG iterations per frame
+//                                           per 1/30 s of simulated time), "CPU s/frame" (their
+//                                           process CPU time: on a busy machine, the work alone),
+//                                           "h (ms)", the Newton and CG iterations per frame
 //   connect/scenes/<scene>/2_threads/ours  the same on 2 threads (the solver's multi-core path)
 //
 // The paper gives no frame rate or time step; a frame is taken as 1/30 s (bench/connect/notes.md).
@@ -39,7 +40,7 @@ void run_scene(benchmark::State& st, const std::string& name, std::uint32_t thre
   opt.until = frames * frame;
   opt.quiet = true;
   app::RunSummary sum;
-  double stepping = 0;
+  double stepping = 0, stepping_cpu = 0;
   bool failed = false;
   for (auto _ : st) {
     try {
@@ -50,12 +51,14 @@ void run_scene(benchmark::State& st, const std::string& name, std::uint32_t thre
       break;
     }
     stepping += sum.stepping;
+    stepping_cpu += sum.stepping_cpu;
   }
   std::filesystem::remove_all(opt.out);
   if (failed) return;
   const double runs = static_cast<double>(st.iterations());
   const double per_run = sum.simulated / frame;  // frames simulated per run
   st.counters["s/frame"] = stepping / runs / per_run;
+  st.counters["CPU s/frame"] = stepping_cpu / runs / per_run;
   st.counters["h (ms)"] = scene.step * 1e3;
   st.counters["Newton tolerance (m/s)"] = scene.newton_tolerance;
   st.counters["Newton iterations/frame"] = static_cast<double>(sum.newton_iterations) / per_run;
