@@ -20,6 +20,7 @@
 #include "sewn/cmap/cmap.hpp"
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/write_gmsh.hpp"
+#include "minimal_scene.hpp"
 
 namespace test_paper_shapes {
 
@@ -202,6 +203,20 @@ TEST_CASE("paper scenes: a few steps each, Newton converged, energy finite, the 
     CHECK(row.at("kinetic_energy") > 0);
     CHECK(row.at("inverted") == 0);
     std::filesystem::remove_all(opt.out);
+  }
+}
+
+TEST_CASE("integrator.solver ldlt: Newton's direct solve, refused with the other integrators by key") {
+  auto j = sewn::app::test::minimal();
+  j["integrator"] = {{"type", "newton"}, {"solver", "ldlt"}};
+  CHECK(sewn::app::parse_scene(j, "s.json").solver == "ldlt");
+  j["integrator"]["type"] = "implicit";
+  try {
+    (void)sewn::app::parse_scene(j, "s.json");
+    FAIL("accepted ldlt with the implicit integrator");
+  } catch (const sewn::app::SceneError& e) {
+    CHECK(e.path() == "integrator.solver");
+    CHECK(e.reason() == "\"ldlt\" solves the Newton systems of integrator.type \"newton\" only (this scene's is \"implicit\")");
   }
 }
 
