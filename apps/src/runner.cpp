@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -83,7 +84,8 @@ physics::SymplecticEulerOptions semi_options(const Scene& scene) {
 
 physics::ImplicitEulerOptions implicit_options(const Scene& scene) {
   physics::ImplicitEulerOptions o;
-  o.solver = physics::solve::parse_backend(scene.solver);
+  // "ldlt" is Newton's own direct solve (scene.cpp refuses it with the other integrators)
+  o.solver = scene.solver == "ldlt" ? physics::solve::Backend::automatic : physics::solve::parse_backend(scene.solver);
   o.cg_tolerance = scene.tolerance;
   o.cg_absolute_tolerance = scene.absolute_tolerance;
   o.cg_max_iterations = static_cast<int>(scene.max_iterations);
@@ -102,6 +104,7 @@ physics::integrate::NewtonEulerOptions newton_options(const Scene& scene) {
   o.max_iterations = static_cast<int>(scene.newton_iterations);
   o.cg_tolerance = scene.tolerance;
   o.cg_max_iterations = static_cast<int>(scene.max_iterations);
+  if (scene.solver == "ldlt") o.solver = physics::integrate::LinearSolver::ldlt;
   return o;
 }
 
@@ -459,7 +462,11 @@ int RunLoop::step(double t) {
     return cg;
   }
   if (use_implicit_) return implicit_.step(sys, h_).cg_iterations;
-  if (use_newton_) return newton_.step(sys, h_).linear_iterations;
+  if (use_newton_) {
+    const auto rep = newton_.step(sys, h_);
+    sum_.newton_iterations += static_cast<std::uint64_t>(rep.iterations);
+    return rep.linear_iterations;
+  }
   step_semi_implicit(semi_, sys, h_, t, scene_);
   return 0;
 }
@@ -512,9 +519,14 @@ void RunLoop::run() {
   for (std::uint64_t s = ck_.step; s < steps_; ++s) {
     const double t = static_cast<double>(s) * h_;
     const auto t0 = Clock::now();
+    const std::clock_t c0 = std::clock();
     apply_due_cuts(t);
     const int cg = step(t);
-    frame_ms_ += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    sum_.stepping += ms / 1e3;
+    sum_.stepping_cpu += static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+    sum_.linear_iterations += static_cast<std::uint64_t>(cg);
+    frame_ms_ += ms;
     frame_cg_sum_ += cg;
     frame_cg_max_ = std::max(frame_cg_max_, cg);
     ++frame_steps_;

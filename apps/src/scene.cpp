@@ -223,8 +223,8 @@ Field build_schema() {
       .members({field("type", Kind::string).one_of({"implicit", "semi-implicit", "midpoint", "newton"}).fallback("implicit")
                     .doc("Linearly implicit Euler (Baraff–Witkin, CG: one solve per step, dissipative, loses angular momentum on fast rotations), semi-implicit (symplectic) Euler (explicit: below the stable step only), or the implicit midpoint rule with discrete-gradient springs solved by Newton and CG (keeps linear and angular momentum and the energy of free bodies to round-off at any step; a step where Newton misses, as at a radian of rotation per step, is taken as 2, 4, ... sub-steps and the summary says so; several solves per step), or backward Euler by Newton on the incremental potential (PSD-projected Hessians, CG solves, Armijo line search; docs/elastic.md). See docs/integrators.md."),
                 field("step", Kind::number).unit("s").fallback(1e-3).above(0).at_most(10).doc("Time step h."),
-                field("solver", Kind::string).one_of({"auto", "jacobi", "cholmod", "cholmod-pcg", "hypre-pcg", "petsc"}).fallback("auto")
-                    .doc("Linear solver (implicit), docs/solvers.md: `jacobi` block-Jacobi CG, `cholmod` sparse Cholesky, `cholmod-pcg` CG preconditioned by a reused Cholesky factorization, `hypre-pcg` CG preconditioned by a reused BoomerAMG hierarchy, `petsc` PETSc's CG with GAMG on the program's MPI ranks; `auto` picks by model size. The CHOLMOD ones need SuiteSparse at build time, `hypre-pcg` hypre, `petsc` PETSc."),
+                field("solver", Kind::string).one_of({"auto", "jacobi", "cholmod", "cholmod-pcg", "hypre-pcg", "petsc", "ldlt"}).fallback("auto")
+                    .doc("Linear solver (implicit), docs/solvers.md: `jacobi` block-Jacobi CG, `cholmod` sparse Cholesky, `cholmod-pcg` CG preconditioned by a reused Cholesky factorization, `hypre-pcg` CG preconditioned by a reused BoomerAMG hierarchy, `petsc` PETSc's CG with GAMG on the program's MPI ranks; `auto` picks by model size. The CHOLMOD ones need SuiteSparse at build time, `hypre-pcg` hypre, `petsc` PETSc. `newton` solves each Newton system by block-Jacobi CG to `tolerance`, or with `ldlt` by Eigen's sparse LDLᵀ factorization (exact solves, symbolic analysis once per pattern: for stiff rods joined to soft shells, where CG needs hundreds of iterations); `ldlt` is for `newton` only."),
                 field("tolerance", Kind::number).fallback(physics::solve::default_tolerance).above(0).below(1).doc("Relative residual of the iterative solvers (implicit)."),
                 field("absolute_tolerance", Kind::number).unit("m/s").fallback(physics::solve::default_absolute_tolerance).at_least(0).at_most(1)
                     .doc("Floor of the residual as a velocity error on every free axis (implicit): a body at rest stops there instead of chasing round-off. 0: none."),
@@ -600,10 +600,15 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     s.integrator = in.string("type");
     s.step = in.number("step");
     s.solver = in.string("solver");
-    try {
-      (void)physics::solve::parse_backend(s.solver);  // a name this build lacks
-    } catch (const physics::InputError& e) {
-      throw SceneError(file, "integrator.solver", e.what());
+    if (s.solver == "ldlt") {
+      if (s.integrator != "newton")
+        throw SceneError(file, "integrator.solver", "\"ldlt\" solves the Newton systems of integrator.type \"newton\" only (this scene's is \"" + s.integrator + "\")");
+    } else {
+      try {
+        (void)physics::solve::parse_backend(s.solver);  // a name this build lacks
+      } catch (const physics::InputError& e) {
+        throw SceneError(file, "integrator.solver", e.what());
+      }
     }
     s.tolerance = in.number("tolerance");
     s.absolute_tolerance = in.number("absolute_tolerance");

@@ -87,6 +87,10 @@ struct RunSummary {
   double simulated = 0;             ///< s
   double wall = 0;                  ///< s, stepping and cuts (output excluded)
   double ms_per_step = 0;
+  double stepping = 0;                   ///< s, this call's steps and cuts (no refinement, no output)
+  double stepping_cpu = 0;               ///< s, the same as the process's CPU time (all threads): on a busy machine, the work alone
+  std::uint64_t newton_iterations = 0;   ///< integrator `newton`: Newton iterations of this call's steps
+  std::uint64_t linear_iterations = 0;   ///< implicit integrators: CG iterations of this call's steps
   double kinetic_start = 0, kinetic_end = 0, kinetic_max = 0;  ///< J
   std::uint64_t energy_rises = 0;   ///< implicit steps that created energy (see physics::EnergyLedger)
   std::uint64_t substepped = 0;     ///< midpoint steps Newton could only take in sub-steps (the summary says so)

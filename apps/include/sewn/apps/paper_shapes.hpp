@@ -1,0 +1,41 @@
+#pragma once
+// The meshes of the 2019 paper's Table 1 scenes (seed 004), rebuilt from their published
+// counts (PHYSICS_NOTES §5): each one conforming mesh of tetrahedra (solids), triangles (shells)
+// and segments (rods) sharing their nodes, with a Gmsh physical name per part. `sewn make-mesh`
+// writes them; scenes/meshes/s04_*.msh are its output, and the scenes select the parts by name.
+//
+// Counts (vertices / rod edges / shell triangles / tetrahedra):
+//   frisbee       289 / 64 / 512 / 0     exact: a polar disc (rings of 8k points), rim as rod
+//   umbrella      3168 / 198 / 6144 / 0  exact: a spherical canopy 96 around × 32 radial quads
+//                                        split, 6 ribs of 32 edges and a hexagonal hub of 6
+//   sticky_hands  200 / 19 / 292 / 0     exact: a hand (a disc of 181 points, 68 on its outline)
+//                                        and a 19-edge string from its wrist
+//   jellyfish     1465 / 1273 / 0 / 454  exact: a thin disc body (432 tets), an eyeball (22) on
+//                                        a stalk, 3 oral-arm loops, 12 tentacles
+//   toy_ball      proxy (the published counts cannot all hold): a 96-triangle platform (61
+//                 points), a 226-tet ball, a 203-edge helical spring between them
+//   sandwich      proxy (1510 shell faces cannot lie in 600 tets): 600 tets (a 10 × 2 × 5 cube
+//                 beam, 6 tets per cube) with its 4 interior horizontal face layers as shells
+#include <string>
+#include <vector>
+
+#include "sewn/cmap/mesh.hpp"
+#include "sewn/io/read.hpp"
+
+namespace sewn::app {
+
+/// A generated mesh, its physical names (one per part), and what the counts follow.
+struct PaperShape {
+  IndexedMesh mesh;
+  std::vector<io::TagName> names;
+  std::string note;
+};
+
+/// "frisbee", "umbrella", "sticky_hands", "jellyfish", "toy_ball", "sandwich".
+const std::vector<std::string>& paper_shape_names();
+
+/// Builds the named shape (deterministic: the same points and cells every call). Throws
+/// std::invalid_argument naming the shape and listing the known ones.
+PaperShape make_paper_shape(const std::string& name);
+
+}  // namespace sewn::app
