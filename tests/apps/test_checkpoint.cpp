@@ -251,7 +251,8 @@ TEST_CASE("cuts of finite-element tetrahedra resume to the same bytes") {
 
 // The fin of scenes/mixed_fin.json without its mast (a label), its connections on, cut at
 // `cut_time` across the fin and the block (x = 0.2): the cut's rule removes or renames the
-// fin's curve connections, and a resumed run replays the cut through the same rule.
+// fin's curve connections, and a resumed run replays the cut through the same rule. Hinge
+// bending: patch bending does not follow cuts yet.
 std::string cut_fin(const std::string& name, const std::string& cut_time) {
   const std::string mesh = (fs::path(SEWN_SOURCE_DIR) / "scenes" / "meshes" / "fin.msh").string();
   return R"({"name": ")" + name + R"(", "materials": {"rubber": {"young": 2e6, "poisson": 0.4, "density": 1100},
@@ -260,7 +261,7 @@ std::string cut_fin(const std::string& name, const std::string& cut_time) {
                 "regions": [{"where": {"type": "tag", "tag": 2}, "material": "sheet"}]}],
     "fixed": [{"where": {"type": "tag", "tag": 4}}],
     "velocities": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, -0.001]}, "linear": [0, 0.3, 0]}],
-    "model": {"type": "mixed", "groups": [{"name": "mast", "as": "label"}], "connections": {}},
+    "model": {"type": "mixed", "bending": "hinge", "groups": [{"name": "mast", "as": "label"}], "connections": {}},
     "damping": {"model": "rayleigh", "alpha": 1.0}, "integrator": {"type": "newton", "step": 0.005},
     "cuts": [{"type": "plane", "time": )" + cut_time + R"(, "point": [0.2, 0, 0], "normal": [1, 0, 0]}],
     "duration": 0.04, "output": {"frames": 4}})";

@@ -71,6 +71,7 @@ struct Joined {
     s.cuts.push_back({});  // cuts are scheduled: the builders must accept them
     s.cuts.back().type = "plane";
     s.connections.enabled = true;
+    s.bending = "hinge";  // the shell bending that follows cuts (patch bending refuses them)
     sewn::physics::MssOptions mo;
     mo.gravity.setZero();
     mo.damping = sewn::physics::DampingModel::none;
