@@ -72,7 +72,7 @@ struct AppliedCut {
 };
 
 struct Checkpoint {
-  static constexpr std::uint32_t format_version = 2;
+  static constexpr std::uint32_t format_version = 3;
 
   std::uint64_t run_hash = 0;    ///< the scene's text, its built model, steps and frames
   std::uint64_t model_hash = 0;  ///< the model's tables after the cuts below
