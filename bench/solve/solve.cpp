@@ -6,8 +6,9 @@
 // Each repetition starts from rest with a fresh solver and takes `steps` steps, so a backend's
 // factorizations and analyses are paid inside the time it reports (ms per step). Counters per
 // step: solver iterations, factorizations, and the solver's own analyse / factor / solve times.
-// "error" is the position error after `error_steps` steps against a direct solve whose every step
-// reached a relative residual below 1e-12, relative to that solve's displacement (once per case,
+// "error" is the position error after `error_steps` steps against a direct solve (block-Jacobi CG
+// where the direct one does not run) whose every step reached a relative residual below 1e-12
+// (or its round-off floor), relative to that solve's displacement (once per case,
 // the same number in every repetition), "worst relative residual" the largest a step reached.
 // The backends run on one thread (petsc on one MPI rank); the threads/ cases
 // time 2 threads against 1 (wall time) on the semi-implicit and implicit steps of 16³ and 32³.
