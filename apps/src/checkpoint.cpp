@@ -197,6 +197,8 @@ std::string encode_payload(const Checkpoint& c) {
   put_watchdog(e, c.implicit.watchdog);
   e.put(c.implicit.solver.factored);
   e.put<std::uint8_t>(c.implicit.solver.refresh_due);
+  e.put(c.implicit.solver.cycle_solves);
+  e.put(c.implicit.solver.cycle_iterations);
   e.put(c.midpoint.steps);
   put_watchdog(e, c.midpoint.watchdog);
   const auto& l = c.ledger;
@@ -271,6 +273,8 @@ Checkpoint decode_payload(Decoder& d) {
   c.implicit.watchdog = get_watchdog(d);
   d.get(c.implicit.solver.factored, "factored matrix");
   c.implicit.solver.refresh_due = d.flag("factorization refresh flag");
+  c.implicit.solver.cycle_solves = d.get<std::uint64_t>("solves since the factorization");
+  c.implicit.solver.cycle_iterations = d.get<std::uint64_t>("iterations since the factorization");
   c.midpoint.steps = d.get<std::uint64_t>("midpoint steps");
   c.midpoint.watchdog = get_watchdog(d);
   auto& l = c.ledger;

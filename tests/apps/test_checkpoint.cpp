@@ -331,7 +331,7 @@ TEST_CASE("a checkpoint that is not this run's, or not whole, is refused with ex
     std::string bad = bytes;
     bad[8] = 1;  // the format before rods, solver state and the energy-ratio peak
     check_refused(saved, put("v1.checkpoint", bad), "format version 1, but this sewn reads version 3 only");
-    bad[8] = 2;  // the format before angle DOFs and connection histories
+    bad[8] = 2;  // the format before angle DOFs, connection histories and the refresh rule's counters
     check_refused(saved, put("v2.checkpoint", bad), "format version 2, but this sewn reads version 3 only");
     bad[8] = 4;
     check_refused(saved, put("v4.checkpoint", bad), "format version 4, but this sewn reads version 3 only");
@@ -412,7 +412,7 @@ TEST_CASE("the checkpoint format: every field comes back, and every shorter file
   c.implicit.warm_start = {0.5, 0.25, 0.125};
   c.implicit.steps = 12;
   c.implicit.watchdog = {true, true, 13, 14, 15, 16};
-  c.implicit.solver = {{1.5, -2.5, 3.5}, true};
+  c.implicit.solver = {{1.5, -2.5, 3.5}, true, 42, 43};
   c.midpoint = {34, {true, true, 35, 36, 37, 38}};
   c.ledger = {17, 18, 19, 20, 21, 22, 41};
   sewn::physics::rods::Rods::RodHistory rod;
@@ -454,6 +454,8 @@ TEST_CASE("the checkpoint format: every field comes back, and every shorter file
   CHECK(d.implicit.warm_start == c.implicit.warm_start);
   CHECK(d.implicit.solver.factored == c.implicit.solver.factored);
   CHECK(d.implicit.solver.refresh_due);
+  CHECK(d.implicit.solver.cycle_solves == 42);
+  CHECK(d.implicit.solver.cycle_iterations == 43);
   REQUIRE(d.rods.size() == 2);
   CHECK(d.rods[0].rod.theta == rod.rod.theta);
   CHECK(d.rods[0].rod.director[1] == rod.rod.director[1]);

@@ -23,7 +23,9 @@ namespace {
 // One CHOLMOD workspace, the filtered matrix in its upper-triangular CSC form, and its factor.
 class Factorization {
  public:
-  Factorization() {
+  /// simplicial_solves: after each numeric factorization, convert the factor to simplicial
+  /// form for the triangular solves (see factorize()); for a factor solved with many times.
+  explicit Factorization(bool simplicial_solves = true) : simplicial_solves_(simplicial_solves) {
     cholmod_start(&c_);
     c_.print = 0;  // failures are reported by our exceptions, not on stderr
     // LLᵀ: a simplicial LDLᵀ would succeed on an indefinite matrix (only a zero pivot stops
@@ -108,12 +110,31 @@ class Factorization {
     free_factor();
     L_ = cholmod_analyze(K_, &c_);
     if (!L_) throw SolverError("cholmod: symbolic analysis failed (status " + std::to_string(c_.status) + ")", 0, 0);
+    // A supernodal analysis is kept aside: factorize() converts L_ to simplicial form and needs
+    // the supernodal structure back for the next factorization.
+    if (simplicial_solves_ && L_->is_super) {
+      symbolic_ = cholmod_copy_factor(L_, &c_);
+      if (!symbolic_) throw SolverError("cholmod: out of memory copying the symbolic analysis", 0, 0);
+    }
+    // One PCG iteration: two triangular solves (2 flops per entry of L each), the product with
+    // A (2 per stored scalar, both triangles) and the vector passes (~10 per unknown).
+    const double n = static_cast<double>(L_->n), upper = static_cast<double>(src_.size());
+    setup_cost_ = c_.fl / (4.0 * c_.lnz + 2.0 * (2.0 * upper - n) + 10.0 * n);
   }
+
+  /// A numeric factorization's cost in PCG iterations (flop counts of the analysis; measured
+  /// against CPU times in docs/solvers.md). Deterministic: KeptPcg's refresh rule uses it.
+  [[nodiscard]] double setup_cost() const { return setup_cost_; }
 
   /// Numeric factorization of K's current values; throws SolverError naming the node and axis
   /// where a pivot was not positive.
   void factorize(const char* who, bool keep_values) {
     valid_ = false;
+    if (symbolic_ && !L_->is_super) {  // converted after the last factorization
+      cholmod_free_factor(&L_, &c_);
+      L_ = cholmod_copy_factor(symbolic_, &c_);
+      if (!L_) throw SolverError(std::string(who) + ": out of memory copying the symbolic analysis", 0, 0);
+    }
     const bool ok = cholmod_factorize(K_, L_, &c_) && c_.status == CHOLMOD_OK;
     const std::size_t bad_pivot = ok ? nonpositive_pivot() : L_->minor;
     if (!ok && c_.status != CHOLMOD_NOT_POSDEF)
@@ -127,6 +148,12 @@ class Factorization {
                             std::to_string(dof / 3) + ", axis " + "xyz"[dof % 3] + ")",
                         0, 0);
     }
+    // Measured (docs/solvers.md): on Debian's reference BLAS the supernodal triangular solves
+    // run at half the speed of the simplicial ones (0.51 against 0.23 ms on the 8x8x10 beam),
+    // while the supernodal factorization is the faster one; the conversion costs ~1/10 of a
+    // factorization (0.46 ms there), repaid by the second solve.
+    if (simplicial_solves_ && L_->is_super && !cholmod_change_factor(CHOLMOD_REAL, 1, 0, 1, 1, L_, &c_))
+      throw SolverError(std::string(who) + ": CHOLMOD could not convert its factor (status " + std::to_string(c_.status) + ")", 0, 0);
     if (keep_values) factored_.assign(static_cast<const double*>(K_->x), static_cast<const double*>(K_->x) + src_.size());
     valid_ = true;
   }
@@ -183,18 +210,22 @@ class Factorization {
   }
   void free_factor() {
     if (L_) cholmod_free_factor(&L_, &c_);
+    if (symbolic_) cholmod_free_factor(&symbolic_, &c_);
     valid_ = false;
   }
 
   cholmod_common c_{};
   cholmod_sparse* K_ = nullptr;
   cholmod_factor* L_ = nullptr;
+  cholmod_factor* symbolic_ = nullptr;  // the supernodal analysis, when L_ is converted after factoring
   cholmod_dense *X_ = nullptr, *Y_ = nullptr, *E_ = nullptr;
   std::uint64_t pattern_ = 0;
   std::vector<std::size_t> src_;  // per entry of K: its index in A's value array
   std::vector<int> col_of_;       // per entry of K: its column
   std::vector<double> factored_;  // K's values when last factored (direct backend)
   bool valid_ = false;
+  bool simplicial_solves_;
+  double setup_cost_ = 0;
 };
 
 // r = S(b - A x̃), x̃ = x on the fixed axes and 0 on the free ones: what the free axes must solve.
@@ -277,7 +308,7 @@ class CholmodDirect final : public LinearSolver {
   }
 
  private:
-  Factorization f_;
+  Factorization f_{false};  // one or two solves per factorization: no conversion
   AlignedVector<double> xt_, r_;
 };
 

@@ -4,6 +4,7 @@
 // The backends cholmod-pcg and hypre-pcg are KeptPcg over their preconditioner.
 
 #include <algorithm>
+#include <cstdint>
 #include <functional>
 #include <span>
 #include <string>
@@ -39,6 +40,7 @@ PcgOutcome pcg_with(const BlockMatrix& A, std::span<const double> b, std::span<d
 ///   bool analysed(), void analyse() the per-pattern set-up
 ///   void fill_values(A, free_dof)  the filtered matrix S A S + (I - S) from A
 ///   void factorize(who, keep)      the per-values set-up (throws SolverError if not SPD)
+///   double setup_cost()            the per-values set-up's cost in CG iterations (deterministic)
 ///   bool valid(); const std::vector<double>& factored_values()
 ///   void factor_values(A, values, who); void forget(); void solve(r, z)
 template <class P>
@@ -49,17 +51,22 @@ class KeptPcg final : public LinearSolver {
   void reset() override {
     p_.forget();
     stale_ = false;
+    cycle_solves_ = cycle_iterations_ = 0;
   }
   [[nodiscard]] SolverState state() const override {
     SolverState s;
     if (p_.valid()) s.factored = p_.factored_values();
     s.refresh_due = stale_;
+    s.cycle_solves = cycle_solves_;
+    s.cycle_iterations = cycle_iterations_;
     return s;
   }
   void restore(const BlockMatrix& A, const SolverState& s) override {
     p_.forget();
     if (!s.factored.empty()) p_.factor_values(A, s.factored, (who_ + " restore").c_str());
     stale_ = s.refresh_due;
+    cycle_solves_ = s.cycle_solves;
+    cycle_iterations_ = s.cycle_iterations;
   }
 
   SolveReport solve(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
@@ -87,7 +94,7 @@ class KeptPcg final : public LinearSolver {
     rep.residual = out.residual;
     rep.relative_residual = out.relative_residual;
     rep.converged = out.converged;
-    stale_ = rep.iterations > opt_.refresh_iterations;
+    stale_ = refresh_pays(rep.iterations);
     if (out.breakdown)
       throw SolverError(who_ + " solve: CG broke down (pᵀAp ≤ 0 or rᵀz ≤ 0) with a fresh preconditioner: the matrix is not "
                                "positive definite on the free axes",
@@ -100,6 +107,22 @@ class KeptPcg final : public LinearSolver {
                  double floor) {
     return pcg_with(A, b, x, free_dof, opt_.tolerance, floor, opt_.max_iterations,
                     [this](std::span<const double> r, std::span<double> z) { p_.solve(r, z); }, ws_);
+  }
+  // The refresh rule. A cycle is a set-up and the solves that use it; its mean cost per solve,
+  // (set-up + Σ iterations) / solves in CG iterations, falls while the solves stay cheaper than
+  // that mean and rises once they cost more (iterations grow as A drifts from the matrix set up
+  // on). So refresh once the last solve cost more than the cycle's mean: going on would raise
+  // it, a new cycle starts low again. The margin of one iteration: at a steady distance from
+  // the factored matrix the count still moves by one from solve to solve (0 and 1 on the
+  // 8x8x10 beam), and without it a long cycle, whose mean has come down to that level, would
+  // be refreshed for such noise. Iteration counts and the set-up's flop-based cost make the
+  // decision deterministic (a rerun or a resumed checkpoint decides the same), unlike timings.
+  // The option refresh_iterations > 0 adds a hard cap.
+  bool refresh_pays(int iterations) {
+    ++cycle_solves_;
+    cycle_iterations_ += static_cast<std::uint64_t>(iterations);
+    const double mean = (p_.setup_cost() + static_cast<double>(cycle_iterations_)) / static_cast<double>(cycle_solves_);
+    return iterations > mean + 1.0 || (opt_.refresh_iterations > 0 && iterations > opt_.refresh_iterations);
   }
   void refresh(const BlockMatrix& A, std::span<const double> free_dof, SolveReport& rep) {
     auto t = Clock::now();
@@ -114,12 +137,14 @@ class KeptPcg final : public LinearSolver {
     ++rep.factorizations;
     rep.factor_ms += ms_since(t);
     stale_ = false;
+    cycle_solves_ = cycle_iterations_ = 0;
   }
 
   Backend tag_;
   std::string who_;
   P p_;
   bool stale_ = false;
+  std::uint64_t cycle_solves_ = 0, cycle_iterations_ = 0;  // since the last set-up (refresh_pays)
   PcgWorkspace ws_;
   std::vector<double> x0_;
 };

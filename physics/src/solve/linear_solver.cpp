@@ -93,12 +93,13 @@ Backend parse_backend(std::string_view name) {
 
 Backend default_backend(std::size_t nodes) {
   (void)nodes;
-  // Measured (docs/solvers.md, bench/solve, CPU time per implicit step at equal or better error):
-  // block-Jacobi CG is the fastest of the five backends on every case, from the 1890-tet beam
-  // (480 nodes) to the N = 8 cantilever at h = 10 ms (6561 nodes, 564 iterations a step): a
-  // CHOLMOD factorization (reference BLAS; OpenBLAS makes it 3x faster, still not enough), a
-  // BoomerAMG or GAMG V-cycle cost more than the block-Jacobi iterations they save. So the rule
-  // is: jacobi at every size measured; larger models are to be measured before it changes.
+  // Measured (docs/solvers.md: bench/solve and a profile, CPU time per implicit step at equal or
+  // better error): block-Jacobi CG is the fastest or within 20 % of it on every case, from the
+  // 1890-tet beam (480 nodes; cholmod-pcg 1.2x faster over 1000 steps, 10 % slower on the
+  // 8x8x10 beam) to the N = 8 cantilever at h = 10 ms (6561 nodes, 600 iterations a step, where
+  // a kept factor's two triangular solves cost as much as 90 block-Jacobi iterations and the
+  // others are 2-9x slower). Half of a small model's step is the Jacobian's assembly, which no
+  // solver changes. So the rule is: jacobi at every size measured.
   return Backend::jacobi;
 }
 

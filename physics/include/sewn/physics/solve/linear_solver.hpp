@@ -71,9 +71,11 @@ struct SolverOptions {
   double absolute_tolerance = default_absolute_tolerance;
   int max_iterations = default_max_iterations;
   /// cholmod-pcg, hypre-pcg: the factorization (AMG hierarchy) is refreshed before the next
-  /// solve once a solve needed more than this many iterations (and at once, with a retry, if CG
-  /// fails with a stale one).
-  int refresh_iterations = 12;
+  /// solve once a solve cost more CG iterations than the mean cost per solve since the last
+  /// refresh, the set-up counted in (its flops in iterations; docs/solvers.md), and at once,
+  /// with a retry, if CG fails with a stale one. A value > 0 also refreshes once a solve needed
+  /// more than this many iterations; 0: the cost rule alone.
+  int refresh_iterations = 0;
 };
 
 /// What one solve cost. Times are wall-clock milliseconds spent inside the solver.
@@ -97,7 +99,9 @@ struct SolveReport {
 /// the analysis of an equal pattern is the same, bit for bit.
 struct SolverState {
   std::vector<double> factored;  ///< cholmod-pcg, hypre-pcg: the filtered matrix's stored entries when factored (empty: no factor)
-  bool refresh_due = false;      ///< cholmod-pcg, hypre-pcg: the last solve needed more than refresh_iterations
+  bool refresh_due = false;      ///< cholmod-pcg, hypre-pcg: the next solve sets up afresh
+  /// cholmod-pcg, hypre-pcg: solves and their CG iterations since the last set-up (the refresh rule's memory)
+  std::uint64_t cycle_solves = 0, cycle_iterations = 0;
 };
 
 class LinearSolver {
