@@ -20,9 +20,12 @@
 #include "sewn/io/cleanup.hpp"
 #include "sewn/refine/cut.hpp"
 
+#include "force_check.hpp"
+
 namespace test_connection_cuts {
 namespace {
 
+using sewn::app::test::force_error;
 using sewn::physics::Index;
 
 // A block of 2 × 2 × 1 cubes of 0.1 m (tetrahedra); flap A, two squares of triangles, hanging
@@ -134,27 +137,6 @@ struct Joined {
     return true;
   }
 };
-
-// Largest difference between the force on particle n and −∂E/∂x_n by central differences.
-double force_error(sewn::physics::MssModel<3>& model, Index n) {
-  sewn::physics::System& sys = model.system();
-  sys.compute_forces();
-  const Eigen::Vector3d f = model.nodes().force(n), x = model.nodes().position(n);
-  double worst = 0;
-  for (int a = 0; a < 3; ++a) {
-    const double h = 1e-7;
-    Eigen::Vector3d xp = x, xm = x;
-    xp[a] += h;
-    xm[a] -= h;
-    model.nodes().set_position(n, xp);
-    const double ep = sys.potential_energy();
-    model.nodes().set_position(n, xm);
-    const double em = sys.potential_energy();
-    model.nodes().set_position(n, x);
-    worst = std::max(worst, std::abs(-(ep - em) / (2 * h) - f[a]) / (1 + f.norm()));
-  }
-  return worst;
-}
 
 TEST_CASE("connections under cuts: built on the block and flaps, two points and two curve edges") {
   Joined j;

@@ -18,9 +18,12 @@
 #include "sewn/io/cleanup.hpp"
 #include "sewn/refine/cut.hpp"
 
+#include "force_check.hpp"
+
 namespace test_shell_cuts {
 namespace {
 
+using sewn::app::test::force_error;
 using sewn::physics::Index;
 
 // A flat sheet of nx × ny squares of 0.1 m, two triangles each, in the plane z = 0.
@@ -91,28 +94,6 @@ struct ShellBody {
     return n;
   }
 };
-
-// Largest difference between the force on particle n and −∂E/∂x_n by central differences,
-// against the force's size.
-double force_error(sewn::physics::MssModel<3>& model, Index n) {
-  sewn::physics::System& sys = model.system();
-  sys.compute_forces();
-  const Eigen::Vector3d f = model.nodes().force(n), x = model.nodes().position(n);
-  double worst = 0;
-  for (int a = 0; a < 3; ++a) {
-    const double h = 1e-7;
-    Eigen::Vector3d xp = x, xm = x;
-    xp[a] += h;
-    xm[a] -= h;
-    model.nodes().set_position(n, xp);
-    const double ep = sys.potential_energy();
-    model.nodes().set_position(n, xm);
-    const double em = sys.potential_energy();
-    model.nodes().set_position(n, x);
-    worst = std::max(worst, std::abs(-(ep - em) / (2 * h) - f[a]) / (1 + f.norm()));
-  }
-  return worst;
-}
 
 TEST_CASE("shell cut: the hinges of the cut edges leave, mass unchanged, the map valid, the two halves free") {
   ShellBody b(4, 2);
