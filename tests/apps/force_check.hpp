@@ -10,26 +10,29 @@
 
 namespace sewn::app::test {
 
-/// Largest difference between the force on particle n and −∂E/∂x_n by central differences
-/// (h = 1e-7 per axis), against the force's size: |f_a + ∂E/∂x_a| / (1 + |f|). Leaves the
-/// positions as they were. Two energy evaluations per axis.
-inline double force_error(physics::MssModel<3>& model, physics::Index n) {
+/// −∂E/∂x_a at particle n by central differences with step h, the positions left as they were.
+/// Two energy evaluations.
+inline double energy_slope(physics::MssModel<3>& model, physics::Index n, int a, double h) {
   physics::System& sys = model.system();
-  sys.compute_forces();
-  const Eigen::Vector3d f = model.nodes().force(n), x = model.nodes().position(n);
+  const Eigen::Vector3d x = model.nodes().position(n);
+  Eigen::Vector3d xp = x, xm = x;
+  xp[a] += h;
+  xm[a] -= h;
+  model.nodes().set_position(n, xp);
+  const double ep = sys.potential_energy();
+  model.nodes().set_position(n, xm);
+  const double em = sys.potential_energy();
+  model.nodes().set_position(n, x);
+  return -(ep - em) / (2 * h);
+}
+
+/// Largest difference between the force on particle n and −∂E/∂x_n by central differences
+/// (h = 1e-7 per axis), against the force's size: |f_a + ∂E/∂x_a| / (1 + |f|).
+inline double force_error(physics::MssModel<3>& model, physics::Index n) {
+  model.system().compute_forces();
+  const Eigen::Vector3d f = model.nodes().force(n);
   double worst = 0;
-  for (int a = 0; a < 3; ++a) {
-    const double h = 1e-7;
-    Eigen::Vector3d xp = x, xm = x;
-    xp[a] += h;
-    xm[a] -= h;
-    model.nodes().set_position(n, xp);
-    const double ep = sys.potential_energy();
-    model.nodes().set_position(n, xm);
-    const double em = sys.potential_energy();
-    model.nodes().set_position(n, x);
-    worst = std::max(worst, std::abs(-(ep - em) / (2 * h) - f[a]) / (1 + f.norm()));
-  }
+  for (int a = 0; a < 3; ++a) worst = std::max(worst, std::abs(energy_slope(model, n, a, 1e-7) - f[a]) / (1 + f.norm()));
   return worst;
 }
 

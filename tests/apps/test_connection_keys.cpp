@@ -16,6 +16,8 @@
 #include "sewn/io/cleanup.hpp"
 #include "sewn/physics/integrate/newton_euler.hpp"
 
+#include "force_check.hpp"
+
 namespace test_connection_keys {
 namespace {
 
@@ -227,16 +229,7 @@ TEST_CASE("rods on and from a solid: curve and point connections with rod sides,
   const double step = 1e-7;
   for (Index i = 0; i < model.nodes().size(); ++i)
     for (int a = 0; a < 3; ++a) {
-      const Eigen::Vector3d x = model.nodes().position(i);
-      Eigen::Vector3d xp = x, xm = x;
-      xp[a] += step;
-      xm[a] -= step;
-      model.nodes().set_position(i, xp);
-      const double ep = sys.potential_energy();
-      model.nodes().set_position(i, xm);
-      const double em = sys.potential_energy();
-      model.nodes().set_position(i, x);
-      worst = std::max(worst, std::abs(-(ep - em) / (2 * step) - model.nodes().force(i)[a]));
+      worst = std::max(worst, std::abs(sewn::app::test::energy_slope(model, i, a, step) - model.nodes().force(i)[a]));
       scale = std::max(scale, std::abs(model.nodes().force(i)[a]));
     }
   CAPTURE(worst);

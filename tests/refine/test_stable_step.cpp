@@ -213,16 +213,7 @@ TEST_CASE("stable step: seeded random refine / coarsen sequences keep the reduce
     rf::RefineOptions o;
     o.max_level = 3;
     for (int step = 0; step < 12; ++step) {
-      std::vector<Index> leaves, families;
-      for (Index e = 0; e < m.elements().size(); ++e) {
-        if (m.elements()[e].alive && rf::level_index(m.elements()[e].level) < o.max_level) leaves.push_back(e);
-        if (rf::can_coarsen(m, e)) families.push_back(e);
-      }
-      const bool refine_now = families.empty() || (!leaves.empty() && std::uniform_int_distribution<int>(0, 2)(rng) > 0);
-      if (refine_now)
-        (void)rf::refine_element(m, leaves[std::uniform_int_distribution<std::size_t>(0, leaves.size() - 1)(rng)], o);
-      else
-        (void)rf::coarsen(m, families[std::uniform_int_distribution<std::size_t>(0, families.size() - 1)(rng)]);
+      refine_test::random_refine_or_coarsen(m, rng, o);
       refine_test::check_all(m);
       CHECK(std::abs(m.node_mass() - mass0) <= 1e-13 * mass0);
       perturb(m, seed * 100 + static_cast<unsigned>(step));
