@@ -1,12 +1,16 @@
 #pragma once
-// The check the cut tests make after every edit: the forces are still the energy's gradient.
+// What the cut tests check after every edit: the forces are still the energy's gradient, and
+// which hinges kept or lost their energy.
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <Eigen/Core>
 
+#include "sewn/apps/continuum.hpp"
 #include "sewn/physics/mss_model.hpp"
+#include "sewn/physics/shells/shell_terms.hpp"
 
 namespace sewn::app::test {
 
@@ -34,6 +38,15 @@ inline double force_error(physics::MssModel<3>& model, physics::Index n) {
   double worst = 0;
   for (int a = 0; a < 3; ++a) worst = std::max(worst, std::abs(energy_slope(model, n, a, 1e-7) - f[a]) / (1 + f.norm()));
   return worst;
+}
+
+/// Each hinge's energy at the model's state (0 for retired ones).
+inline std::vector<double> hinge_energies(const ContinuumParts& parts, const physics::MssModel<3>& model) {
+  const auto s = model.system().state();
+  std::vector<double> e(parts.hinges->size(), 0.0);
+  for (physics::Index h = 0; h < e.size(); ++h)
+    if (parts.hinges->is_alive(h)) e[h] = parts.hinges->element_energy(h, parts.hinges->gather(s, h));
+  return e;
 }
 
 }  // namespace sewn::app::test

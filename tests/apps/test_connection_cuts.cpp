@@ -96,13 +96,7 @@ struct Joined {
     for (Index c = 0; c < joints.curves->size(); ++c) e[joints.curves->connection(c).name()] = joints.curves->evaluate(c, s).energy;
     return e;
   }
-  [[nodiscard]] std::vector<double> hinge_energies() const {
-    const auto s = model->system().state();
-    std::vector<double> e(parts.hinges->size(), 0.0);
-    for (Index h = 0; h < e.size(); ++h)
-      if (parts.hinges->is_alive(h)) e[h] = parts.hinges->element_energy(h, parts.hinges->gather(s, h));
-    return e;
-  }
+  [[nodiscard]] std::vector<double> hinge_energies() const { return sewn::app::test::hinge_energies(parts, *model); }
   // `nodes` are all corners of one live element.
   [[nodiscard]] bool on_live_element(const std::vector<Index>& nodes) const {
     for (Index e = 0; e < model->elements().size(); ++e) {

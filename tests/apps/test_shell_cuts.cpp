@@ -60,13 +60,7 @@ struct ShellBody {
       model->nodes().set_position(i, model->nodes().position(i) + Eigen::Vector3d(u(rng), u(rng), u(rng)));
   }
   // Each live hinge's energy now (0 for retired ones).
-  [[nodiscard]] std::vector<double> hinge_energies() const {
-    const auto s = model->system().state();
-    std::vector<double> e(parts.hinges->size(), 0.0);
-    for (Index h = 0; h < e.size(); ++h)
-      if (parts.hinges->is_alive(h)) e[h] = parts.hinges->element_energy(h, parts.hinges->gather(s, h));
-    return e;
-  }
+  [[nodiscard]] std::vector<double> hinge_energies() const { return sewn::app::test::hinge_energies(parts, *model); }
   // Every membrane sits on its model element's current corners (or left with it), and every
   // live hinge on two of those triangles: its edge's particles in both, its wings one in each.
   [[nodiscard]] bool terms_on_elements() const {
