@@ -23,7 +23,8 @@
 // block pattern when it sees the topology changed (System::refresh), for either integrator, and
 // the energy watchdog takes a new baseline. The cases first_step_after_* time that first
 // semi-implicit step after a cut (the cut untimed) against an ordinary step, so that the cut's
-// whole cost is cut + (first step after - step).
+// whole cost is cut + (first step after - step). stable_step_bound times the bound a guarded run
+// (the default) recomputes after every cut: the rest of what a cut costs such a run.
 //
 // Meshes: the 8x8x10 grid of 1.25 cm cubes (the paper's SOFA comparison, 891 particles), the 32³
 // grid of 0.3125 cm cubes (the paper's largest scale-up beam, 35 937 particles), and a stand-in
@@ -163,6 +164,16 @@ void first_step_after_cut(benchmark::State& st, const MeshCase& c, const std::ve
   st.counters["faces"] = static_cast<double>(facets.size());
 }
 
+// The stable-step bound that a guarded run (enforce_stable_step, the default) recomputes after
+// every cut and every 100 steps: one Gershgorin pass over the model's blocks.
+void stable_step_bound(benchmark::State& st, const MeshCase& c) {
+  const auto m = build_model(c);
+  physics::SymplecticEulerOptions so;
+  so.enforce_stable_step = false;
+  (void)physics::SymplecticEuler(so).step(m->system(), semi_implicit_h(*m));
+  for (auto _ : st) benchmark::DoNotOptimize(m->system().stable_step().h_max);
+}
+
 struct Restorable {
   std::unique_ptr<MssModel<3>> m;
   std::vector<double> x0, v0;
@@ -266,6 +277,9 @@ void register_all() {
          [c, sel](benchmark::State& st) { first_step_after_cut(st, *c, sel->plane); })
         ->Unit(benchmark::kMicrosecond)->Iterations(it);
     peer(kSuite, n + "/first_step_after_cut_plane", one_step, semi(1))->Unit(benchmark::kMicrosecond);
+    ours(kSuite, n + "/stable_step_bound", [c](benchmark::State& st) { stable_step_bound(st, *c); })
+        ->Unit(benchmark::kMicrosecond);
+    peer(kSuite, n + "/stable_step_bound", one_step, semi(1))->Unit(benchmark::kMicrosecond);
     ours(kSuite, n + "/cut_plane", [c, sel](benchmark::State& st) { cut_ours(st, *c, sel->plane); })
         ->Unit(benchmark::kMicrosecond)->Iterations(it);
     peer(kSuite, n + "/cut_plane", five_steps, semi(5))->Unit(benchmark::kMicrosecond);

@@ -112,8 +112,7 @@ StepReport SymplecticEuler::step(System& sys, double h) {
     }
   }
   const bool watch = opt_.health.energy_check_interval > 0;
-  // an unguarded run still needs the bound to suggest a step if it diverges
-  if (watch && watchdog_.baseline_if_needed(sys) && !opt_.enforce_stable_step) bound_ = sys.stable_step();
+  if (watch) watchdog_.baseline_if_needed(sys);
   sys.compute_forces();
   NodeTable& nodes = sys.nodes();
   if (opt_.health.check_finite) check_finite(nodes, "SymplecticEuler::step");
@@ -143,10 +142,17 @@ StepReport SymplecticEuler::step(System& sys, double h) {
   sys.step_accepted();
   if (watch && finite)
     if (auto blowup = watchdog_.after_step(sys, opt_.health, steps_, max_speed)) {
-      const double suggested = 0.9 * bound_.h_max;
+      // An unguarded run has no bound yet: computing one after every cut would cost several
+      // steps for a message. Taken now, in the diverging state, it is the bound of a stiffer
+      // configuration (stretched springs add their geometric stiffness), so the suggestion errs
+      // on the safe side.
+      const bool guarded = opt_.enforce_stable_step && !std::isnan(bound_.h_max);
+      const StableStep bound = guarded ? bound_ : sys.stable_step();
+      const double suggested = 0.9 * bound.h_max;
       throw BlowupError("SymplecticEuler::step: " + blowup->message + ". The step h = " + detail::format_number(h) +
-                            " s is too large for the scheme: the stable-step bound at the start was " +
-                            detail::format_number(bound_.h_max) + " s; suggested step " + detail::format_number(suggested) + " s",
+                            " s is too large for the scheme: the stable-step bound " +
+                            (guarded ? "checked before this step" : "in the state the run stopped in") + " is " +
+                            detail::format_number(bound.h_max) + " s; suggested step " + detail::format_number(suggested) + " s",
                         blowup->node, "energy", steps_, suggested);
     }
   return rep;

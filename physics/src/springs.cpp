@@ -713,29 +713,32 @@ void Springs::add_jacobians_threads(const StateView& st, const JacobianRequest& 
 }
 
 void Springs::add_stability_rows(const StateView& st, StabilityRows& rows) const {
-  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  using Sym = StabilityRows::SymBlock;
   for (Index s = 0; s < size(); ++s) {
     if (alive_[s] == 0) continue;
     const Index i = ni_[s], j = nj_[s];
     const SpringFrame fr = frame(st, i, j, l_[s]);
-    Eigen::Matrix3d Kb, Cb;
+    // K = k (U Uᵀ + c (I - U Uᵀ)), c = max(0, 1 - l/d) (compression clamped); C = γ U Uᵀ
+    // (viscous) or β K (Rayleigh)
+    Sym K, UU;
     if (fr.ok) {
-      const Eigen::Vector3d U = fr.dx / fr.d;
-      const Eigen::Matrix3d UU = U * U.transpose();
-      Kb = k_[s] * (UU + std::max(0.0, 1.0 - l_[s] / fr.d) * (I - UU));
-      Cb = damping_ == SpringDamping::viscous ? Eigen::Matrix3d(gamma_[s] * UU) : Eigen::Matrix3d(beta_ * Kb);
+      const double inv_d = 1.0 / fr.d;
+      const double u0 = fr.dx[0] * inv_d, u1 = fr.dx[1] * inv_d, u2 = fr.dx[2] * inv_d;
+      UU = {u0 * u0, u1 * u1, u2 * u2, u0 * u1, u0 * u2, u1 * u2};
+      const double c = std::max(0.0, 1.0 - l_[s] * inv_d);
+      const double k = k_[s], kc = k * c, k1c = k * (1.0 - c);
+      K = {k1c * UU[0] + kc, k1c * UU[1] + kc, k1c * UU[2] + kc, k1c * UU[3], k1c * UU[4], k1c * UU[5]};
     } else {
-      // No direction: bound the block by its largest possible norm.
-      Kb = k_[s] * I;
-      Cb = (damping_ == SpringDamping::viscous ? gamma_[s] : beta_ * k_[s]) * I;
+      // no direction: bound the block by its largest possible norm
+      UU = {1, 1, 1, 0, 0, 0};
+      K = {k_[s], k_[s], k_[s], 0, 0, 0};
     }
-    if (damping_ == SpringDamping::none) Cb.setZero();
-    rows.add_diagonal(StabilityRows::stiffness, i, Kb);
-    rows.add_diagonal(StabilityRows::stiffness, j, Kb);
-    rows.add_offdiagonal(StabilityRows::stiffness, i, j, Kb);
-    rows.add_diagonal(StabilityRows::damping, i, Cb);
-    rows.add_diagonal(StabilityRows::damping, j, Cb);
-    rows.add_offdiagonal(StabilityRows::damping, i, j, Cb);
+    Sym C{};
+    if (damping_ == SpringDamping::viscous)
+      for (int e = 0; e < 6; ++e) C[e] = gamma_[s] * UU[e];
+    else if (damping_ == SpringDamping::stiffness_proportional)
+      for (int e = 0; e < 6; ++e) C[e] = beta_ * K[e];
+    rows.add_pair(i, j, K, C);
   }
 }
 

@@ -16,6 +16,8 @@ StabilityRows::StabilityRows(std::span<const double> mass, std::span<const AxisM
     diag_[w].assign(9 * mass.size(), 0.0);
     off_[w].assign(3 * mass.size(), 0.0);
   }
+  inv_sqrt_mass_.resize(mass.size());
+  for (std::size_t i = 0; i < mass.size(); ++i) inv_sqrt_mass_[i] = mass[i] > 0 ? 1.0 / std::sqrt(mass[i]) : 0.0;
 }
 
 void StabilityRows::add_diagonal(Which w, Index i, const Eigen::Matrix3d& B) {
@@ -49,6 +51,19 @@ void StabilityRows::add_offdiagonal(Which w, Index i, Index j, const Eigen::Matr
       else
         offdiagonal_block(w, a.node, b.node, a.weight * b.weight * B);
     }
+}
+
+bool StabilityRows::fold_is_slave(Index i) const { return fold_->is_slave(i); }
+
+void StabilityRows::add_pair_folded(Index i, Index j, const SymBlock& K, const SymBlock& C) {
+  for (int w = 0; w < 2; ++w) {
+    const SymBlock& b = w == stiffness ? K : C;
+    Eigen::Matrix3d B;
+    B << b[0], b[3], b[4], b[3], b[1], b[5], b[4], b[5], b[2];
+    add_diagonal(static_cast<Which>(w), i, B);
+    add_diagonal(static_cast<Which>(w), j, B);
+    add_offdiagonal(static_cast<Which>(w), i, j, B);
+  }
 }
 
 void StabilityRows::diagonal_block(Which w, Index i, const Eigen::Matrix3d& B) {

@@ -139,6 +139,39 @@ TEST_CASE("stable-step bound: Gershgorin constants of PHYSICS_NOTES §1.6 and a 
   }
 }
 
+TEST_CASE("stability rows: a spring pair added at once gives the rows of its blocks added one by one") {
+  // add_pair is the springs' fast path; add_diagonal / add_offdiagonal the general one. Fixed
+  // axes, a removed node (mass 0) and signed entries must give the same bound either way.
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const std::vector<double> mass{1.0, 2.5, 0.0, 0.7, 3.0};
+  const std::vector<AxisMask> fixed{no_axes, axis_y, no_axes, axis_x | axis_z, all_axes};
+  StabilityRows pairs(mass, fixed), blocks(mass, fixed);
+  const std::vector<std::pair<Index, Index>> springs{{0, 1}, {1, 3}, {0, 2}, {3, 4}, {0, 3}, {2, 4}, {1, 4}};
+  for (const auto& [i, j] : springs) {
+    StabilityRows::SymBlock K, C;
+    for (int e = 0; e < 6; ++e) {
+      K[e] = u(rng);
+      C[e] = u(rng);
+    }
+    pairs.add_pair(i, j, K, C);
+    for (int w = 0; w < 2; ++w) {
+      const auto& b = w == 0 ? K : C;
+      Eigen::Matrix3d B;
+      B << b[0], b[3], b[4], b[3], b[1], b[5], b[4], b[5], b[2];
+      const auto which = static_cast<StabilityRows::Which>(w);
+      blocks.add_diagonal(which, i, B);
+      blocks.add_diagonal(which, j, B);
+      blocks.add_offdiagonal(which, i, j, B);
+    }
+  }
+  for (auto w : {StabilityRows::stiffness, StabilityRows::damping}) {
+    CHECK(pairs.bound(w).value == Approx(blocks.bound(w).value).epsilon(1e-14));
+    CHECK(pairs.bound(w).node == blocks.bound(w).node);
+    CHECK(pairs.bound(w).value > 0);
+  }
+}
+
 TEST_CASE("semi-implicit steps above the bound are refused with the bound in the message") {
   System sys;
   cube_lattice(sys, 3, 0.1, 1e5, 0.3, 1000, SpringDamping::viscous);

@@ -13,6 +13,7 @@
 // may use scratch buffers owned by the term.
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string_view>
@@ -77,13 +78,56 @@ class StabilityRows {
   void add_diagonal(Which w, Index i, const Eigen::Matrix3d& B);
   /// Blocks (i,j) = B and (j,i) = Bᵀ (sign irrelevant: absolute values are summed).
   void add_offdiagonal(Which w, Index i, Index j, const Eigen::Matrix3d& B);
+  /// A symmetric 3×3 block by its entries xx, yy, zz, xy, xz, yz.
+  using SymBlock = std::array<double, 6>;
+  /// A two-node term (a spring) whose stiffness and damping Hessians are [[B, -B], [-B, B]]
+  /// for symmetric B = K and B = C: both diagonal blocks and the pair's off-diagonal block, in
+  /// one call. The same rows as add_diagonal and add_offdiagonal would give; inline and
+  /// branch-free when neither node is a slave, since it runs once per spring.
+  void add_pair(Index i, Index j, const SymBlock& K, const SymBlock& C) {
+    if (fold_ != nullptr && (fold_is_slave(i) || fold_is_slave(j))) {
+      add_pair_folded(i, j, K, C);
+      return;
+    }
+    // 1 for a free axis of a node with fixed-axis mask m, 0 for a fixed one
+    static constexpr double free_axis[8][3] = {{1, 1, 1}, {0, 1, 1}, {1, 0, 1}, {0, 0, 1},
+                                               {1, 1, 0}, {0, 1, 0}, {1, 0, 0}, {0, 0, 0}};
+    const double scale = inv_sqrt_mass_[i] * inv_sqrt_mass_[j];
+    const double* fi = free_axis[fixed_[i] & 7u];
+    const double* fj = free_axis[fixed_[j] & 7u];
+    for (int w = 0; w < 2; ++w) {
+      const SymBlock& B = w == stiffness ? K : C;
+      // column-major 3×3 from the six entries
+      const double full[9] = {B[0], B[3], B[4], B[3], B[1], B[5], B[4], B[5], B[2]};
+      double* di = diag_[w].data() + 9 * std::size_t{i};
+      double* dj = diag_[w].data() + 9 * std::size_t{j};
+      for (int e = 0; e < 9; ++e) {
+        di[e] += full[e];
+        dj[e] += full[e];
+      }
+      if (scale == 0) continue;  // a removed node: no row, no column
+      const double a0 = std::abs(B[0]), a1 = std::abs(B[1]), a2 = std::abs(B[2]);
+      const double a3 = std::abs(B[3]), a4 = std::abs(B[4]), a5 = std::abs(B[5]);
+      double* oi = off_[w].data() + 3 * std::size_t{i};
+      double* oj = off_[w].data() + 3 * std::size_t{j};
+      oi[0] += scale * (fj[0] * a0 + fj[1] * a3 + fj[2] * a4);
+      oi[1] += scale * (fj[0] * a3 + fj[1] * a1 + fj[2] * a5);
+      oi[2] += scale * (fj[0] * a4 + fj[1] * a5 + fj[2] * a2);
+      oj[0] += scale * (fi[0] * a0 + fi[1] * a3 + fi[2] * a4);
+      oj[1] += scale * (fi[0] * a3 + fi[1] * a1 + fi[2] * a5);
+      oj[2] += scale * (fi[0] * a4 + fi[1] * a5 + fi[2] * a2);
+    }
+  }
   /// max over free axes of the scalar Gershgorin row sum. O(n).
   [[nodiscard]] Bound bound(Which w) const;
 
  private:
   void diagonal_block(Which w, Index i, const Eigen::Matrix3d& B);
   void offdiagonal_block(Which w, Index i, Index j, const Eigen::Matrix3d& B);
+  void add_pair_folded(Index i, Index j, const SymBlock& K, const SymBlock& C);
+  [[nodiscard]] bool fold_is_slave(Index i) const;
   std::span<const double> mass_;
+  std::vector<double> inv_sqrt_mass_;  // 1/sqrt(m), 0 for a removed node (no row, no column)
   const SlaveExpansion* fold_ = nullptr;
   std::span<const AxisMask> fixed_;
   std::vector<double> diag_[2];  // 9 per node, column-major
