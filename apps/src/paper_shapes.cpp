@@ -78,6 +78,24 @@ void add_rod(IndexedMesh& m, std::uint32_t from, std::uint32_t edges, const std:
   add_chain(m, chain, tag);
 }
 
+// A closed band of rings × around points, point (j, i) at place(j, i), joined ring to ring by
+// quads split along their diagonal (j, i)–(j + 1, i + 1). Returns point (j, i)'s index (i taken
+// modulo around).
+std::function<std::uint32_t(std::uint32_t, std::uint32_t)> split_quad_band(
+    IndexedMesh& m, std::uint32_t rings, std::uint32_t around, const std::function<Point3(std::uint32_t, std::uint32_t)>& place,
+    std::int32_t tag) {
+  const std::uint32_t first = m.num_points();
+  auto v = [=](std::uint32_t j, std::uint32_t i) { return first + j * around + i % around; };
+  for (std::uint32_t j = 0; j < rings; ++j)
+    for (std::uint32_t i = 0; i < around; ++i) m.points.push_back(place(j, i));
+  for (std::uint32_t j = 0; j + 1 < rings; ++j)
+    for (std::uint32_t i = 0; i < around; ++i) {
+      m.add_cell(CellType::triangle, {v(j, i), v(j + 1, i), v(j + 1, i + 1)}, tag);
+      m.add_cell(CellType::triangle, {v(j, i), v(j + 1, i + 1), v(j, i + 1)}, tag);
+    }
+  return v;
+}
+
 double signed_volume(const IndexedMesh& m, const std::array<std::uint32_t, 4>& t) {
   const auto& p0 = m.points[t[0]];
   auto d = [&](int k) {
@@ -122,17 +140,10 @@ PaperShape umbrella() {
   IndexedMesh& m = s.mesh;
   constexpr std::uint32_t around = 96, radial = 32;
   const double R = 0.6, a0 = 0.03, a1 = 0.95;
-  auto v = [&](std::uint32_t j, std::uint32_t i) { return j * around + i % around; };
-  for (std::uint32_t j = 0; j <= radial; ++j)
-    for (std::uint32_t i = 0; i < around; ++i) {
-      const double phi = a0 + (a1 - a0) * j / radial, th = 2 * pi * i / around;
-      m.points.push_back({R * std::sin(phi) * std::cos(th), R * std::sin(phi) * std::sin(th), R * std::cos(phi)});
-    }
-  for (std::uint32_t j = 0; j < radial; ++j)
-    for (std::uint32_t i = 0; i < around; ++i) {
-      m.add_cell(CellType::triangle, {v(j, i), v(j + 1, i), v(j + 1, i + 1)}, 1);
-      m.add_cell(CellType::triangle, {v(j, i), v(j + 1, i + 1), v(j, i + 1)}, 1);
-    }
+  const auto v = split_quad_band(m, radial + 1, around, [&](std::uint32_t j, std::uint32_t i) {
+    const double phi = a0 + (a1 - a0) * j / radial, th = 2 * pi * i / around;
+    return Point3{R * std::sin(phi) * std::cos(th), R * std::sin(phi) * std::sin(th), R * std::cos(phi)};
+  }, 1);
   for (std::uint32_t r = 0; r < 6; ++r) {
     std::vector<std::uint32_t> rib;
     for (std::uint32_t j = 0; j <= radial; ++j) rib.push_back(v(j, 16 * r));
@@ -289,11 +300,104 @@ PaperShape sandwich() {
   return s;
 }
 
+// Toy tunnel (Fig. 14; no published counts): a cylindrical cloth along x (radius 8 cm, 45 cm
+// long, lying 2 cm above z = 0), 30 rings of 20 quads each split along the diagonal (j, i)–(j + 1, i + 1), so that the
+// diagonals form helices; two of them (half a turn apart, 30 edges and 1.5 turns each) are rods:
+// the paper's spiral of existing edges labelled as rods. 620 points, 1200 triangles, 60 rod edges.
+PaperShape toy_tunnel() {
+  PaperShape s;
+  IndexedMesh& m = s.mesh;
+  constexpr std::uint32_t around = 20, along = 30;
+  const double r = 0.08, length = 0.45, lift = 0.02;
+  const auto v = split_quad_band(m, along + 1, around, [&](std::uint32_t j, std::uint32_t i) {
+    const double th = 2 * pi * i / around;
+    return Point3{length * j / along, r * std::cos(th), lift + r + r * std::sin(th)};
+  }, 1);
+  for (const std::uint32_t start : {0u, around / 2}) {
+    std::vector<std::uint32_t> helix;
+    for (std::uint32_t j = 0; j <= along; ++j) helix.push_back(v(j, start + j));
+    add_chain(m, helix, 2);
+  }
+  s.names = {{shell, 1, "cloth"}, {rod, 2, "spiral"}};
+  s.note = "from the figure (no published counts): 20 x 31 points, 2 x 20 x 30 triangles, 2 helices of 30 diagonal edges as rods";
+  return s;
+}
+
+// Anglerfish (Fig. 17; no published counts): a body of tetrahedra (a 6 × 4 × 4 grid of
+// 2 × 1.5 × 1.5 cm cells, 6 tets each: 576), fins of triangles joined to it along rows of its
+// edges (curve connections): a dorsal fin on the top's middle line, a tail fin on the back face's,
+// a pectoral fin on each side; a 20-edge antenna (rod) arching forward from the top of the head,
+// point-joined to the body and, at its tip, to a light ball (tetrahedra, 16).
+PaperShape anglerfish() {
+  PaperShape s;
+  IndexedMesh& m = s.mesh;
+  GridSpec g;
+  g.spacing = {0.02, 0.015, 0.015};
+  append_tagged(m, tet_grid(6, 4, 4, TetSplit::kuhn6, g), 1);
+  auto body = [](std::uint32_t i, std::uint32_t j, std::uint32_t k) { return i + 7 * (j + 5 * k); };
+  // A fin of `rows` rows of triangles on the root points (a row of body edges): each row's
+  // points are the last row's moved by step(row) (one fewer per row, a tapering fin).
+  auto fin = [&](std::vector<std::uint32_t> root, std::uint32_t rows, const std::function<Point3(const Point3&, std::uint32_t)>& step) {
+    for (std::uint32_t row = 1; row <= rows && root.size() > 1; ++row) {
+      std::vector<std::uint32_t> next;
+      for (std::size_t q = 0; q + 1 < root.size(); ++q) {
+        const Point3 a = m.points[root[q]], b = m.points[root[q + 1]];
+        next.push_back(add_point(m, step({(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2}, row)));
+      }
+      for (std::size_t q = 0; q + 1 < root.size(); ++q) {
+        m.add_cell(CellType::triangle, {root[q], root[q + 1], next[q]}, 2);
+        if (q + 1 < next.size()) m.add_cell(CellType::triangle, {next[q], root[q + 1], next[q + 1]}, 2);
+      }
+      root = std::move(next);
+    }
+  };
+  std::vector<std::uint32_t> dorsal, tail, left, right;
+  for (std::uint32_t i = 1; i <= 4; ++i) dorsal.push_back(body(i, 2, 4));
+  for (std::uint32_t k = 0; k <= 4; ++k) tail.push_back(body(0, 2, k));
+  for (std::uint32_t i = 2; i <= 5; ++i) left.push_back(body(i, 0, 2)), right.push_back(body(i, 4, 2));
+  fin(dorsal, 3, [](const Point3& p, std::uint32_t) { return Point3{p[0] - 0.006, p[1], p[2] + 0.012}; });
+  fin(tail, 4, [](const Point3& p, std::uint32_t) { return Point3{p[0] - 0.012, p[1], p[2] + (p[2] - 0.03) * 0.25}; });
+  fin(left, 2, [](const Point3& p, std::uint32_t) { return Point3{p[0] - 0.006, p[1] - 0.012, p[2] - 0.003}; });
+  fin(right, 2, [](const Point3& p, std::uint32_t) { return Point3{p[0] - 0.006, p[1] + 0.012, p[2] - 0.003}; });
+  // the light ball's lowest pole ends the antenna: it arcs up from the head's top front edge
+  const std::uint32_t head = body(6, 2, 4);
+  const Point3 h = m.points[head];
+  const Point3 ball{h[0] + 0.05, h[1], h[2] + 0.02 + 0.008};
+  const std::uint32_t pole = m.num_points() + 2;  // add_bipyramid: centre, top, bottom, ...
+  add_bipyramid(m, ball, 0.008, 8, 4);
+  add_rod(m, head, 20, [&](double t) {
+    const double a = pi * t;  // a half ellipse over the head, ending under the ball
+    return Point3{h[0] + 0.025 - 0.025 * std::cos(a), h[1], h[2] + 0.06 * std::sin(a) + 0.02 * t};
+  }, 3, pole);
+  s.names = {{solid, 1, "body"}, {shell, 2, "fins"}, {rod, 3, "antenna"}, {solid, 4, "light"}};
+  s.note = "from the figure (no published counts): 576 body tets, 41 fin triangles on 3 + 4 + 3 + 3 body edges, a 20-edge antenna, a 16-tet light ball";
+  return s;
+}
+
 }  // namespace
 
 const std::vector<std::string>& paper_shape_names() {
-  static const std::vector<std::string> names{"frisbee", "umbrella", "sticky_hands", "jellyfish", "toy_ball", "sandwich"};
+  static const std::vector<std::string> names{"frisbee", "umbrella", "sticky_hands", "jellyfish", "toy_ball", "sandwich",
+                                                   "toy_tunnel", "anglerfish"};
   return names;
+}
+
+IndexedMesh fig18_slab(std::uint32_t solid, std::uint32_t shell, std::uint32_t ny, std::uint32_t nz, double cell) {
+  GridSpec grid;
+  grid.spacing = {cell, cell, cell};
+  IndexedMesh m = tet_grid(solid, ny, nz, TetSplit::kuhn6, grid);
+  for (auto& t : m.tags) t = 1;
+  std::vector<std::uint32_t> prev(ny + 1), cur(ny + 1);
+  for (std::uint32_t j = 0; j <= ny; ++j) prev[j] = solid + (solid + 1) * (j + (ny + 1) * (nz / 2));
+  for (std::uint32_t i = 1; i <= shell; ++i) {
+    for (std::uint32_t j = 0; j <= ny; ++j) cur[j] = add_point(m, {(solid + i) * cell, j * cell, nz / 2 * cell});
+    for (std::uint32_t j = 0; j < ny; ++j) {
+      m.add_cell(CellType::triangle, {prev[j], cur[j], cur[j + 1]}, 2);
+      m.add_cell(CellType::triangle, {prev[j], cur[j + 1], prev[j + 1]}, 2);
+    }
+    prev = cur;
+  }
+  return m;
 }
 
 PaperShape make_paper_shape(const std::string& name) {
@@ -303,6 +407,8 @@ PaperShape make_paper_shape(const std::string& name) {
   if (name == "jellyfish") return jellyfish();
   if (name == "toy_ball") return toy_ball();
   if (name == "sandwich") return sandwich();
+  if (name == "toy_tunnel") return toy_tunnel();
+  if (name == "anglerfish") return anglerfish();
   std::string known;
   for (const auto& n : paper_shape_names()) known += (known.empty() ? "" : ", ") + n;
   throw std::invalid_argument("no paper shape '" + name + "' (known: " + known + ")");

@@ -292,8 +292,22 @@ void warn_elongation_policies(const RunSummary& sum, const Assembly& assembly) {
                  assembly.source_cells);
 }
 
-// The fixed particles, then the initial velocities of their free axes.
-void set_initial_state(const Scene& scene, const Assembly& assembly, physics::MssModel<3>& model) {
+// The particles `motion` drives (held on every axis from here), none of them in `fixed`.
+MotionDriver driven_particles(const Scene& scene, const Assembly& assembly, physics::MssModel<3>& model) {
+  std::vector<std::vector<Index>> nodes;
+  for (std::size_t k = 0; k < scene.motion.size(); ++k) {
+    const std::string path = "motion[" + std::to_string(k) + "].where";
+    const std::set<Index> picked = selected_nodes(scene.motion_where[k], assembly, model, scene.file, path);
+    for (Index i : picked)
+      if (model.nodes().fixed(i) != physics::no_axes)
+        throw SceneError(scene.file, path, "selects particle " + std::to_string(i) + ", which `fixed` holds: a particle is either held or driven");
+    nodes.emplace_back(picked.begin(), picked.end());
+  }
+  return MotionDriver(scene.motion, nodes, model.nodes(), scene.file);
+}
+
+// The fixed particles, the driven ones, then the initial velocities of the free axes.
+MotionDriver set_initial_state(const Scene& scene, const Assembly& assembly, physics::MssModel<3>& model) {
   for (std::size_t k = 0; k < scene.fixed.size(); ++k) {
     const FixSpec& fix = scene.fixed[k];
     physics::AxisMask axes = 0;
@@ -303,6 +317,7 @@ void set_initial_state(const Scene& scene, const Assembly& assembly, physics::Ms
     for (Index i : selected_nodes(fix.where, assembly, model, scene.file, "fixed[" + std::to_string(k) + "].where"))
       model.nodes().fix(i, axes);
   }
+  MotionDriver motion = driven_particles(scene, assembly, model);
   for (std::size_t k = 0; k < scene.velocities.size(); ++k) {
     const VelocitySpec& vel = scene.velocities[k];
     const Vec3d linear(vel.linear[0], vel.linear[1], vel.linear[2]), angular(vel.angular[0], vel.angular[1], vel.angular[2]),
@@ -315,6 +330,7 @@ void set_initial_state(const Scene& scene, const Assembly& assembly, physics::Ms
       model.nodes().set_velocity(i, v);
     }
   }
+  return motion;
 }
 
 }  // namespace
@@ -345,7 +361,7 @@ Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum) {
   sum.connection_energies = connection_energies_text(b.joints);
   add_volume_term(scene, assembly.material_names, model);
 
-  set_initial_state(scene, assembly, model);
+  b.motion = set_initial_state(scene, assembly, model);
   if (scene.refinement.enabled) b.refinement = std::make_unique<RefinementRun>(scene, model);
   return b;
 }

@@ -10,6 +10,7 @@
 
 #include "sewn/apps/connections.hpp"
 #include "sewn/apps/continuum.hpp"
+#include "sewn/apps/motion_keys.hpp"
 #include "sewn/apps/refine_keys.hpp"
 #include "sewn/apps/runner.hpp"
 #include "sewn/apps/scene.hpp"
@@ -24,6 +25,7 @@ struct Bodies {
   ContinuumParts continuum;
   ConnectionParts joints;  ///< the rotational energies where the bodies meet (model.connections)
   std::unique_ptr<RefinementRun> refinement;  ///< null if the scene refines nothing
+  MotionDriver motion;                        ///< the particles `motion` drives (empty: none)
 };
 
 /// Builds the scene's bodies at rest with their initial motion. Fills the summary's

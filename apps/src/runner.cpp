@@ -453,6 +453,7 @@ refine::CutReport RunLoop::apply_cut(std::size_t k) {
 // One step of the scene's integrator; returns its linear-solver iterations.
 int RunLoop::step(double t) {
   physics::System& sys = model_.system();
+  if (!b_.motion.empty()) b_.motion.drive(model_.nodes(), t, h_);
   if (use_midpoint_) {
     const int cg = midpoint_.step(sys, h_).cg_iterations;
     if (midpoint_.last_substeps() > 1) {

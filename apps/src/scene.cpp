@@ -255,6 +255,7 @@ Field build_schema() {
       field("meshes", Kind::array).of(mesh).items(1, 1u << 16).required().doc("The bodies."),
       field("fixed", Kind::array).of(fix).fallback(nlohmann::json::array()).doc("Fixed particles."),
       field("velocities", Kind::array).of(velocity).fallback(nlohmann::json::array()).doc("Initial velocities (default: at rest)."),
+      motion_schema(),
       field("gravity", Kind::vec3).unit("m/s²").fallback({0.0, 0.0, -9.81}).at_least(-1e6).at_most(1e6)
           .doc("Gravity (each component within ±10⁶ m/s², 10⁵ g: beyond, the forces overflow the solver)."),
       model,
@@ -387,6 +388,19 @@ void check_limits(const Scene& s, const nlohmann::json& limits_json, const Field
                          short_number(steps) + " steps, more than limits.steps = " + short_number(max_steps) +
                          "; use a longer step or a shorter duration, or raise limits.steps");
 }
+
+// What `motion` cannot be combined with, said at the key.
+void check_motion(const Scene& s) {
+  for (std::size_t k = 0; k < s.motion.size(); ++k) {
+    const std::string path = "motion[" + std::to_string(k) + "]";
+    if (s.motion[k].from >= s.duration)
+      throw SceneError(s.file, path + ".from", "is not before the end of the run (duration " + std::to_string(s.duration) + " s)");
+    if (!s.cuts.empty()) throw SceneError(s.file, path, "prescribed motion cannot be combined with `cuts` yet (a cut duplicates driven particles)");
+    if (s.refinement.enabled)
+      throw SceneError(s.file, path, "prescribed motion cannot be combined with `refinement` yet (refinement renumbers particles)");
+  }
+}
+
 }  // namespace
 
 Selector read_selector(const nlohmann::json& j, const Field& schema) {
@@ -551,6 +565,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     s.velocities.push_back({read_selector(vj.at("where"), *velocity_schema.member("where")), vr.vec3("linear"),
                             vr.vec3("angular"), vr.vec3("center")});
   }
+  s.motion = read_motion(r["motion"], *schema.member("motion"), file, s.motion_where);
   s.gravity = r.vec3("gravity");
   s.obstacles = read_obstacles(r["obstacles"], *schema.member("obstacles"), file);
   {
@@ -654,6 +669,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     }
     s.cuts.push_back(std::move(c));
   }
+  check_motion(s);
 
   {
     Reader o(r["output"], *schema.member("output"));

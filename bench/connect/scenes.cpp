@@ -70,7 +70,7 @@ void register_all() {
   const Scale sc = scale();
   // frames per run: enough steps to leave the first one's transient, few enough for the suite
   const std::uint32_t frames = sc == Scale::smoke ? 1 : sc == Scale::small ? 2 : 6;
-  for (const char* name : {"frisbee", "sticky_hands", "toy_ball", "sandwich", "jellyfish", "umbrella"}) {
+  for (const char* name : {"frisbee", "sticky_hands", "toy_ball", "sandwich", "jellyfish", "umbrella", "toy_tunnel", "anglerfish"}) {
     if (sc == Scale::smoke && std::string(name) != "frisbee") continue;
     for (const std::uint32_t threads : {1u, 2u}) {
       const std::string c = std::string("scenes/") + name + (threads == 2 ? "/2_threads" : "");

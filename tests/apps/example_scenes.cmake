@@ -33,6 +33,8 @@ set(expect_s04_sticky_hands      "200;311;0.07")
 set(expect_s04_jellyfish         "1465;1727;0.07")
 set(expect_s04_toy_ball          "350;525;0.07")
 set(expect_s04_sandwich          "198;760;0.07")
+set(expect_s04_toy_tunnel        "620;1260;0.07")  # the figures' scenes: 1200 triangles + 60 rod edges
+set(expect_s04_anglerfish        "231;653;0.07")   # 592 tetrahedra, 41 fin triangles, 20 antenna edges
 # The 2014 paper's adaptive refinement, stopped once refinement has run (their ends cost minutes
 # under the sanitizers): counts = particles and live hexahedra the criterion has made by then.
 set(expect_refine_fig09_spike    "1421;884;0.25")  # 100 hexahedra, 112 of them refined by t = 0.25 s

@@ -9,6 +9,7 @@
 
 #include "sewn/apps/connections.hpp"
 #include "sewn/apps/continuum.hpp"
+#include "sewn/apps/paper_shapes.hpp"
 #include "sewn/io/cleanup.hpp"
 #include "sewn/physics/integrate/newton_euler.hpp"
 
@@ -23,25 +24,7 @@ constexpr double E = 1e7, nu = 0.3, rho = 1000, g = 9.81;
 
 // `solid` cells of tetrahedra along x from x = 0, then `shell` cells of triangles on the
 // mid-surface z = h, their first column the solid's end-face nodes at z = h.
-sewn::IndexedMesh slab(std::uint32_t solid, std::uint32_t shell) {
-  sewn::GridSpec grid;
-  grid.spacing = {h, h, h};
-  sewn::IndexedMesh m = sewn::tet_grid(solid, ny, nz, sewn::TetSplit::kuhn6, grid);
-  std::vector<std::uint32_t> prev(ny + 1), cur(ny + 1);
-  for (std::uint32_t j = 0; j <= ny; ++j) prev[j] = solid + (solid + 1) * (j + (ny + 1) * 1);
-  for (std::uint32_t i = 1; i <= shell; ++i) {
-    for (std::uint32_t j = 0; j <= ny; ++j) {
-      cur[j] = m.num_points();
-      m.points.push_back({(solid + i) * h, j * h, h});
-    }
-    for (std::uint32_t j = 0; j < ny; ++j) {
-      m.add_cell(sewn::CellType::triangle, {prev[j], cur[j], cur[j + 1]}, 2);
-      m.add_cell(sewn::CellType::triangle, {prev[j], cur[j + 1], prev[j + 1]}, 2);
-    }
-    prev = cur;
-  }
-  return m;
-}
+sewn::IndexedMesh slab(std::uint32_t solid, std::uint32_t shell) { return sewn::app::fig18_slab(solid, shell, ny, nz, h); }
 
 // The static tip deflection (mean z displacement of the nodes at x = L) of the slab clamped at
 // x = 0 under gravity: backward Euler steps of 100 s from rest (the inertia term is then

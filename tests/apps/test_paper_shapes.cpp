@@ -82,7 +82,10 @@ TEST_CASE("paper shapes: the published counts, or the stated proxies") {
   // sandwich's points are the proxies' own (61 platform + 87 ball + 202 spring; 11 × 3 × 6)
   const Expect expect[] = {{"frisbee", {289, 64, 512, 0}},        {"umbrella", {3168, 198, 6144, 0}},
                            {"sticky_hands", {200, 19, 292, 0}},   {"jellyfish", {1465, 1273, 0, 454}},
-                           {"toy_ball", {61 + 87 + 202, 203, 96, 226}}, {"sandwich", {198, 0, 160, 600}}};
+                           {"toy_ball", {61 + 87 + 202, 203, 96, 226}}, {"sandwich", {198, 0, 160, 600}},
+                           // from the figures (no published counts): 20 x 31 points; 175 body +
+                           // 26 fin + 11 light + 19 antenna points
+                           {"toy_tunnel", {620, 60, 1200, 0}},    {"anglerfish", {175 + 26 + 11 + 19, 20, 41, 576 + 16}}};
   REQUIRE(sewn::app::paper_shape_names().size() == std::size(expect));
   for (const Expect& e : expect) {
     CAPTURE(e.name);
@@ -148,6 +151,15 @@ TEST_CASE("paper shapes: the joints are where the paper puts them") {
   CHECK(found(c, K::surface, Body::shell, Body::solid) > 0);
   CHECK(found(c, K::curve, Body::shell, Body::solid) == 0);
   CHECK(found(c, K::point, Body::shell, Body::solid) == 0);
+  // toy tunnel: both helices lie along the cloth's diagonals, every edge a curve joint
+  c = joints("toy_tunnel");
+  CHECK(found(c, K::curve, Body::rod, Body::shell) == 60);
+  CHECK(c.found.total() == 60);
+  // anglerfish: the fins along 3 + 4 + 3 + 3 body edges, the antenna on the head and the light
+  c = joints("anglerfish");
+  CHECK(found(c, K::curve, Body::shell, Body::solid) == 13);
+  CHECK(found(c, K::point, Body::rod, Body::solid) == 2);
+  CHECK(c.found.total() == 15);
 }
 
 TEST_CASE("paper shapes: the sticky hand's triangles all face one way (no fold from its fingers)") {
@@ -175,7 +187,7 @@ TEST_CASE("paper shapes: the committed meshes are the generator's output") {
 TEST_CASE("paper scenes: a few steps each, Newton converged, energy finite, the map of the scene valid") {
   // run() throws NewtonError when a step's Newton iteration does not converge within the
   // scene's limit, so a run that returns took every step to the scene's tolerance.
-  for (const std::string name : {"frisbee", "sticky_hands", "toy_ball", "sandwich", "jellyfish"}) {
+  for (const std::string name : {"frisbee", "sticky_hands", "toy_ball", "sandwich", "jellyfish", "toy_tunnel", "anglerfish"}) {
     CAPTURE(name);
     const auto file = std::filesystem::path(SEWN_SOURCE_DIR) / "scenes" / ("s04_" + name + ".json");
     const sewn::app::Scene scene = sewn::app::load_scene(file.string());
@@ -222,7 +234,7 @@ TEST_CASE("integrator.solver ldlt: Newton's direct solve, refused with the other
 
 TEST_CASE("paper shapes: an unknown name is refused with the known ones") {
   CHECK_THROWS_WITH_AS(sewn::app::make_paper_shape("kite"),
-                       "no paper shape 'kite' (known: frisbee, umbrella, sticky_hands, jellyfish, toy_ball, sandwich)",
+                       "no paper shape 'kite' (known: frisbee, umbrella, sticky_hands, jellyfish, toy_ball, sandwich, toy_tunnel, anglerfish)",
                        std::invalid_argument);
 }
 

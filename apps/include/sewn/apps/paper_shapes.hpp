@@ -16,6 +16,10 @@
 //                 points), a 226-tet ball, a 203-edge helical spring between them
 //   sandwich      proxy (1510 shell faces cannot lie in 600 tets): 600 tets (a 10 × 2 × 5 cube
 //                 beam, 6 tets per cube) with its 4 interior horizontal face layers as shells
+//   toy_tunnel    620 / 60 / 1200 / 0    from Fig. 14 (no published counts): a cloth cylinder
+//                                        whose two diagonal helices are rods
+//   anglerfish    231 / 20 / 41 / 592    from Fig. 17 (no published counts): a tet body with
+//                                        four fins on rows of its edges, an antenna, a light ball
 #include <string>
 #include <vector>
 
@@ -31,11 +35,17 @@ struct PaperShape {
   std::string note;
 };
 
-/// "frisbee", "umbrella", "sticky_hands", "jellyfish", "toy_ball", "sandwich".
+/// "frisbee", "umbrella", "sticky_hands", "jellyfish", "toy_ball", "sandwich", "toy_tunnel", "anglerfish".
 const std::vector<std::string>& paper_shape_names();
 
 /// Builds the named shape (deterministic: the same points and cells every call). Throws
 /// std::invalid_argument naming the shape and listing the known ones.
 PaperShape make_paper_shape(const std::string& name);
+
+/// The paper's Fig. 18 slab on cubes of side `cell` from x = 0: `solid` × ny × nz cubes of 6
+/// tetrahedra (tag 1, the points of tet_grid), then `shell` columns of ny × 2 triangles (tag 2)
+/// on the mid-surface z = cell · nz / 2 (nz even), the first column on the solid's end-face
+/// points there (a shared edge line: the curve joints).
+IndexedMesh fig18_slab(std::uint32_t solid, std::uint32_t shell, std::uint32_t ny, std::uint32_t nz, double cell);
 
 }  // namespace sewn::app

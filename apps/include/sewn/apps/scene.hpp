@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "sewn/apps/connection_keys.hpp"
+#include "sewn/apps/motion_keys.hpp"
 #include "sewn/apps/obstacle_keys.hpp"
 #include "sewn/apps/schema.hpp"
 #include "sewn/physics/solve/linear_solver.hpp"
@@ -131,6 +132,8 @@ struct Scene {
   std::vector<MeshSpec> meshes;
   std::vector<FixSpec> fixed;
   std::vector<VelocitySpec> velocities;  // later entries win
+  std::vector<MotionSpec> motion;        // prescribed motions, each driving motion_where[k]
+  std::vector<Selector> motion_where;
   Vec3 gravity{0, 0, -9.81};
   std::string model = "mass-spring", law = "stable_neo_hookean";  // model.type, model.law
   std::string bending = "patch";                                     // model.bending (shells)
