@@ -40,7 +40,8 @@ template <int D>
 std::vector<std::uint32_t> facet_points(const MssModel<D>& m, const Facet& f) {
   std::vector<std::uint32_t> pts;
   for (Dart x : facet_darts(m, f)) pts.push_back(m.point_of_node(m.node_of(x)));
-  if (f.index == 2) pts.push_back(m.point_of_node(m.node_of(m.map().beta(f.dart, 2))));
+  // an edge's other end: where the next dart of its face starts (β2 is null on a free edge)
+  if (f.index == 2) pts.push_back(m.point_of_node(m.node_of(m.map().beta(f.dart, 1))));
   std::sort(pts.begin(), pts.end());
   return pts;
 }
@@ -54,7 +55,7 @@ Vec3 facet_centroid(const MssModel<D>& m, const Facet& f) {
     ++n;
   }
   if (f.index == 2) {
-    c += m.rest_position(m.node_of(m.map().beta(f.dart, 2)));
+    c += m.rest_position(m.node_of(m.map().beta(f.dart, 1)));
     ++n;
   }
   return c / static_cast<double>(n);
