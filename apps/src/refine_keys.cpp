@@ -1,5 +1,6 @@
 #include "sewn/apps/refine_keys.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <vector>
 
@@ -44,6 +45,11 @@ refine::InRegion<3>::Predicate region_predicate(const Selector& s) {
   return [s](const Eigen::Vector3d& p) { return s.contains({p.x(), p.y(), p.z()}); };
 }
 
+// What sewn::refine splits regularly: hexahedra 1:8, quads (membranes) 1:4.
+bool refinable(const physics::Element& el) {
+  return el.alive && (el.kind == physics::ElementKind::hexahedron || el.kind == physics::ElementKind::quad);
+}
+
 std::string count_text(double x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3g", x);
@@ -54,13 +60,13 @@ std::string count_text(double x) {
 
 Field refinement_schema() {
   Field pre = field("pre_refine", Kind::object);
-  pre.doc("Hexahedra refined before the run.")
-      .members({selector_schema("where", "The hexahedra whose rest centroid lies here (all, box or sphere).").required(),
+  pre.doc("Hexahedra and quads refined before the run.")
+      .members({selector_schema("where", "The hexahedra and quads whose rest centroid lies here (all, box or sphere).").required(),
                 field("levels", Kind::integer).fallback(1).at_least(1).at_most(max_level_index - 1)
-                    .doc("Times refined (each 1:8): the elements end at level index 1 + levels, within `max_level`.")});
+                    .doc("Times refined (each 1:8, or 1:4 for a quad): the elements end at level index 1 + levels, within `max_level`.")});
   Field r = field("refinement", Kind::object);
-  r.doc("Hierarchical adaptive refinement of the hexahedra of a mass-spring model (the 2014 paper; docs/refinement.md): "
-        "after every step, each element a criterion picks is split 1:8 (at most one level per element per step, "
+  r.doc("Hierarchical adaptive refinement of the hexahedra and quads (membranes) of a mass-spring model (the 2014 paper; docs/refinement.md): "
+        "after every step, each element a criterion picks is split 1:8 (a quad 1:4; at most one level per element per step, "
         "never past `max_level`), T-junctions become slave particles, and with `coarsen` calm families merge back "
         "into their parent. The .vtu series has the cell field `refinement_level`; `color_by: \"level\"` draws it. "
         "Memory: pre-refinement is counted against `limits.memory` as if it applied to every cell; adaptive "
@@ -71,7 +77,7 @@ Field refinement_schema() {
                     .doc("Finest level allowed, as an index: 1 is the mesh's own size, each level halves it (3: down to a quarter of the mesh's cell size)."),
                 field("pre_refine", Kind::array).of(pre).fallback(nlohmann::json::array()).doc("Regions refined before the run, in order."),
                 field("coarsen", Kind::boolean).fallback(false)
-                    .doc("Merge a family of 8 back into its parent when the criteria have allowed it for `calm_steps` steps running (momentum kept, the fine-scale kinetic energy dissipated)."),
+                    .doc("Merge a family (8 children, 4 of a quad) back into its parent when the criteria have allowed it for `calm_steps` steps running (momentum kept, the fine-scale kinetic energy dissipated)."),
                 field("calm_steps", Kind::integer).fallback(20).at_least(1).at_most(1000000).doc("Hysteresis of coarsening, in steps."),
                 field("balance", Kind::boolean).fallback(false)
                     .doc("2:1 balance: before an element is refined, its neighbours (sharing an edge or a face) that would end more than one level coarser are refined first, and coarsening skips families whose merge would break it."),
@@ -134,11 +140,9 @@ RefinementRun::RefinementRun(const Scene& scene, physics::MssModel<3>& model) : 
   impl_->max_elements = spec.max_elements;
   if (scene.model != "mass-spring")
     throw SceneError(scene.file, "refinement", "refines the mass-spring model only (model.type is \"" + scene.model + "\")");
-  bool hexahedra = false;
-  for (const auto& el : model.elements()) hexahedra = hexahedra || (el.alive && el.kind == physics::ElementKind::hexahedron);
-  if (!hexahedra)
+  if (std::none_of(model.elements().begin(), model.elements().end(), refinable))
     throw SceneError(scene.file, "refinement",
-                     "refines hexahedra, and the meshes have none (quads of membranes and tetrahedra are not refined; docs/refinement.md)");
+                     "refines hexahedra (1:8) and quads (1:4), and the meshes have none (triangles and tetrahedra are not refined; docs/refinement.md)");
   refine::constrain_t_junctions(model, spec.t_junctions == "paper_projection" ? physics::SlaveTreatment::paper_projection
                                                                               : physics::SlaveTreatment::reduction);
   refine::RefineOptions options;
@@ -152,8 +156,8 @@ RefinementRun::RefinementRun(const Scene& scene, physics::MssModel<3>& model) : 
     const refine::InRegion<3> inside(region_predicate(p.where));
     bool any = false;
     for (physics::Index e = 0; e < model.elements().size() && !any; ++e)
-      any = model.elements()[e].alive && model.elements()[e].kind == physics::ElementKind::hexahedron && inside.wants_refinement(model, e);
-    if (!any) throw SceneError(scene.file, path + ".where", "holds the rest centroid of no hexahedron");
+      any = refinable(model.elements()[e]) && inside.wants_refinement(model, e);
+    if (!any) throw SceneError(scene.file, path + ".where", "holds the rest centroid of no hexahedron or quad");
     refine::RefineOptions upto = options;
     upto.max_level = static_cast<int>(1 + p.levels);
     for (std::uint32_t pass = 0; pass < p.levels; ++pass) {

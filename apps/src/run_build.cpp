@@ -231,17 +231,13 @@ Assembly assemble(const Scene& scene) {
 namespace {
 
 
-// takes its element's corner particles after the cut) but not refinement, whose new elements
-// would have none: a scene that refines is refused rather than given a term with holes.
+// The volume term of the materials that ask for it (volume_stiffness > 0). It follows cuts (a
+// stencil takes its element's corner particles after the cut) and refinement and coarsening (the
+// model's after_edits hook gives children their own stencils and retires the parent's), so a
+// scene that refines, before the run or during it, keeps it on its live elements.
 void add_volume_term(const Scene& scene, const std::vector<std::string>& material_names, physics::MssModel<3>& model) {
   std::vector<double> kappa;
-  for (const auto& name : material_names) {
-    kappa.push_back(scene.materials.at(name).volume_stiffness);
-    if (kappa.back() > 0 && scene.refinement.enabled)
-      throw SceneError(scene.file, "materials." + name + ".volume_stiffness",
-                       "the volume term is not supported with refinement yet (the elements refinement creates would have no "
-                       "volume stencils)");
-  }
+  for (const auto& name : material_names) kappa.push_back(scene.materials.at(name).volume_stiffness);
   // Materials past the scene's own are copies apply_rod_sections made for rod cells, which have
   // no volume to keep.
   kappa.resize(model.materials().size(), 0.0);

@@ -314,26 +314,39 @@ void CgWorkspace::resize(std::size_t n3) {
   q.resize(n3);
 }
 
-void block_jacobi_inverse(const BlockMatrix& A, std::span<const double> free_dof, std::span<double> inverse) {
-  for (Index i = 0; i < A.size(); ++i) {
-    Eigen::Matrix3d B = A.block(A.diagonal(i));
-    for (int a = 0; a < 3; ++a) {
-      if (free_dof[3 * i + a] != 0.0) continue;
-      B.row(a).setZero();
-      B.col(a).setZero();
-      B(a, a) = 1.0;
-    }
-    Eigen::Matrix3d inv;
-    bool invertible = false;
-    double det = 0;
-    B.computeInverseAndDetWithCheck(inv, det, invertible, 0.0);
-    if (!invertible || !inv.allFinite()) {
-      // Singular block (a node no term stiffens and without mass): fall back to Jacobi.
-      inv.setZero();
-      for (int a = 0; a < 3; ++a) inv(a, a) = B(a, a) != 0.0 ? 1.0 / B(a, a) : 1.0;
-    }
-    Eigen::Map<Eigen::Matrix3d>(inverse.data() + 9 * std::size_t{i}) = inv;
+namespace {
+
+// (S B S + I - S)⁻¹ of one diagonal block, S the node's free axes.
+Eigen::Matrix3d filtered_block_inverse(Eigen::Matrix3d B, const double* free_dof) {
+  for (int a = 0; a < 3; ++a) {
+    if (free_dof[a] != 0.0) continue;
+    B.row(a).setZero();
+    B.col(a).setZero();
+    B(a, a) = 1.0;
   }
+  Eigen::Matrix3d inv;
+  bool invertible = false;
+  double det = 0;
+  B.computeInverseAndDetWithCheck(inv, det, invertible, 0.0);
+  if (!invertible || !inv.allFinite()) {
+    // Singular block (a node no term stiffens and without mass): fall back to Jacobi.
+    inv.setZero();
+    for (int a = 0; a < 3; ++a) inv(a, a) = B(a, a) != 0.0 ? 1.0 / B(a, a) : 1.0;
+  }
+  return inv;
+}
+
+}  // namespace
+
+void block_jacobi_inverse(const BlockMatrix& A, std::span<const double> free_dof, std::span<double> inverse) {
+  for (Index i = 0; i < A.size(); ++i)
+    Eigen::Map<Eigen::Matrix3d>(inverse.data() + 9 * std::size_t{i}) = filtered_block_inverse(A.block(A.diagonal(i)), free_dof.data() + 3 * std::size_t{i});
+}
+
+void block_jacobi_inverse(std::span<const double> blocks, std::span<const double> free_dof, std::span<double> inverse) {
+  for (std::size_t i = 0; i < blocks.size() / 9; ++i)
+    Eigen::Map<Eigen::Matrix3d>(inverse.data() + 9 * i) =
+        filtered_block_inverse(Eigen::Map<const Eigen::Matrix3d>(blocks.data() + 9 * i), free_dof.data() + 3 * i);
 }
 
 CgResult filtered_pcg(const BlockMatrix& A, std::span<const double> b, std::span<double> x,

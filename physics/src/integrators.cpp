@@ -269,10 +269,11 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
   solve::SolveReport sr;
   try {
     if (slaves.reduces()) {
-      // T-junctions: block-Jacobi CG on the reduced system WᵀAW (the layer's backends take the
-      // full pattern; a reduced pattern for them is future work).
+      // T-junctions: block-Jacobi CG on the reduced system WᵀAW, preconditioned by its own
+      // diagonal blocks (the layer's backends take the full pattern; a reduced pattern for them
+      // is future work).
       AlignedVector<double> precond(9 * static_cast<std::size_t>(A.size()));
-      block_jacobi_inverse(A, free_, precond);
+      slaves.reduced_block_jacobi(A, free_, precond);
       const CgResult cg = slaves.solve_reduced(A, b_, dv_, free_, precond, opt_.cg_tolerance, opt_.cg_max_iterations);
       sr.iterations = cg.iterations;
       sr.relative_residual = cg.relative_residual;

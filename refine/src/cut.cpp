@@ -6,8 +6,10 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "hierarchy/bilinear.hpp"
+#include "hierarchy/neighbours.hpp"
 #include "hierarchy/sides.hpp"
 #include "sewn/refine/hierarchy.hpp"
 #include "sewn/refine/subdivide.hpp"
@@ -38,7 +40,8 @@ template <int D>
 std::vector<std::uint32_t> facet_points(const MssModel<D>& m, const Facet& f) {
   std::vector<std::uint32_t> pts;
   for (Dart x : facet_darts(m, f)) pts.push_back(m.point_of_node(m.node_of(x)));
-  if (f.index == 2) pts.push_back(m.point_of_node(m.node_of(m.map().beta(f.dart, 2))));
+  // an edge's other end: where the next dart of its face starts (β2 is null on a free edge)
+  if (f.index == 2) pts.push_back(m.point_of_node(m.node_of(m.map().beta(f.dart, 1))));
   std::sort(pts.begin(), pts.end());
   return pts;
 }
@@ -52,7 +55,7 @@ Vec3 facet_centroid(const MssModel<D>& m, const Facet& f) {
     ++n;
   }
   if (f.index == 2) {
-    c += m.rest_position(m.node_of(m.map().beta(f.dart, 2)));
+    c += m.rest_position(m.node_of(m.map().beta(f.dart, 1)));
     ++n;
   }
   return c / static_cast<double>(n);
@@ -173,12 +176,13 @@ bool holds_t_junction(const MssModel<D>& m, Dart s) {
 // are gone (what the map's split hooks do); a group in which no element has the vertex as a
 // corner holds only T-junctions of its elements: nothing would weigh that copy. Returns, for
 // each such group, its coarsest element, whose refinement makes the vertex a corner there (or
-// brings it one level closer). Facets of full dimension only (faces of 3-maps, edges of 2-maps):
-// the others (edges of membranes in 3-maps) are never refined. O(facet darts · vertex degree).
+// brings it one level closer). Faces between volumes and edges between 2D cells (of a 2-map or
+// membranes of a 3-map) alike. O(facet darts · vertex degree).
 template <int D>
 std::vector<Index> orphan_holders(const MssModel<D>& m, std::span<const Facet> facets) {
   const auto& map = m.map();
-  std::vector<Dart> cut_darts, starts;  // the darts whose β_D link the cut removes; those to group
+  std::vector<std::pair<int, Dart>> cut_darts;  // the links the cut removes: (β index, dart)
+  std::vector<Dart> starts;                     // the darts to group
   // per particle: 0 not looked at, 1 nothing to group, 2 holds a T-junction (each vertex is
   // walked once, though every facet around it names it)
   std::vector<std::uint8_t> vertex(m.nodes().size(), 0);
@@ -188,11 +192,10 @@ std::vector<Index> orphan_holders(const MssModel<D>& m, std::span<const Facet> f
     return v == 2;
   };
   for (const Facet& f : facets) {
-    if (f.index != D) continue;
     for (Dart x : facet_darts(m, f))
-      if (const Dart y = map.beta(x, D); !y.is_null()) {
-        cut_darts.push_back(x);
-        cut_darts.push_back(y);
+      if (const Dart y = map.beta(x, f.index); !y.is_null()) {
+        cut_darts.emplace_back(f.index, x);
+        cut_darts.emplace_back(f.index, y);
         // only vertices with a hierarchical dart can leave an orphan (a cut of an unrefined
         // model, the common case, ends here without grouping any vertex)
         if (needs_grouping(x)) starts.push_back(x);
@@ -200,9 +203,9 @@ std::vector<Index> orphan_holders(const MssModel<D>& m, std::span<const Facet> f
       }
   }
   if (starts.empty()) return {};
-  std::set<std::uint32_t> unsewn;
-  for (Dart x : cut_darts) unsewn.insert(x.index());
-  auto link = [&](Dart x, int j) { return j == D && unsewn.count(x.index()) ? Dart{} : map.beta(x, j); };
+  std::set<std::pair<int, std::uint32_t>> unsewn;
+  for (const auto& [j, x] : cut_darts) unsewn.emplace(j, x.index());
+  auto link = [&](Dart x, int j) { return unsewn.count({j, x.index()}) ? Dart{} : map.beta(x, j); };
   std::set<std::uint32_t> seen;
   std::vector<Index> out;
   for (Dart s : starts) {
@@ -240,14 +243,16 @@ std::vector<Index> orphan_holders(const MssModel<D>& m, std::span<const Facet> f
           coarsest = e;
       }
       if (!weighed && coarsest != invalid_index) out.push_back(coarsest);
-      // 3D: a vertex the cut splits must not end a side that holds T-junctions, nor be one: many
-      // elements share an edge, and a T-junction the cut leaves whole could stay on the sides of
-      // elements whose corners it separated, slaved to one side and off the other
+      // hexahedra: a vertex the cut splits must not end a side that holds T-junctions, nor be
+      // one: many hexahedra share an edge, and a T-junction the cut leaves whole could stay on the
+      // sides of elements whose corners it separated, slaved to one side and off the other
       if constexpr (D == 3)
         if (groups.size() > 1)
           for (Dart x : group) {
             const Index e = m.element_of(x);
-            if (e != invalid_index && (!m.is_corner_dart(x) || detail::edge_level(m, x) > m.elements()[e].level)) out.push_back(e);
+            if (e != invalid_index && m.elements()[e].kind == ElementKind::hexahedron &&
+                (!m.is_corner_dart(x) || detail::edge_level(m, x) > m.elements()[e].level))
+              out.push_back(e);
           }
     }
     groups.clear();
@@ -257,7 +262,7 @@ std::vector<Index> orphan_holders(const MssModel<D>& m, std::span<const Facet> f
 
 // The elements to refine before cutting `facets`: the coarser side of each facet on a level jump
 // and the holders of would-be massless copies (orphan_holders). Throws physics::InputError if
-// one is no quad of a 2-map or hexahedron (nothing else refines).
+// one is no quad or hexahedron (nothing else refines).
 template <int D>
 std::vector<Index> to_refine(const MssModel<D>& m, std::span<const Facet> facets) {
   std::vector<Index> out = orphan_holders(m, facets);
@@ -266,9 +271,9 @@ std::vector<Index> to_refine(const MssModel<D>& m, std::span<const Facet> facets
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   for (Index e : out)
-    if (m.elements()[e].kind != (D == 2 ? ElementKind::quad : ElementKind::hexahedron))
+    if (!detail::refinable_kind<D>(m.elements()[e].kind))
       throw InputError("cut: element " + std::to_string(e) +
-                       " holds T-junctions on the cut (a level jump) but cannot be refined to meet it (only quads of 2-maps and hexahedra are)");
+                       " holds T-junctions on the cut (a level jump) but cannot be refined to meet it (only quads and hexahedra are)");
   return out;
 }
 

@@ -2,12 +2,21 @@
 // the beam of the 2014 paper's Table 1 is pre-refined and refined adaptively.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <limits>
+#include <span>
 #include <fstream>
 #include <string>
 
+#include "sewn/apps/refine_keys.hpp"
 #include "sewn/apps/runner.hpp"
 #include "sewn/apps/scene.hpp"
+#include "sewn/physics/integrators.hpp"
+#include "sewn/physics/solids/volume_term.hpp"
+#include "sewn/refine/cut.hpp"
+#include "sewn/refine/hierarchy.hpp"
 
 using namespace sewn::app;
 using nlohmann::json;
@@ -107,11 +116,11 @@ TEST_CASE("scene refinement: what the model cannot take stops the run before it 
   j["refinement"] = json::parse(R"({"criteria": [{"type": "contact"}]})");
   CHECK(run_refused(j) == "refinement.criteria[0]: \"contact\" needs obstacles, and the scene has none");
   j["refinement"] = json::parse(R"({"pre_refine": [{"where": {"type": "box", "min": [5, 5, 5], "max": [6, 6, 6]}}]})");
-  CHECK(run_refused(j) == "refinement.pre_refine[0].where: holds the rest centroid of no hexahedron");
+  CHECK(run_refused(j) == "refinement.pre_refine[0].where: holds the rest centroid of no hexahedron or quad");
   json tets = beam_scene();
   tets["meshes"][0]["type"] = "tet_grid";
   tets["refinement"] = json::parse(R"({"pre_refine": [{"where": {"type": "all"}}]})");
-  CHECK(run_refused(tets).find("refinement: refines hexahedra, and the meshes have none") == 0);
+  CHECK(run_refused(tets).find("refinement: refines hexahedra (1:8) and quads (1:4), and the meshes have none") == 0);
   tets["model"] = json::parse(R"({"type": "solid"})");
   tets["damping"] = json::parse(R"({"model": "none"})");
   CHECK(run_refused(tets) == "refinement: refines the mass-spring model only (model.type is \"solid\")");
@@ -194,6 +203,167 @@ TEST_CASE("scene surface meshes: voxelized, refined, and skipped when optional a
   j["meshes"][0]["resolution"] = 1024;
   CHECK(refused(j).find("meshes[0].resolution: the scene needs about") == 0);
   std::filesystem::remove_all(dir);
+}
+
+namespace {
+
+// Signed volume of a hexahedron (VTK corner order) from its corners' positions, as six
+// tetrahedra around the diagonal 0-6: exact for any trilinear box with planar faces, and the
+// same measure at rest and deformed.
+double hex_volume(const std::array<Eigen::Vector3d, 8>& x) {
+  constexpr int tets[6][2] = {{1, 2}, {2, 3}, {3, 7}, {7, 4}, {4, 5}, {5, 1}};
+  double v = 0;
+  for (const auto& t : tets) v += (x[static_cast<std::size_t>(t[0])] - x[0]).cross(x[static_cast<std::size_t>(t[1])] - x[0]).dot(x[6] - x[0]) / 6;
+  return v;
+}
+
+// The live hexahedra's volume, at rest or now.
+double live_volume(const sewn::physics::MssModel<3>& m, bool rest) {
+  double v = 0;
+  for (sewn::physics::Index e = 0; e < m.elements().size(); ++e) {
+    if (!m.elements()[e].alive) continue;
+    const auto c = m.element_nodes(e);
+    std::array<Eigen::Vector3d, 8> x;
+    for (std::size_t k = 0; k < 8; ++k) x[k] = rest ? m.rest_position(c[k]) : m.nodes().position(c[k]);
+    v += hex_volume(x);
+  }
+  return v;
+}
+
+// The relative volume change of a soft 0.2 m cube on a clamped base under gravity after 0.4 s,
+// built as `sewn run` builds it (the volume term, then the refinement with its pre-refinement),
+// refined again after every step by a region criterion. Checks validate() and the hierarchy
+// after every refinement.
+double refined_cube_volume_change(double kappa) {
+  json j = json::parse(R"({
+    "materials": {"soft": {"young": 1e3, "poisson": 0.3, "density": 1000}},
+    "meshes": [{"type": "hex_grid", "material": "soft", "cells": [2, 2, 2], "size": [0.2, 0.2, 0.2]}],
+    "fixed": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 0.001]}}],
+    "integrator": {"type": "implicit", "step": 0.002}, "duration": 0.4,
+    "refinement": {"criteria": [{"type": "region", "where": {"type": "box", "min": [-1, -1, 0.1], "max": [1, 1, 1]}}],
+                   "max_level": 3, "pre_refine": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [0.1, 1, 1]}}]}
+  })");
+  j["materials"]["soft"]["volume_stiffness"] = kappa;
+  const Scene scene = parse_scene(j, "cube.json");
+  sewn::physics::MssOptions mo;
+  mo.gravity = Eigen::Vector3d(0, 0, -9.81);
+  sewn::physics::MssModel<3> m(sewn::hex_grid(2, 2, 2, {{0.1, 0.1, 0.1}, {}}), {{1e3, 0.3, 1000}}, {}, mo);
+  for (sewn::physics::Index i = 0; i < m.nodes().size(); ++i)
+    if (m.rest_position(i).z() < 1e-3) m.nodes().fix(i);
+  const std::vector<double> k{kappa};
+  (void)sewn::physics::solids::add_volume_preservation(m, k);
+  RefinementRun refinement(scene, m);
+  const double v0 = live_volume(m, true), mass0 = m.node_mass();
+  sewn::physics::LinearlyImplicitEuler euler;
+  for (int s = 0; s < 200; ++s) {
+    (void)euler.step(m.system(), scene.step);
+    if (refinement.after_step(m, scene.step * (s + 1))) {
+      const auto report = m.map().validate();
+      INFO(report.str());
+      REQUIRE(report.ok());
+      const auto h = sewn::refine::check_hierarchy(m);
+      INFO(h.str());
+      REQUIRE(h.ok());
+      REQUIRE(std::abs(live_volume(m, true) - v0) <= 1e-12 * v0);
+      REQUIRE(std::abs(m.node_mass() - mass0) <= 1e-12 * mass0);
+    }
+  }
+  CHECK(refinement.refined() > 2);
+  return (live_volume(m, false) - v0) / v0;
+}
+
+}  // namespace
+
+TEST_CASE("scene refinement with a volume term: the children keep the volume within the load over the bulk stiffness") {
+  // a 1 kPa cube 0.2 m high under its own weight: the pressure at its base is ρgH = 1962 Pa
+  const double rho_g_h = 1000 * 9.81 * 0.2, kappa = 1e5;
+  const double kept = refined_cube_volume_change(kappa), free = refined_cube_volume_change(0);
+  MESSAGE("relative volume change with kappa = 1e5 Pa: " << kept << ", without the term: " << free);
+  // a suddenly applied load at most doubles its static response (no pressure above ρgH anywhere)
+  CHECK(std::abs(kept) <= 2 * rho_g_h / kappa);
+  CHECK(std::abs(free) > 2 * rho_g_h / kappa);
+}
+
+namespace {
+
+// Distance from p to the polyline through `pts` (in the xz plane of the sheet).
+double to_path(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3d>& pts) {
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k + 1 < pts.size(); ++k) {
+    const Eigen::Vector3d u = pts[k + 1] - pts[k];
+    const double t = std::clamp((p - pts[k]).dot(u) / u.squaredNorm(), 0.0, 1.0);
+    best = std::min(best, (p - pts[k] - t * u).norm());
+  }
+  return best;
+}
+
+}  // namespace
+
+TEST_CASE("scenes/refine_fig08_cut_path.json: membrane quads refined where the cut strains the sheet, and only there") {
+  const Scene scene = load_scene(std::string(SEWN_SOURCE_DIR) + "/scenes/refine_fig08_cut_path.json");
+  REQUIRE(scene.cuts.size() == 1);
+  // `sewn run` itself, briefly: it cuts, refines and finishes
+  RunOptions o;
+  o.quiet = true;
+  o.until = 0.4;
+  o.out = std::filesystem::temp_directory_path() / "sewn_refine_keys_fig08";
+  const RunSummary run_summary = run(scene, o);
+  CHECK(run_summary.cuts == 1);
+  CHECK(run_summary.refined > 0);
+
+  // the same model built as the runner builds it, to look inside after every change
+  const Assembly a = assemble(scene);
+  const MaterialSpec& ms = scene.materials.at("sheet");
+  sewn::physics::MssOptions mo;
+  mo.gravity = Eigen::Vector3d(scene.gravity[0], scene.gravity[1], scene.gravity[2]);
+  sewn::physics::MssModel<3> m(a.mesh, {{ms.young, ms.poisson, ms.density, ms.thickness}}, {}, mo);
+  for (sewn::physics::Index i = 0; i < m.nodes().size(); ++i) {
+    const Eigen::Vector3d r = m.rest_position(i);
+    if (r.x() < 1e-3 || r.x() > 1 - 1e-3 || r.z() < 1e-3 || r.z() > 1 - 1e-3) m.nodes().fix(i);  // the scene's 4 boxes
+  }
+  RefinementRun refinement(scene, m);
+  std::vector<Eigen::Vector3d> path;  // the cut's rest polyline, from its edges' mesh points
+  for (const auto& edge : scene.cuts[0].faces) {
+    const auto& q = a.mesh.points[edge[0]];
+    path.emplace_back(q[0], q[1], q[2]);
+  }
+  const auto& last = a.mesh.points[scene.cuts[0].faces.back()[1]];
+  path.emplace_back(last[0], last[1], last[2]);
+  const double mass0 = m.node_mass();
+  auto check_model = [&] {
+    const auto report = m.map().validate();
+    INFO(report.str());
+    REQUIRE(report.ok());
+    const auto h = sewn::refine::check_hierarchy(m);
+    INFO(h.str());
+    REQUIRE(h.ok());
+    REQUIRE(std::abs(m.node_mass() - mass0) <= 1e-12 * mass0);
+  };
+  sewn::physics::LinearlyImplicitEuler euler;
+  const int cut_step = static_cast<int>(std::lround(scene.cuts[0].time / scene.step));
+  for (int s = 0; s < 400; ++s) {
+    if (s == cut_step) {
+      CHECK(refinement.refined() == 0);  // the sag alone strains no diagonal past the threshold
+      const auto facets = sewn::refine::facets_with_points(m, std::span(scene.cuts[0].faces));
+      REQUIRE(facets.size() == scene.cuts[0].faces.size());
+      CHECK(sewn::refine::cut(m, std::span(facets)).facets == facets.size());
+      check_model();
+    }
+    (void)euler.step(m.system(), scene.step);
+    if (refinement.after_step(m, scene.step * (s + 1))) check_model();
+  }
+  REQUIRE(refinement.refined() > 0);
+  CHECK(refinement.refined() == run_summary.refined);  // the runner's own run did the same
+  // every element refined lies by the cut: within two coarse cells (0.1 m) of the path at rest
+  int finer = 0;
+  for (sewn::physics::Index e = 0; e < m.elements().size(); ++e) {
+    if (!m.elements()[e].alive || m.elements()[e].level == 1) continue;
+    ++finer;
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (sewn::physics::Index n : m.element_nodes(e)) c += m.rest_position(n) / 4;
+    CHECK(to_path(c, path) < 0.1);
+  }
+  CHECK(finer >= 4);
 }
 
 }  // namespace refine_keys_test

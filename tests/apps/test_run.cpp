@@ -406,9 +406,17 @@ TEST_CASE("materials' volume_stiffness keeps the soft region of the column from 
   CHECK(cut.cuts == 2);
   CHECK(cut.inverted_max == 0);
   CHECK(column(header, cut_rows.back(), "elements") == 20.0);  // 24 less the 4 pierced away
-  // refinement would create elements the term has no stencils for: refused, naming the key
-  expect_run_error<SceneError>(volume_column + R"(, "refinement": {"criteria": [{"type": "diagonal_strain", "threshold": 1.2}], "max_level": 2})" + rest,
-                               "materials.soft.volume_stiffness");
+  // with refinement: the children get their own stencils (tests/apps/test_refine_keys.cpp
+  // checks the volume kept), and the column still stands
+  std::vector<std::vector<double>> refined_rows;
+  const RunSummary refined = run_text(volume_column + R"(, "refinement": {"criteria": [{"type": "diagonal_strain", "threshold": 1.2}], "max_level": 2})" + rest,
+                                      "column_volume_refined", header, refined_rows);
+  CHECK(refined.refined > 0);
+  CHECK(refined.inverted_max == 0);
+  const auto& end = refined_rows.back();
+  CHECK(column(header, end, "total_energy") ==
+        doctest::Approx(column(header, end, "kinetic_energy") + column(header, end, "elastic_energy") +
+                        column(header, end, "gravity_energy")).epsilon(1e-12));
   expect_run_error<SceneError>(R"({"materials": {"m": {"young": 1e6, "density": 1000, "volume_stiffness": -1}},
                                    "meshes": [{"type": "hex_grid", "cells": [1, 1, 1], "size": [1, 1, 1], "material": "m"}]})",
                                "materials.m.volume_stiffness");

@@ -171,6 +171,26 @@ TEST_CASE("Fig. 5 and Fig. 6 through the cutting API") {
   CHECK_THROWS_WITH_AS(facets_with_points(m, std::span(bottom)), doctest::Contains("boundary"), InputError);
 }
 
+template <int D>
+void edges_by_points() {
+  // a 2 x 1 grid of quads (points i + 3 j): the inner edge x = 1, a boundary edge, both ends
+  MssModel<D> m(sewn::quad_grid(2, 1, {{0.1, 0.1, 1}, {}}), {paper_material}, {}, options(false));
+  const std::vector<std::vector<std::uint32_t>> inner{{1, 4}}, boundary{{0, 1}};
+  const auto facets = facets_with_points(m, std::span(inner));
+  REQUIRE(facets.size() == 1);
+  CHECK(facets[0].index == 2);
+  CHECK(cut(m, std::span(facets)).facets == 1);
+  check_consistent(m);
+  // named again: already cut, so nothing; a boundary edge (β2 free) is an error, not a crash
+  CHECK(facets_with_points(m, std::span(inner)).empty());
+  CHECK_THROWS_WITH_AS(facets_with_points(m, std::span(boundary)), doctest::Contains("boundary"), InputError);
+}
+
+TEST_CASE("edges of 2D cells named by their points: a 2-map and membranes of a 3-map") {
+  edges_by_points<2>();
+  edges_by_points<3>();
+}
+
 TEST_CASE("selections: faces among a path of particles, faces across a plane within a region, elements in a region") {
   const double a = 0.05;
   const IndexedMesh mesh = hex_grid(10, 2, 2, {{a, a, a}, {}});

@@ -256,4 +256,37 @@ TEST_CASE("adaptive refinement: the docs/refinement.md example runs and refines 
   CHECK(beam.map().validate().ok());
 }
 
+TEST_CASE("T-junctions: the reduced solve's preconditioner is the diagonal blocks of W^T D W, nested slaves included") {
+  // particle 2 on the edge 0-1, particle 3 nested on the edge 2-4: W's rows are
+  // e2 = (e0 + e1)/2 and e3 = e2/4 + 3 e4/4 = e0/8 + e1/8 + 3 e4/4
+  SlaveNodes sn;
+  sn.set({{2, {0, 1, invalid_index, invalid_index}, {0.5, 0.5, 0, 0}, 2}, {3, {2, 4, invalid_index, invalid_index}, {0.25, 0.75, 0, 0}, 2}});
+  BlockMatrix A;
+  A.build_pattern(5, {});
+  std::array<Eigen::Matrix3d, 5> d;
+  for (Index i = 0; i < 5; ++i) {
+    Eigen::Matrix3d r;
+    r << 1.0 + i, 0.2, -0.1, 0.3 * i, 2.0, 0.4, 0.1, -0.2, 3.0 + 0.5 * i;
+    d[i] = r * r.transpose() + Eigen::Matrix3d::Identity();  // symmetric positive definite
+    A.block(A.diagonal(i)) = d[i];
+  }
+  const std::vector<double> free(15, 1.0);
+  std::vector<double> inverse(45);
+  sn.reduced_block_jacobi(A, free, inverse);
+  const std::array<Eigen::Matrix3d, 3> expected = {d[0] + 0.25 * d[2] + d[3] / 64, d[1] + 0.25 * d[2] + d[3] / 64, d[4] + 0.5625 * d[3]};
+  const std::array<Index, 3> masters = {0, 1, 4};
+  for (std::size_t k = 0; k < 3; ++k) {
+    const Eigen::Matrix3d inv = Eigen::Map<const Eigen::Matrix3d>(inverse.data() + 9 * masters[k]);
+    CHECK((inv * expected[k] - Eigen::Matrix3d::Identity()).norm() <= 1e-12);
+  }
+  // a fixed axis is filtered out as block_jacobi_inverse does: identity on it
+  std::vector<double> held = free;
+  held[3 * 4 + 2] = 0;
+  sn.reduced_block_jacobi(A, held, inverse);
+  const Eigen::Matrix3d inv4 = Eigen::Map<const Eigen::Matrix3d>(inverse.data() + 36);
+  CHECK(std::abs(inv4(2, 2) - 1.0) <= 1e-12);  // the 3x3 inverse by cofactors rounds
+  CHECK(inv4(0, 2) == 0.0);
+  CHECK((inv4.topLeftCorner<2, 2>() * expected[2].topLeftCorner<2, 2>() - Eigen::Matrix2d::Identity()).norm() <= 1e-12);
+}
+
 }  // namespace test_t_junctions

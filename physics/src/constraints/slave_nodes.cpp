@@ -189,6 +189,18 @@ void SlaveNodes::remap(std::span<const Index> old_to_new) {
   shares_ = std::move(kept_shares);
 }
 
+void SlaveNodes::reduced_block_jacobi(const BlockMatrix& A, std::span<const double> free_dof, std::span<double> inverse) {
+  blocks_.resize(9 * static_cast<std::size_t>(A.size()));
+  for (Index i = 0; i < A.size(); ++i) Eigen::Map<Eigen::Matrix3d>(blocks_.data() + 9 * std::size_t{i}) = A.block(A.diagonal(i));
+  // fine to coarse: a slave that masters finer ones holds their shares when it passes its own on
+  for (auto s = slaves_.rbegin(); s != slaves_.rend(); ++s) {
+    const Eigen::Map<const Eigen::Matrix3d> own(blocks_.data() + 9 * std::size_t{s->node});
+    for (int k = 0; k < s->masters; ++k)
+      Eigen::Map<Eigen::Matrix3d>(blocks_.data() + 9 * std::size_t{s->master[k]}) += s->weight[k] * s->weight[k] * own;
+  }
+  block_jacobi_inverse(std::span<const double>(blocks_), free_dof, inverse);
+}
+
 CgResult SlaveNodes::solve_reduced(const BlockMatrix& A, std::span<const double> b, std::span<double> x,
                                    std::span<const double> free_dof, std::span<const double> precond_inverse,
                                    double tolerance, int max_iterations) {

@@ -80,6 +80,39 @@ void retie_t_junctions(MssModel<D>& m, Index p) {
   update_t_junctions(m, std::span<const Index>(&p, 1));
 }
 
+// A hexahedron family of a 3-map: no cut between siblings nor one stopping the removals.
+template <int D, class No>
+bool can_coarsen_hex(const MssModel<D>& m, Index p, const No& no) {
+  const Element& el = m.elements()[p];
+  // a cut between siblings: an interior face (all hold the centre) left free
+  const Index centre = m.element_nodes(el.first_child)[6];
+  for (Index c = el.first_child; c < el.first_child + 8; ++c)
+    for (Dart x : m.map().template cell<3>(m.elements()[c].dart))
+      if (m.node_of(x) == centre && m.map().beta(x, 3).is_null())
+        return no("has a cut between its children (child " + std::to_string(c) + "): a cut family stays refined");
+  if (const std::string conflict = detail::hex_cut_conflict(m, p); !conflict.empty()) return no(conflict);
+  return true;
+}
+
+// A quad family (2-map, or membrane of a 3-map): no cut between siblings nor one stopping the
+// removal of a side midpoint.
+template <int D, class No>
+bool can_coarsen_quad(const MssModel<D>& m, Index p, const No& no) {
+  const Element& el = m.elements()[p];
+  // a cut between siblings: an interior edge (from the centre) left free
+  const Index centre = m.element_nodes(el.first_child)[2];
+  for (Index c = el.first_child; c < el.first_child + 4; ++c) {
+    Dart x = m.elements()[c].dart;
+    do {
+      const Dart next = m.map().beta(x, 1);
+      if ((m.node_of(x) == centre || m.node_of(next) == centre) && m.map().beta(x, 2).is_null())
+        return no("has a cut between its children (child " + std::to_string(c) + "): a cut family stays refined");
+      x = next;
+    } while (x != m.elements()[c].dart);
+  }
+  return side_midpoints_removable(m, p, no);
+}
+
 }  // namespace
 
 template <int D>
@@ -99,27 +132,9 @@ bool can_coarsen(const MssModel<D>& m, Index p, std::string* why) {
     if (ch.first_child != physics::invalid_index) return no("has child " + std::to_string(c) + " refined further: coarsen it first");
     if (!ch.alive) return no("has child " + std::to_string(c) + " removed");
   }
-  if constexpr (D == 3) {  // a cut between siblings: an interior face (all hold the centre) left free
-    const Index centre = m.element_nodes(el.first_child)[6];
-    for (Index c = el.first_child; c < el.first_child + 8; ++c)
-      for (Dart x : m.map().template cell<3>(m.elements()[c].dart))
-        if (m.node_of(x) == centre && m.map().beta(x, 3).is_null())
-          return no("has a cut between its children (child " + std::to_string(c) + "): a cut family stays refined");
-    if (const std::string conflict = detail::hex_cut_conflict(m, p); !conflict.empty()) return no(conflict);
-    return true;
-  }
-  // a cut between siblings: an interior edge (from the centre) left free
-  const Index centre = m.element_nodes(el.first_child)[2];
-  for (Index c = el.first_child; c < el.first_child + 4; ++c) {
-    Dart x = m.elements()[c].dart;
-    do {
-      const Dart next = m.map().beta(x, 1);
-      if ((m.node_of(x) == centre || m.node_of(next) == centre) && m.map().beta(x, 2).is_null())
-        return no("has a cut between its children (child " + std::to_string(c) + "): a cut family stays refined");
-      x = next;
-    } while (x != m.elements()[c].dart);
-  }
-  return side_midpoints_removable(m, p, no);
+  if constexpr (D == 3)
+    if (hex) return can_coarsen_hex(m, p, no);
+  return can_coarsen_quad(m, p, no);
 }
 
 template <int D>
@@ -127,11 +142,14 @@ CoarsenReport coarsen(MssModel<D>& m, Index p) {
   std::string why;
   if (!can_coarsen(m, p, &why)) throw physics::InputError(why);
   CoarsenReport report;
-  if constexpr (D == 3) {
-    report = detail::coarsen_hex(m, p);
-    retie_t_junctions(m, p);
-  } else {
-    using A = detail::ModelAccess<2>;
+  if constexpr (D == 3)
+    if (m.elements()[p].kind == ElementKind::hexahedron) {
+      report = detail::coarsen_hex(m, p);
+      retie_t_junctions(m, p);
+      return report;
+    }
+  {
+    using A = detail::ModelAccess<D>;
     auto& map = A::map(m);
     physics::NodeTable& nodes = m.nodes();
     const Element parent = m.elements()[p];

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "hierarchy/neighbours.hpp"
 #include "sewn/physics/errors.hpp"
 #include "sewn/refine/hierarchy.hpp"
 
@@ -41,14 +42,15 @@ bool DiagonalStrain<D>::allows_coarsening(const MssModel<D>& m, Index e) const {
 
 template <int D>
 RefineReport adapt(MssModel<D>& m, const Criterion<D>& criterion, const RefineOptions& options, std::vector<Index>* chosen_out) {
-  const physics::ElementKind regular = D == 2 ? physics::ElementKind::quad : physics::ElementKind::hexahedron;
   std::vector<Index> chosen;
+  std::uint64_t after = m.num_live_elements();
   for (Index e = 0; e < m.elements().size(); ++e) {
     const physics::Element& el = m.elements()[e];
-    if (el.alive && el.kind == regular && level_index(el.level) < options.max_level && criterion.wants_refinement(m, e))
+    if (el.alive && detail::refinable_kind<D>(el.kind) && level_index(el.level) < options.max_level && criterion.wants_refinement(m, e)) {
       chosen.push_back(e);
+      after += el.kind == physics::ElementKind::hexahedron ? 7 : 3;  // children replace the parent
+    }
   }
-  const std::uint64_t after = m.num_live_elements() + (D == 2 ? 3 : 7) * std::uint64_t{chosen.size()};
   if (after > options.max_elements)
     throw physics::InputError("adaptive refinement: refining the " + std::to_string(chosen.size()) + " elements the criterion picks would leave " +
                               std::to_string(after) + " live elements, more than the limit of " + std::to_string(options.max_elements));

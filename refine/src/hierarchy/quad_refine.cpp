@@ -16,9 +16,22 @@ using physics::ElementKind;
 // {0,1}, {3,2}, {1,2}, {0,3}).
 constexpr std::array<int, 4> side_from = {0, 2, 1, 3};
 
-class QuadRefiner : RefinerBase<2> {
+// A quad of a 2-map, or a membrane quad of a 3-map (a face with no volume): the same ring
+// walks and insertions, the 3-map's β3 being free on it.
+template <int D>
+class QuadRefiner : RefinerBase<D> {
+  using Base = RefinerBase<D>;
+  using typename Base::A;
+  using typename Base::Vec3;
+  using Base::m_;
+  using Base::map_;
+  using Base::insert_vertex;
+  using Base::mean;
+  using Base::new_spring;
+  using Base::retire;
+
  public:
-  using RefinerBase<2>::RefinerBase;
+  using Base::Base;
 
   void run(Index e) {
     A::grow_darts(m_);
@@ -102,6 +115,12 @@ class QuadRefiner : RefinerBase<2> {
 
 }  // namespace
 
-void refine_quad(physics::MssModel<2>& m, physics::Index e, RefineReport& report) { QuadRefiner(m, report).run(e); }
+template <int D>
+void refine_quad(physics::MssModel<D>& m, physics::Index e, RefineReport& report) {
+  QuadRefiner<D>(m, report).run(e);
+}
+
+template void refine_quad(physics::MssModel<2>&, physics::Index, RefineReport&);
+template void refine_quad(physics::MssModel<3>&, physics::Index, RefineReport&);
 
 }  // namespace sewn::refine::detail

@@ -109,7 +109,9 @@ class RefinerBase {
   RefineReport& report_;
 };
 
-void refine_quad(physics::MssModel<2>& m, physics::Index e, RefineReport& report);
+/// 1:4: a quad of a 2-map or a membrane quad of a 3-map.
+template <int D>
+void refine_quad(physics::MssModel<D>& m, physics::Index e, RefineReport& report);
 void refine_hex(physics::MssModel<3>& m, physics::Index e, RefineReport& report);
 
 }  // namespace sewn::refine::detail

@@ -29,11 +29,10 @@ void check_refinable(const MssModel<D>& m, Index e, const RefineOptions& o) {
   const Element& el = m.elements()[e];
   if (el.first_child != physics::invalid_index) throw InputError(name + " is already refined");
   if (!el.alive) throw InputError(name + " was removed (a dead element cannot be refined)");
-  const ElementKind regular = D == 2 ? ElementKind::quad : ElementKind::hexahedron;
-  if (el.kind != regular) {
+  if (!detail::refinable_kind<D>(el.kind)) {
     const char* kinds[] = {"hexahedron", "tetrahedron", "quad", "triangle", "segment"};
     throw InputError(name + " is a " + kinds[static_cast<int>(el.kind)] + ": only " +
-                     (D == 2 ? "quads of a 2-map (1:4)" : "hexahedra of a 3-map (1:8)") + " are refined regularly");
+                     (D == 2 ? "quads (1:4)" : "hexahedra (1:8) and membrane quads (1:4)") + " are refined regularly");
   }
   if (level_index(el.level) + 1 > o.max_level)
     throw InputError(name + " is at level " + std::to_string(level_index(el.level)) +
@@ -45,8 +44,9 @@ void refine_one(MssModel<D>& m, Index e, RefineReport& report) {
   detail::ModelAccess<D>::set_refining(m, true);
   try {
     m.edit([&](auto&) {
-      if constexpr (D == 2) detail::refine_quad(m, e, report);
-      else detail::refine_hex(m, e, report);
+      if constexpr (D == 3)
+        if (m.elements()[e].kind == ElementKind::hexahedron) return detail::refine_hex(m, e, report);
+      detail::refine_quad(m, e, report);
     });
   } catch (...) {
     detail::ModelAccess<D>::set_refining(m, false);

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "hierarchy/bilinear.hpp"
+#include "hierarchy/neighbours.hpp"
 #include "hierarchy/segment_walk.hpp"
 #include "hierarchy/sides.hpp"
 #include "sewn/refine/hierarchy.hpp"
@@ -138,7 +139,7 @@ void update_t_junctions(MssModel<D>& m, std::span<const Index> changed) {
   std::vector<Index> els;
   for (Index e : changed) {
     if (e >= m.elements().size() || !m.elements()[e].alive) continue;
-    for (Dart x : m.map().template cell<D>(m.elements()[e].dart)) {
+    for (Dart x : detail::element_darts(m, e)) {
       if (std::exchange(again[m.node_of(x)], 1)) continue;
       for (Dart y : m.map().template cell<0>(x))
         if (const Index n = m.element_of(y); n != physics::invalid_index && m.elements()[n].alive) els.push_back(n);

@@ -21,6 +21,8 @@ struct CgResult {
 /// Inverses of the filtered 3×3 diagonal blocks, (S A_ii S + I - S)⁻¹, 9 per node
 /// (column-major), for block-Jacobi preconditioning. free_dof is 1 on free axes, 0 on fixed. O(n).
 void block_jacobi_inverse(const BlockMatrix& A, std::span<const double> free_dof, std::span<double> inverse);
+/// The same for given 3×3 blocks (column-major, 9 per node), e.g. those of a reduced system. O(n).
+void block_jacobi_inverse(std::span<const double> blocks, std::span<const double> free_dof, std::span<double> inverse);
 
 /// Work arrays reused between solves (no allocation once sized).
 struct CgWorkspace {

@@ -43,12 +43,13 @@ struct RefineReport {
   std::vector<Index> children;  ///< the new elements, 4 per refined element, in refinement order
 };
 
-/// Refines element e: a quad of a 2-map 1:4, a hexahedron of a 3-map 1:8. Returns its children
+/// Refines element e: a quad 1:4 (a face of a 2-map, or a membrane of a 3-map: a face with no
+/// volume, as `sewn run` builds 2D meshes), a hexahedron of a 3-map 1:8. Returns its children
 /// (Element::first_child .. +3 or +7; quad child k has the parent's k-th corner in β1 order as
 /// its local vertex 0, hexahedron child v holds the parent's corner v as its local vertex v).
 /// Throws physics::InputError, the model unchanged, for an element that does not exist, was removed or refined, is not a quad
-/// (2D) or hexahedron (3D) — triangles, tetrahedra, quads of a 3-map have no regular refinement
-/// here — or whose children would pass options.max_level. Invalidates nothing held by the
+/// or hexahedron — triangles and tetrahedra have no regular refinement here — or whose children
+/// would pass options.max_level. Invalidates nothing held by the
 /// caller (particles, springs and elements are appended; the parent stays, not alive).
 /// O(darts of the element and of the paths its insertions walk) plus the model's resync of the
 /// touched particles and the incremental update of the T-junction constraints (update_t_junctions:
@@ -61,7 +62,7 @@ RefineReport refine_element(MssModel<D>& m, Index e, const RefineOptions& option
 template <int D>
 RefineReport refine_elements(MssModel<D>& m, std::span<const Index> elements, const RefineOptions& options = {});
 
-/// True if no two live elements sharing an edge (quads of a 2-map, hexahedra of a 3-map) differ
+/// True if no two live elements sharing an edge (quads, hexahedra) differ
 /// by more than one level (2:1 balance); otherwise `why` names the first such pair. O(darts ·
 /// edge degree).
 template <int D>

@@ -95,8 +95,16 @@ class SlaveNodes {
   /// Renumbers after System::compact_nodes() (old -> new; a removed slave or master drops the slave).
   void remap(std::span<const Index> old_to_new);
 
+  /// The block-Jacobi preconditioner of the reduced system: the inverses (9 per node, as
+  /// block_jacobi_inverse) of the diagonal blocks of Wᵀ D W, D the block diagonal of A: each
+  /// master's own block plus w² times each of its slaves' (passed fine to coarse, so a nested
+  /// slave's share reaches the particles that move; exact when each slave reaches a master by
+  /// one path). Without the slaves' shares a master of many T-junctions is preconditioned by a
+  /// block far lighter than its row of WᵀAW. O(n + slaves).
+  void reduced_block_jacobi(const BlockMatrix& A, std::span<const double> free_dof, std::span<double> inverse);
+
   /// Solves (Wᵀ A W) z = Wᵀ b on the free master axes (free_dof 0 on fixed axes), by block-Jacobi
-  /// PCG with A's diagonal blocks as preconditioner, and returns x = W z; x holds the warm start
+  /// PCG (precond_inverse: from reduced_block_jacobi), and returns x = W z; x holds the warm start
   /// on entry. O(iterations · blocks).
   CgResult solve_reduced(const BlockMatrix& A, std::span<const double> b, std::span<double> x,
                          std::span<const double> free_dof, std::span<const double> precond_inverse, double tolerance,
@@ -108,7 +116,7 @@ class SlaveNodes {
   SlaveTreatment treatment_ = SlaveTreatment::reduction;
   void lump(const NodeTable& nodes, std::vector<double>& lumped) const;  // lumped_masses into a buffer
 
-  std::vector<double> inv_mass_, lumped_, r_, z_, p_, q_, ap_, free_;
+  std::vector<double> inv_mass_, lumped_, r_, z_, p_, q_, ap_, free_, blocks_;
 };
 
 }  // namespace sewn::physics
