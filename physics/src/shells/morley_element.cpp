@@ -8,6 +8,7 @@
 
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/shells/hinge_element.hpp"
+#include "plate_quadratic.hpp"
 
 namespace sewn::physics::shells {
 
@@ -40,36 +41,9 @@ MorleyRest morley_rest(const MorleyPositions& X, const std::array<MorleyEdge, 3>
   }
   MorleyRest r;
   r.kind = kind;
-  const Eigen::Vector3d e1 = X.col(1) - X.col(0), e2 = X.col(2) - X.col(0);
-  const Eigen::Vector3d n = e1.cross(e2);
-  const double area = 0.5 * n.norm();
-  const double longest2 = std::max({e1.squaredNorm(), e2.squaredNorm(), (X.col(2) - X.col(1)).squaredNorm()});
-  if (!std::isfinite(area) || !(area > 1e-12 * longest2)) {
-    std::ostringstream s;
-    s << "Morley bending: degenerate rest triangle (area " << area << " m^2)";
-    throw InputError(s.str());
-  }
-  // gradients of the barycentric coordinates in T's rest plane
-  const Eigen::Vector3d u = e1.normalized(), v = n.normalized().cross(u);
-  Eigen::Matrix2d Dm;
-  Dm << e1.dot(u), e2.dot(u), e1.dot(v), e2.dot(v);
-  const Eigen::Matrix2d Dm_inv = Dm.inverse();
-  Eigen::Matrix<double, 2, 3> grad;
-  grad.col(1) = Dm_inv.row(0).transpose();
-  grad.col(2) = Dm_inv.row(1).transpose();
-  grad.col(0) = -grad.col(1) - grad.col(2);
-  std::array<Eigen::Matrix2d, 3> B;  // ∇²b_m
-  for (int mm = 0; mm < 3; ++mm) {
-    const Eigen::Vector2d ga = grad.col((mm + 1) % 3), gb = grad.col((mm + 2) % 3);
-    B[static_cast<std::size_t>(mm)] = ga * gb.transpose() + gb * ga.transpose();
-  }
-  Eigen::Matrix3d Q;  // E = ½ cᵀ Q c
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) {
-      const auto& Ba = B[static_cast<std::size_t>(a)];
-      const auto& Bb = B[static_cast<std::size_t>(b)];
-      Q(a, b) = area * m.stiffness * ((1.0 - m.poisson) * (Ba * Bb).trace() + m.poisson * Ba.trace() * Bb.trace());
-    }
+  const detail::PlateQuadratic pq = detail::plate_quadratic(X.leftCols<3>(), m, "Morley bending");
+  const double area = pq.area;
+  const Eigen::Matrix3d& Q = pq.Q;
   Eigen::Matrix3d G;  // c = G Δs
   for (int mm = 0; mm < 3; ++mm)
     for (int i = 0; i < 3; ++i) {
