@@ -25,11 +25,11 @@ void check_cuts(const Scene& scene, const std::vector<CellModel>& models) {
                      "cutting is supported on solid tetrahedra and shells only, and this scene has " + std::to_string(rods) +
                          " rod segments (a rod's stencils and twist angles cannot follow a cut yet)");
   const auto shells = std::count(models.begin(), models.end(), CellModel::shell);
-  if (shells > 0 && scene.bending == "patch")
+  if (shells > 0 && scene.bending != "hinge")
     throw SceneError(scene.file, "model.bending",
-                     "this scene cuts " + std::to_string(shells) +
-                         " shell triangles, which \"patch\" bending cannot follow yet (a triangle's patch holds its "
-                         "neighbours' nodes): use \"hinge\"");
+                     "this scene cuts " + std::to_string(shells) + " shell triangles, which \"" + scene.bending +
+                         "\" bending cannot follow yet (a triangle's bending element holds its neighbours' nodes"
+                         " and its edges' angles): use \"hinge\"");
 }
 
 // Checks what a continuum model cannot take and removes the springs it replaces.
@@ -171,7 +171,7 @@ std::vector<HingeCorners> hinge_corners(const physics::shells::Hinges& hinges, c
 }
 
 void add_shells(const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh, const std::vector<CellModel>& models,
-                physics::MssModel<3>& model, const Scene& scene, ContinuumParts& parts) {
+                physics::MssModel<3>& model, const Scene& scene, std::span<const std::uint8_t> held, ContinuumParts& parts) {
   std::vector<std::array<Index, 3>> triangles;
   std::vector<double> k_b;
   std::vector<physics::shells::PlateMaterial> plates;
@@ -189,9 +189,22 @@ void add_shells(const std::vector<physics::MaterialParams>& materials, const Ind
     plates.push_back(physics::shells::plate_material(mat.young, mat.poisson, mat.thickness));
   }
   if (triangles.empty()) return;
+  // a triangle held on every node is a clamp: its edges hold the slope of the free triangles
+  std::vector<std::uint8_t> clamp(triangles.size(), 0);
+  if (!held.empty())
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      clamp[t] = held[triangles[t][0]] != 0 && held[triangles[t][1]] != 0 && held[triangles[t][2]] != 0;
+  if (scene.bending == "morley" && scene.integrator != "newton")
+    throw SceneError(scene.file, "model.bending",
+                     "\"morley\" bending gives every shell edge an angle DOF, which integrator.type \"newton\" alone "
+                     "integrates (this scene's is \"" + scene.integrator + "\"): use \"newton\", or \"patch\" or \"hinge\" bending");
   try {
+    if (scene.bending == "morley") {
+      parts.morley = physics::shells::add_morley_bending(model.system(), triangles, rest_state(model), plates, clamp);
+      return;
+    }
     if (scene.bending == "patch") {
-      parts.patches = physics::shells::add_patch_bending(model.system(), triangles, rest_state(model), plates);
+      parts.patches = physics::shells::add_patch_bending(model.system(), triangles, rest_state(model), plates, clamp);
       return;
     }
     parts.hinges = &model.system().add<physics::shells::Hinges>();
@@ -239,12 +252,16 @@ void apply_rod_sections(const Scene& scene, const IndexedMesh& mesh, const std::
 }
 
 ContinuumParts build_continuum(const Scene& scene, const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh,
-                               const std::vector<CellModel>& models, const std::vector<int>& groups, physics::MssModel<3>& model) {
+                               const std::vector<CellModel>& models, const std::vector<int>& groups, physics::MssModel<3>& model,
+                               std::span<const std::uint8_t> held) {
+  if (!held.empty() && held.size() != model.nodes().size())
+    throw physics::InputError("build_continuum: " + std::to_string(held.size()) + " held flags for " +
+                              std::to_string(model.nodes().size()) + " nodes");
   check_cuts(scene, models);
   drop_springs(scene, model);
   ContinuumParts parts;
   add_solids(materials, mesh, models, model, scene, parts);
-  add_shells(materials, mesh, models, model, scene, parts);
+  add_shells(materials, mesh, models, model, scene, held, parts);
   add_rods(scene, materials, mesh, models, groups, model, parts);
   // every edit of the model (a cut, a piercing) is followed before the model compacts its
   // particles, so that elements it removed are retired while their nodes still exist; the

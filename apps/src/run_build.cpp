@@ -329,6 +329,17 @@ MotionDriver set_initial_state(const Scene& scene, const Assembly& assembly, phy
   return motion;
 }
 
+// Per node, 1 if a `fixed` entry holds it on all three axes (a shell's clamp, build_continuum).
+std::vector<std::uint8_t> held_nodes(const Scene& scene, const Assembly& assembly, const physics::MssModel<3>& model) {
+  std::vector<std::uint8_t> held(model.nodes().size(), 0);
+  for (std::size_t k = 0; k < scene.fixed.size(); ++k) {
+    const FixSpec& fix = scene.fixed[k];
+    if (!(fix.axes[0] && fix.axes[1] && fix.axes[2])) continue;
+    for (Index i : selected_nodes(fix.where, assembly, model, scene.file, "fixed[" + std::to_string(k) + "].where")) held[i] = 1;
+  }
+  return held;
+}
+
 }  // namespace
 
 namespace detail {
@@ -350,7 +361,8 @@ Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum) {
 
   // The continuum models (solids, shells, rods) and the volume term join or replace the springs.
   if (scene.model != "mass-spring")
-    b.continuum = build_continuum(scene, materials, assembly.mesh, assembly.model_of_cell, assembly.group_of_cell, model);
+    b.continuum = build_continuum(scene, materials, assembly.mesh, assembly.model_of_cell, assembly.group_of_cell, model,
+                                  held_nodes(scene, assembly, model));
   // the rotational energies where the bodies meet (model.connections), on the rest state
   if (scene.model != "mass-spring")
     b.joints = build_connections(scene, assembly.mesh, assembly.model_of_cell, materials, b.continuum, model);

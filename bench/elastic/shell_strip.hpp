@@ -3,7 +3,7 @@
 // convergence rows and test_elastic_shells' order checks: L = 1 m, b = 0.1 m, t = 0.01 m,
 // E = 200 GPa, ν = 0, ρ = 1000 kg/m³, g = 9.81 m/s², clamped at x = 0 (the columns x = 0 and
 // x = -L/nx held, which fixes the slope there) and loaded by its own weight (lumped masses, a
-// third of each triangle per corner); CST membranes plus a bending model (patch bending with
+// third of each triangle per corner); CST membranes plus a bending model (patch or Morley bending with
 // the held cells as clamps); one quasi-static
 // Newton step (LDLT, |p|∞ < 1e-13 m). The answer is Euler–Bernoulli's δ = qL⁴/(8EI) (ν = 0:
 // no anticlastic coupling, so narrow and wide strips share it). Tip = mean z of the x = L nodes.
@@ -12,7 +12,12 @@
 //   flipped   the same with every diagonal from (i+1, j) to (i, j+1);
 //   row       ny = 1 (triangles of aspect nx/10), diagonals as `square`;
 //   jittered  ny = nx/10, inner nodes moved by up to a quarter cell in x and y and each
-//             cell's diagonal drawn at random (seeded: the same mesh every run).
+//             cell's diagonal drawn at random (seeded: the same mesh every run);
+//   diagonals ny = nx/10, nodes on the grid, each cell's diagonal drawn at random (seeded);
+//   offset    an unstructured mesh of the kind Gmsh's frontal mesher makes: rows of nodes
+//             about a·√3/2 apart, every other row shifted by half a cell, inner nodes moved
+//             by up to a quarter cell, and two rows zipped together by always taking the
+//             shorter diagonal, so valences vary from 4 to 8 (generated here, not by Gmsh).
 
 #include <array>
 #include <cmath>
@@ -24,13 +29,14 @@
 
 #include "sewn/physics/basic_terms.hpp"
 #include "sewn/physics/integrate/newton_euler.hpp"
+#include "sewn/physics/shells/morley_terms.hpp"
 #include "sewn/physics/shells/patch_terms.hpp"
 #include "sewn/physics/shells/shell_terms.hpp"
 
 namespace sewn::shell_strip {
 
-enum class Mesh { square, flipped, row, jittered };
-enum class Bending { patch, hinge };
+enum class Mesh { square, flipped, row, jittered, diagonals, offset };
+enum class Bending { patch, hinge, morley };
 
 inline const char* mesh_name(Mesh m) {
   switch (m) {
@@ -38,6 +44,8 @@ inline const char* mesh_name(Mesh m) {
     case Mesh::flipped: return "flipped";
     case Mesh::row: return "row";
     case Mesh::jittered: return "jittered";
+    case Mesh::diagonals: return "diagonals";
+    case Mesh::offset: return "offset";
   }
   return "?";
 }
@@ -61,7 +69,52 @@ struct Strip {
   std::vector<std::array<physics::Index, 3>> triangles;
 };
 
+// The `offset` mesh (see the header comment).
+inline Strip offset_mesh(int nx) {
+  const double a = length / nx;
+  const int ny = std::max(1, static_cast<int>(std::lround(width / (a * std::sqrt(3.0) / 2))));
+  const double c = width / ny;
+  std::mt19937 rng(777u + static_cast<unsigned>(nx));
+  std::uniform_real_distribution<double> jitter(-0.25, 0.25);
+  Strip s;
+  std::vector<std::vector<physics::Index>> rows(static_cast<std::size_t>(ny) + 1);
+  for (int j = 0; j <= ny; ++j) {
+    std::vector<double> xs{-a, 0.0};  // the clamp's columns, in every row
+    for (int i = 1; i < nx; ++i) xs.push_back(a * i - (j % 2 == 1 ? 0.5 * a : 0.0));
+    if (j % 2 == 1) xs.push_back(length - 0.5 * a);
+    xs.push_back(length);
+    for (double x : xs) {
+      double y = c * j;
+      if (x > 1e-12 && x < length - 1e-12) {
+        x += a * jitter(rng);
+        if (j >= 1 && j < ny) y += c * jitter(rng);
+      }
+      rows[static_cast<std::size_t>(j)].push_back(static_cast<physics::Index>(s.rest.size() / 3));
+      s.rest.insert(s.rest.end(), {x, y, 0.0});
+    }
+  }
+  auto at = [&](physics::Index v) { return Eigen::Vector2d(s.rest[3 * std::size_t{v}], s.rest[3 * std::size_t{v} + 1]); };
+  for (std::size_t j = 0; j + 1 < rows.size(); ++j) {
+    const auto& lo = rows[j];
+    const auto& hi = rows[j + 1];
+    std::size_t i = 0, k = 0;
+    while (i + 1 < lo.size() || k + 1 < hi.size()) {
+      const bool take_lo = k + 1 == hi.size() ||
+                           (i + 1 < lo.size() && (at(lo[i + 1]) - at(hi[k])).norm() < (at(hi[k + 1]) - at(lo[i])).norm());
+      if (take_lo) {
+        s.triangles.push_back({lo[i], lo[i + 1], hi[k]});
+        ++i;
+      } else {
+        s.triangles.push_back({lo[i], hi[k + 1], hi[k]});
+        ++k;
+      }
+    }
+  }
+  return s;
+}
+
 inline Strip strip_mesh(Mesh mesh, int nx) {
+  if (mesh == Mesh::offset) return offset_mesh(nx);
   const int ny = mesh == Mesh::row ? 1 : std::max(1, nx / 10);
   const double a = length / nx, c = width / ny;
   const int cols = nx + 2;  // x = -a, 0, a, ..., L
@@ -82,7 +135,7 @@ inline Strip strip_mesh(Mesh mesh, int nx) {
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i + 1 < cols; ++i) {
       const auto p = id(i, j), q = id(i + 1, j), r = id(i + 1, j + 1), u = id(i, j + 1);
-      const bool other = mesh == Mesh::flipped || (mesh == Mesh::jittered && coin(rng));
+      const bool other = mesh == Mesh::flipped || ((mesh == Mesh::jittered || mesh == Mesh::diagonals) && coin(rng));
       if (other) {
         s.triangles.push_back({p, q, u});
         s.triangles.push_back({q, r, u});
@@ -117,14 +170,17 @@ inline Result solve(Mesh mesh, Bending bending, int nx) {
   if (bending == Bending::hinge) {
     sys.add<physics::shells::Hinges>().add_interior_edges(s.triangles, s.rest,
                                                            physics::shells::hinge_stiffness(young, 0.0, thickness));
-  } else {
+  } else {  // patch and Morley: the cells behind x = 0 are held, clamps on the edge x = 0
     const std::vector<physics::shells::PlateMaterial> mat(s.triangles.size(),
                                                           physics::shells::plate_material(young, 0.0, thickness));
-    std::vector<std::uint8_t> clamp(s.triangles.size(), 0);  // the cells behind x = 0 are held
+    std::vector<std::uint8_t> clamp(s.triangles.size(), 0);
     for (std::size_t t = 0; t < s.triangles.size(); ++t)
       clamp[t] = s.rest[3 * std::size_t{s.triangles[t][0]}] <= 1e-12 && s.rest[3 * std::size_t{s.triangles[t][1]}] <= 1e-12 &&
                  s.rest[3 * std::size_t{s.triangles[t][2]}] <= 1e-12;
-    (void)physics::shells::add_patch_bending(sys, s.triangles, s.rest, mat, clamp);
+    if (bending == Bending::morley)
+      (void)physics::shells::add_morley_bending(sys, s.triangles, s.rest, mat, clamp);
+    else
+      (void)physics::shells::add_patch_bending(sys, s.triangles, s.rest, mat, clamp);
   }
   sys.add<physics::Gravity>(Eigen::Vector3d(0, 0, -gravity));
   std::vector<Index> tip;

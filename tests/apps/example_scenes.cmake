@@ -22,7 +22,7 @@ set(expect_sofa_8x8x10           "891;640")
 set(expect_tet_beam_5x7x9        "480;1890")
 set(expect_newton_cantilever     "189;80")   # backward Euler by Newton on the mass-spring beam
 set(expect_solid_cantilever      "189;480")  # the same beam as finite-element tetrahedra
-set(expect_shell_plate           "85;128")   # membranes and patch bending on 16x4x2 triangles
+set(expect_shell_plate           "85;128")   # membranes and Morley bending on 16x4x2 triangles
 set(expect_obstacles_spike       "81;32")    # rigid obstacles: no cut
 set(expect_mixed_fin             "177;449")  # 411 tetrahedra, 34 shell triangles, 4 rod segments; the top face a label
 # The 2019 paper's Table 1 scenes (meshes from `sewn make-mesh`), two steps each (the umbrella

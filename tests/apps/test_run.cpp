@@ -500,6 +500,11 @@ TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped b
     std::string hex = scene("tet_grid", rayleigh, "");
     hex.replace(hex.find(R"("solid", "law": "stvk")"), 22, R"("shell")");
     expect_run_error<SceneError>(hex, "needs triangles only");
+    // Morley bending's edge angles are integrated by Newton alone
+    std::string implicit = text;
+    implicit.replace(implicit.find(R"("type": "shell")"), 15, R"("type": "shell", "bending": "morley")");
+    implicit.replace(implicit.find(R"("type": "newton")"), 16, R"("type": "implicit")");
+    expect_run_error<SceneError>(implicit, "model.bending: \"morley\" bending gives every shell edge an angle DOF");
   }
   SUBCASE("per-spring damping") {
     expect_run_error<SceneError>(scene("tet_grid", R"({"model": "viscous"})", ""), "per-spring damping");
@@ -520,7 +525,10 @@ TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped b
     CHECK(pierced["particles"] == 16.0);  // the 4 corner points at x = 0.4 went with them
     std::string shell = scene("tri_grid", rayleigh, R"(, "cuts": [{"type": "plane", "time": 0.05, "point": [0.2, 0, 0], "normal": [1, 0, 0]}])");
     shell.replace(shell.find(R"("cells": [4, 1, 1], "size": [0.4, 0.1, 0.1])"), 43, R"("cells": [4, 1], "size": [0.4, 0.1])");
-    std::string patch_shell = shell;
+    std::string morley_shell = shell;
+    morley_shell.replace(morley_shell.find(R"("solid", "law": "stvk")"), 22, R"("shell", "bending": "morley")");
+    expect_run_error<SceneError>(morley_shell, "model.bending: this scene cuts 8 shell triangles, which \"morley\" bending cannot follow yet");
+    std::string patch_shell = shell;  // the default bending
     patch_shell.replace(patch_shell.find(R"("solid", "law": "stvk")"), 22, R"("shell")");
     expect_run_error<SceneError>(patch_shell, "model.bending: this scene cuts 8 shell triangles, which \"patch\" bending cannot follow yet");
     shell.replace(shell.find(R"("solid", "law": "stvk")"), 22, R"("shell", "bending": "hinge")");

@@ -11,6 +11,7 @@
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/shells/hinge_element.hpp"
 #include "sewn/physics/shells/material_check.hpp"
+#include "plate_quadratic.hpp"
 
 namespace sewn::physics::shells {
 
@@ -71,43 +72,14 @@ PatchRest patch_rest(const PatchPositions<N>& X, const std::array<std::uint8_t, 
       if (edges[static_cast<std::size_t>(k)] > 2 || edges[static_cast<std::size_t>(k)] == edges[static_cast<std::size_t>(j)])
         throw InputError("patch bending: neighbour edges " + describe(r.edge, K) + " must be distinct corners 0, 1, 2");
   if (edges[0] > 2) throw InputError("patch bending: neighbour edges " + describe(r.edge, K) + " must be corners 0, 1, 2");
-  // T in an orthonormal frame of its rest plane
-  const Eigen::Vector3d e1 = X.col(1) - X.col(0), e2 = X.col(2) - X.col(0);
-  const Eigen::Vector3d n = e1.cross(e2);
-  const double area = 0.5 * n.norm();
-  const double longest2 = std::max({e1.squaredNorm(), e2.squaredNorm(), (X.col(2) - X.col(1)).squaredNorm()});
-  if (!std::isfinite(area) || !(area > 1e-12 * longest2)) {
-    std::ostringstream s;
-    s << "patch bending: degenerate rest triangle (area " << area << " m^2)";
-    throw InputError(s.str());
-  }
-  const Eigen::Vector3d u = e1.normalized(), v = n.normalized().cross(u);
-  Eigen::Matrix<double, 2, 3> p;  // corners in the frame
-  for (int a = 0; a < 3; ++a) p.col(a) << (X.col(a) - X.col(0)).dot(u), (X.col(a) - X.col(0)).dot(v);
-  Eigen::Matrix2d Dm;
-  Dm << p.col(1) - p.col(0), p.col(2) - p.col(0);
-  const Eigen::Matrix2d Dm_inv = Dm.inverse();
-  Eigen::Matrix<double, 2, 3> grad;  // column a: ∇λ_a
-  grad.col(1) = Dm_inv.row(0).transpose();
-  grad.col(2) = Dm_inv.row(1).transpose();
-  grad.col(0) = -grad.col(1) - grad.col(2);
+  const detail::PlateQuadratic pq = detail::plate_quadratic(X.template leftCols<3>(), m, "patch bending");
+  const auto& p = pq.corners;
+  const auto& grad = pq.grad;
+  const Eigen::Matrix3d& Q = pq.Q;
   auto bary = [&](const Eigen::Vector2d& q) {
-    const Eigen::Vector2d l = Dm_inv * (q - p.col(0));
+    const Eigen::Vector2d l = pq.Dm_inv * (q - p.col(0));
     return Eigen::Vector3d(1.0 - l[0] - l[1], l[0], l[1]);
   };
-  // Hessians of the bubbles b_m = λ_{m+1} λ_{m+2}, and the energy's matrix Q in β
-  std::array<Eigen::Matrix2d, 3> B;
-  for (int m = 0; m < 3; ++m) {
-    const Eigen::Vector2d ga = grad.col((m + 1) % 3), gb = grad.col((m + 2) % 3);
-    B[static_cast<std::size_t>(m)] = ga * gb.transpose() + gb * ga.transpose();
-  }
-  Eigen::Matrix3d Q;
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) {
-      const auto& Ba = B[static_cast<std::size_t>(a)];
-      const auto& Bb = B[static_cast<std::size_t>(b)];
-      Q(a, b) = area * m.stiffness * ((1.0 - m.poisson) * (Ba * Bb).trace() + m.poisson * Ba.trace() * Bb.trace());
-    }
   // each neighbour unfolded into T's plane across its edge: its lever ℓ and bubble values
   Eigen::Matrix<double, K, 3> C;
   for (int k = 0; k < K; ++k) {

@@ -15,6 +15,7 @@
 #include "sewn/cmap/mesh.hpp"
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/rods/rods_term.hpp"
+#include "sewn/physics/shells/morley_terms.hpp"
 #include "sewn/physics/shells/patch_terms.hpp"
 #include "sewn/physics/shells/shell_terms.hpp"
 #include "sewn/physics/solids/tets.hpp"
@@ -42,6 +43,7 @@ struct ContinuumParts {
   physics::shells::Hinges* hinges = nullptr;
   std::vector<HingeCorners> hinge_corners;  ///< per hinge
   physics::shells::PatchTerms patches;      ///< scene.bending "patch" (no cuts)
+  physics::shells::MorleyTerms morley;      ///< scene.bending "morley" (no cuts)
 };
 
 /// Rod segments whose group (`groups`: per cell its model.groups entry, -1: none) gives a
@@ -51,15 +53,19 @@ void apply_rod_sections(const Scene& scene, const IndexedMesh& mesh, const std::
                         std::vector<physics::MaterialParams>& materials, std::vector<std::uint32_t>& material_of_cell);
 
 /// Removes every spring of `model` and adds the force terms of the cells' models: Tets (solid
-/// cells, scene.law), Membranes and patch bending (shell cells; scene.bending "hinge": Hinges
+/// cells, scene.law), Membranes and Morley bending (shell cells; scene.bending "patch": patch bending; "hinge": Hinges
 /// on the edges two shell triangles share), Rods (rod segments chained wherever exactly two segments of one group and
 /// material meet; sections from the group, else the circle of the material's area). `groups`:
 /// per mesh cell its model.groups entry, -1: none (match_groups). Throws
 /// SceneError for what a continuum model cannot take (per-spring damping; cuts and piercing
-/// of rods and of patch-bent shells, whose stencils cannot follow a cut yet) and for a rod or hinge the rest shape
-/// makes impossible, naming the key. Registers follow_cut with the model (after_edits). O(cells).
+/// of rods and of Morley- and patch-bent shells, whose stencils cannot follow a cut yet) and for a rod or hinge the rest shape
+/// makes impossible, naming the key. Registers follow_cut with the model (after_edits).
+/// `held` (per node, empty: none) marks the nodes the scene holds on every axis: a shell
+/// triangle whose three nodes are held is a clamp of Morley and patch bending, so a shell held
+/// by two rows of nodes is clamped exactly on the inner row (not half a cell beyond it). O(cells).
 ContinuumParts build_continuum(const Scene& scene, const std::vector<physics::MaterialParams>& materials, const IndexedMesh& mesh,
-                               const std::vector<CellModel>& models, const std::vector<int>& groups, physics::MssModel<3>& model);
+                               const std::vector<CellModel>& models, const std::vector<int>& groups, physics::MssModel<3>& model,
+                               std::span<const std::uint8_t> held = {});
 
 /// Brings the continuum in line with the model after refine::cut or refine::pierce: the
 /// tetrahedra and membrane triangles move onto the particles the cut duplicated (same rest
