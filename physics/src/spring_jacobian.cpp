@@ -109,7 +109,13 @@ void Springs::symmetric_blocks(const StateView& st, const JacobianRequest& req, 
   const double cx = req.cx, cv = req.cv;
   const double* __restrict x = st.x.data();
   const double* __restrict p = product ? req.product_in.data() : nullptr;
-  for (Index s = s0; s < s1; ++s) {
+  Index s = s0;
+#if defined(__AVX512F__)
+  // Groups of 8 springs from s0 (a multiple of 8, as every caller's ranges start): the same
+  // spring is in a group whatever the thread count, so the results do not depend on it.
+  for (; s + 8 <= s1; s += 8) symmetric_group(st, req, s, blocks + 9 * std::size_t{s - s0}, products + 3 * std::size_t{s - s0}, ok + (s - s0));
+#endif
+  for (; s < s1; ++s) {
     const std::size_t o = s - s0;
     const std::size_t i = 3 * std::size_t{ni_[s]}, j = 3 * std::size_t{nj_[s]};
     const double k = k_[s], l = l_[s];
@@ -152,6 +158,64 @@ void Springs::symmetric_blocks(const StateView& st, const JacobianRequest& req, 
     }
   }
 }
+
+#if defined(__AVX512F__)
+// symmetric_blocks for springs [s, s + 8), one spring a lane (the same formulas).
+void Springs::symmetric_group(const StateView& st, const JacobianRequest& req, Index s, double* __restrict blocks,
+                              double* __restrict products, std::uint8_t* __restrict ok) const {
+  const __m512d one = _mm512_set1_pd(1.0), zero = _mm512_setzero_pd();
+  const __m256i three = _mm256_set1_epi32(3);
+  const __m256i i3 = _mm256_mullo_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(ni_.data() + s)), three);
+  const __m256i j3 = _mm256_mullo_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(nj_.data() + s)), three);
+  const double* x = st.x.data();
+  __m512d d[3];
+  for (int a = 0; a < 3; ++a)
+    d[a] = _mm512_sub_pd(_mm512_i32gather_pd(j3, x + a, 8), _mm512_i32gather_pd(i3, x + a, 8));
+  const __m512d dd = _mm512_fmadd_pd(d[2], d[2], _mm512_fmadd_pd(d[1], d[1], _mm512_mul_pd(d[0], d[0])));
+  const __m512d k = _mm512_loadu_pd(k_.data() + s), l = _mm512_loadu_pd(l_.data() + s);
+  const __mmask8 long_enough =
+      _mm512_cmp_pd_mask(dd, _mm512_mul_pd(_mm512_set1_pd(detail::degenerate_ratio_sq), _mm512_mul_pd(l, l)), _CMP_GT_OQ);
+  for (int q = 0; q < 8; ++q) ok[q] = alive_[s + q] != 0 && ((long_enough >> q) & 1) != 0 ? 1 : 0;
+  const __m512d inv = _mm512_div_pd(one, _mm512_sqrt_pd(dd));
+  const __m512d u[3] = {_mm512_mul_pd(d[0], inv), _mm512_mul_pd(d[1], inv), _mm512_mul_pd(d[2], inv)};
+  const __m512d stretch = _mm512_fnmadd_pd(l, inv, one);
+  const __m512d ax = _mm512_mul_pd(k, req.options.clamp_compression ? _mm512_max_pd(zero, stretch) : stretch);
+  const __m512d bx = _mm512_sub_pd(k, ax);
+  __m512d av = zero, bv = zero;
+  if (damping_ == SpringDamping::viscous) {
+    bv = _mm512_loadu_pd(gamma_.data() + s);
+  } else if (damping_ == SpringDamping::stiffness_proportional) {
+    const __m512d bk = _mm512_mul_pd(_mm512_set1_pd(beta_), k);
+    av = _mm512_mul_pd(bk, _mm512_max_pd(zero, stretch));
+    bv = _mm512_sub_pd(bk, av);
+  }
+  const __m512d cx = _mm512_set1_pd(req.cx), cv = _mm512_set1_pd(req.cv);
+  const __m512d a = _mm512_fmadd_pd(cv, av, _mm512_mul_pd(cx, ax));
+  const __m512d b = _mm512_fmadd_pd(cv, bv, _mm512_mul_pd(cx, bx));
+  // The 9 entries (column-major) lane by lane, then each spring's block stored whole.
+  alignas(64) double e[9][8];
+  for (int r = 0; r < 3; ++r) {
+    const __m512d bu = _mm512_mul_pd(b, u[r]);
+    _mm512_store_pd(e[4 * r], _mm512_fmadd_pd(bu, u[r], a));
+    for (int c = r + 1; c < 3; ++c) {
+      const __m512d off = _mm512_mul_pd(bu, u[c]);
+      _mm512_store_pd(e[3 * c + r], off);
+      _mm512_store_pd(e[3 * r + c], off);
+    }
+  }
+  for (int q = 0; q < 8; ++q)
+    for (int m = 0; m < 9; ++m) blocks[9 * q + m] = e[m][q];
+  if (req.product_in.empty()) return;
+  const double* p = req.product_in.data();
+  __m512d pd[3];
+  for (int c = 0; c < 3; ++c)
+    pd[c] = _mm512_sub_pd(_mm512_i32gather_pd(j3, p + c, 8), _mm512_i32gather_pd(i3, p + c, 8));
+  const __m512d w = _mm512_mul_pd(bx, _mm512_fmadd_pd(u[2], pd[2], _mm512_fmadd_pd(u[1], pd[1], _mm512_mul_pd(u[0], pd[0]))));
+  for (int c = 0; c < 3; ++c) _mm512_store_pd(e[c], _mm512_fmadd_pd(w, u[c], _mm512_mul_pd(ax, pd[c])));
+  for (int q = 0; q < 8; ++q)
+    for (int c = 0; c < 3; ++c) products[3 * q + c] = e[c][q];
+}
+#endif
 
 void Springs::add_jacobians(const StateView& st, const JacobianRequest& req) const {
   if (req.matrix != nullptr &&
@@ -241,8 +305,9 @@ void Springs::add_jacobians_threads(const StateView& st, const JacobianRequest& 
   jac_products_.resize(3 * std::size_t{m});
   jac_ok_.resize(m);
   detail::run_parts(parts, [&](int t) {
-    const auto s0 = static_cast<Index>(detail::range_begin(m, parts, t));
-    const auto s1 = static_cast<Index>(detail::range_begin(m, parts, t + 1));
+    // ranges start at multiples of 8 springs: the same groups of 8 as on one thread
+    const auto s0 = static_cast<Index>(detail::range_begin(m, parts, t) / 8 * 8);
+    const auto s1 = t + 1 == parts ? m : static_cast<Index>(detail::range_begin(m, parts, t + 1) / 8 * 8);
     double* blocks = jac_blocks_.data() + 9 * std::size_t{s0};
     double* products = jac_products_.data() + 3 * std::size_t{s0};
     if constexpr (Symmetric)

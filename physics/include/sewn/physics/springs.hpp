@@ -111,10 +111,13 @@ class Springs final : public ForceTerm {
   [[nodiscard]] detail::SpringArrays arrays() const;
   // The assembly (spring_jacobian.cpp) runs in two phases: each spring's block and product
   // into per-spring arrays, then those added into the matrix and product_out.
-  // Phase one over springs [s0, s1) for the symmetric Jacobians (every case but viscous damping
+  // Phase one over springs [s0, s1) (s0 a multiple of 8) for the symmetric Jacobians (every case but viscous damping
   // with its position terms kept): B = a·I + b·UUᵀ. Blocks are stored column-major, 9 a spring.
   void symmetric_blocks(const StateView& st, const JacobianRequest& req, Index s0, Index s1, double* blocks,
                         double* products, std::uint8_t* ok) const;
+  // symmetric_blocks for springs [s, s + 8) in 512-bit vectors (AVX-512 builds).
+  void symmetric_group(const StateView& st, const JacobianRequest& req, Index s, double* blocks, double* products,
+                       std::uint8_t* ok) const;
   // Phase one for the general (non-symmetric) Jacobian.
   void general_blocks(const StateView& st, const JacobianRequest& req, Index s0, Index s1, double* blocks,
                       double* products, std::uint8_t* ok) const;
