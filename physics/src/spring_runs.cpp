@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "parallel/ranges.hpp"
+#include "spring_frame.hpp"
 
 #if defined(__AVX512F__)
 #include <immintrin.h>
@@ -17,8 +18,6 @@ namespace {
 using detail::range_begin;
 using detail::run_parts;
 
-// The springs term's degenerate-spring guard (springs.cpp): no force below d² = 1e-18 l².
-constexpr double degenerate_ratio_sq = 1e-18;
 constexpr std::uint32_t no_lane = ~std::uint32_t{0};
 // A run shorter than this is cheaper one spring at a time than as a chunk.
 constexpr int min_chunk_lanes = 4;

@@ -11,14 +11,13 @@
 
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/nodes.hpp"
-#include "parallel/ranges.hpp"
+#include "spring_frame.hpp"
 
 namespace sewn::physics {
 
 namespace {
 
-// A spring shorter than this fraction of its rest length has no usable direction.
-constexpr double degenerate_ratio_sq = 1e-18;
+using detail::degenerate_ratio_sq;
 
 std::string sp(Index s) { return "spring " + std::to_string(s); }
 
@@ -191,25 +190,6 @@ void to_rows(std::span<const double> in, double* __restrict out, std::size_t n) 
     out[4 * p + 2] = a[3 * p + 2];
     out[4 * p + 3] = 0.0;
   }
-}
-
-struct SpringFrame {
-  Eigen::Vector3d dx;
-  double d = 0;
-  bool ok = false;
-};
-
-SpringFrame frame(const StateView& st, Index i, Index j, double l) {
-  SpringFrame fr;
-  fr.dx = Eigen::Vector3d(st.x[3 * j] - st.x[3 * i], st.x[3 * j + 1] - st.x[3 * i + 1], st.x[3 * j + 2] - st.x[3 * i + 2]);
-  const double d2 = fr.dx.squaredNorm();
-  fr.ok = d2 > degenerate_ratio_sq * l * l;
-  fr.d = std::sqrt(d2);
-  return fr;
-}
-
-Eigen::Vector3d vel_diff(const StateView& st, Index i, Index j) {
-  return {st.v[3 * j] - st.v[3 * i], st.v[3 * j + 1] - st.v[3 * i + 1], st.v[3 * j + 2] - st.v[3 * i + 2]};
 }
 
 }  // namespace
@@ -585,138 +565,11 @@ bool Springs::jacobian_symmetric(const JacobianOptions& opt) const {
   return damping_ != SpringDamping::viscous || opt.drop_viscous_position_terms;
 }
 
-// Spring s's Jacobian blocks: Jx = ∂F_i/∂x_j (as used in the product) and B = cx·Jx + cv·Jv,
-// the block the matrix receives. False if the spring is too short to have a direction.
-bool Springs::spring_jacobian(const StateView& st, const JacobianRequest& req, Index s, Eigen::Matrix3d& Jx,
-                              Eigen::Matrix3d& B) const {
-  const Index i = ni_[s], j = nj_[s];
-  const double k = k_[s], l = l_[s];
-  const SpringFrame fr = frame(st, i, j, l);
-  if (!fr.ok) return false;
-  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  const Eigen::Vector3d U = fr.dx / fr.d;
-  const Eigen::Matrix3d UU = U * U.transpose();
-  const Eigen::Matrix3d Q = I - UU;
-  const double stretch = 1.0 - l / fr.d;
-  const double cl = req.options.clamp_compression ? std::max(0.0, stretch) : stretch;
-  Jx = k * (UU + cl * Q);
-  Eigen::Matrix3d Jv = Eigen::Matrix3d::Zero();
-  if (damping_ == SpringDamping::viscous) {
-    const double gamma = gamma_[s];
-    if (!req.options.drop_viscous_position_terms) {
-      const Eigen::Vector3d dv = vel_diff(st, i, j);
-      const double w = dv.dot(U);
-      Jx += (gamma / fr.d) * (w * Q + U * (dv.transpose() * Q));
-    }
-    Jv = gamma * UU;
-  } else if (damping_ == SpringDamping::stiffness_proportional) {
-    Jv = beta_ * k * (UU + std::max(0.0, stretch) * Q);
-  }
-  B = req.cx * Jx + req.cv * Jv;
-  return true;
-}
-
-Eigen::Vector3d Springs::spring_product(const JacobianRequest& req, Index s, const Eigen::Matrix3d& Jx) const {
-  const Index i = ni_[s], j = nj_[s];
-  const Eigen::Vector3d p(req.product_in[3 * j] - req.product_in[3 * i], req.product_in[3 * j + 1] - req.product_in[3 * i + 1],
-                          req.product_in[3 * j + 2] - req.product_in[3 * i + 2]);
-  return Jx * p;
-}
-
-void Springs::add_jacobians(const StateView& st, const JacobianRequest& req) const {
-  if (req.matrix != nullptr &&
-      (req.matrix->pattern_version() != bound_pattern_ || bound_topology_ != topology_version()))
-    throw InputError("springs: add_jacobians on a pattern that is not bound to the current springs; call System::refresh()");
-  if (const int parts = detail::parts_for(size(), jacobian_grain); parts > 1) {
-    add_jacobians_threads(st, req, parts);
-    return;
-  }
-  const bool product = !req.product_in.empty();
-  Eigen::Matrix3d Jx, B;
-  for (Index s = 0; s < size(); ++s) {
-    if (alive_[s] == 0 || !spring_jacobian(st, req, s, Jx, B)) continue;
-    if (req.matrix != nullptr) {
-      req.matrix->block(slot_ij_[s]) += B;
-      req.matrix->block(slot_ji_[s]) += B;
-      req.matrix->block(slot_ii_[s]) -= B;
-      req.matrix->block(slot_jj_[s]) -= B;
-    }
-    if (product) {
-      const Eigen::Vector3d q = spring_product(req, s, Jx);
-      for (int a = 0; a < 3; ++a) {
-        req.product_out[3 * std::size_t{ni_[s]} + a] += q[a];
-        req.product_out[3 * std::size_t{nj_[s]} + a] -= q[a];
-      }
-    }
-  }
-}
-
-// Two passes: every spring's blocks into a per-spring array (ranges of springs), then every
-// node gathers its springs' blocks (ranges of nodes), in increasing spring order: each matrix
-// block and product entry receives the same additions in the same order as in the one-thread
-// loop, so the result is the same bitwise, and no two threads write one block.
-void Springs::add_jacobians_threads(const StateView& st, const JacobianRequest& req, int parts) const {
-  const Index n = st.size();
-  const Index m = size();
-  if (incidence_topology_ != topology_version() || incidence_row_.size() != std::size_t{n} + 1) {
-    incidence_row_.assign(std::size_t{n} + 1, 0);
-    for (Index s = 0; s < m; ++s)
-      if (alive_[s] != 0) {
-        ++incidence_row_[ni_[s] + 1];
-        ++incidence_row_[nj_[s] + 1];
-      }
-    for (Index i = 0; i < n; ++i) incidence_row_[i + 1] += incidence_row_[i];
-    incidence_.resize(incidence_row_[n]);
-    std::vector<Index> fill(incidence_row_.begin(), incidence_row_.end() - 1);
-    for (Index s = 0; s < m; ++s)  // increasing s: each node's list is in spring order
-      if (alive_[s] != 0) {
-        incidence_[fill[ni_[s]]++] = 2 * s;      // s's i end
-        incidence_[fill[nj_[s]]++] = 2 * s + 1;  // s's j end
-      }
-    incidence_topology_ = topology_version();
-  }
-  const bool product = !req.product_in.empty();
-  jac_blocks_.resize(9 * std::size_t{m});
-  jac_products_.resize(3 * std::size_t{m});
-  jac_ok_.resize(m);
-  detail::run_parts(parts, [&](int t) {
-    Eigen::Matrix3d Jx, B;
-    for (auto s = static_cast<Index>(detail::range_begin(m, parts, t)); s < detail::range_begin(m, parts, t + 1); ++s) {
-      jac_ok_[s] = alive_[s] != 0 && spring_jacobian(st, req, s, Jx, B) ? 1 : 0;
-      if (jac_ok_[s] == 0) continue;
-      Eigen::Map<Eigen::Matrix3d>(jac_blocks_.data() + 9 * std::size_t{s}) = B;
-      if (product) Eigen::Map<Eigen::Vector3d>(jac_products_.data() + 3 * std::size_t{s}) = spring_product(req, s, Jx);
-    }
-  });
-  const int node_parts = detail::parts_for(n, 1);
-  detail::run_parts(std::min(parts, node_parts), [&, parts = std::min(parts, node_parts)](int t) {
-    for (auto i = static_cast<Index>(detail::range_begin(n, parts, t)); i < detail::range_begin(n, parts, t + 1); ++i)
-      for (Index e = incidence_row_[i]; e < incidence_row_[i + 1]; ++e) {
-        const Index s = incidence_[e] / 2;
-        const bool i_end = incidence_[e] % 2 == 0;
-        if (jac_ok_[s] == 0) continue;
-        if (req.matrix != nullptr) {
-          const Eigen::Map<const Eigen::Matrix3d> B(jac_blocks_.data() + 9 * std::size_t{s});
-          req.matrix->block(i_end ? slot_ij_[s] : slot_ji_[s]) += B;
-          req.matrix->block(i_end ? slot_ii_[s] : slot_jj_[s]) -= B;
-        }
-        if (product)
-          for (int a = 0; a < 3; ++a) {
-            const double q = jac_products_[3 * std::size_t{s} + a];
-            if (i_end)
-              req.product_out[3 * std::size_t{i} + a] += q;
-            else
-              req.product_out[3 * std::size_t{i} + a] -= q;
-          }
-      }
-  });
-}
-
 void Springs::add_stability_rows(const StateView& st, StabilityRows& rows) const {
   using Sym = StabilityRows::SymBlock;
   // 1/d first, in a pass of its own: with the square root and the division inside the
   // accumulation loop, each spring's long dependency chain left the core waiting (measured:
-  // 3x slower on a hexahedral grid). 0 marks a spring with no direction.
+  // 1.3-1.45x slower on hexahedral grids). 0 marks a spring with no direction.
   std::vector<double> inv_d(size());
   for (Index s = 0; s < size(); ++s) {
     const Index i = ni_[s], j = nj_[s];

@@ -467,3 +467,78 @@ TEST_CASE("bad spring input is refused with a message naming the spring") {
   CHECK_THROWS_AS((void)paper_viscosity(1, 0, 1), InputError);
   CHECK(paper_viscosity(8, 1, 3) == doctest::Approx(8.0));
 }
+
+namespace test_springs_fast_jacobian {
+namespace {
+
+// cx·Jx + cv·Jv and Jx·p assembled spring by spring from the 3×3 formulas of springs.hpp
+// (Jx = k(UUᵀ + c(I − UUᵀ)), Jv per damping model), independently of spring_jacobian.cpp.
+struct Reference {
+  Eigen::MatrixXd matrix;
+  Eigen::VectorXd product;
+};
+
+Reference reference_jacobian(const System& sys, const Springs& sp, double cx, double cv, bool clamp,
+                             const Eigen::VectorXd& p) {
+  const NodeTable& nd = sys.nodes();
+  const Eigen::Index n3 = 3 * Eigen::Index{nd.size()};
+  Reference r{Eigen::MatrixXd::Zero(n3, n3), Eigen::VectorXd::Zero(n3)};
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  for (Index s = 0; s < sp.size(); ++s) {
+    if (!sp.is_alive(s)) continue;
+    const Index i = sp.node_i(s), j = sp.node_j(s);
+    const Vector3d dx = nd.position(j) - nd.position(i);
+    const double d = dx.norm(), k = sp.stiffness(s), l = sp.rest_length(s);
+    if (!(d > 1e-9 * l)) continue;  // no direction: no Jacobian
+    const Vector3d U = dx / d;
+    const Eigen::Matrix3d UU = U * U.transpose(), Q = I - UU;
+    const double stretch = 1 - l / d;
+    const Eigen::Matrix3d Jx = k * (UU + (clamp ? std::max(0.0, stretch) : stretch) * Q);
+    Eigen::Matrix3d Jv = Eigen::Matrix3d::Zero();
+    if (sp.damping() == SpringDamping::viscous) Jv = sp.viscosity(s) * UU;
+    if (sp.damping() == SpringDamping::stiffness_proportional)
+      Jv = sp.rayleigh_beta() * k * (UU + std::max(0.0, stretch) * Q);
+    const Eigen::Matrix3d B = cx * Jx + cv * Jv;
+    for (const auto& [a, b, sign] : {std::tuple{i, j, 1.0}, std::tuple{j, i, 1.0}, std::tuple{i, i, -1.0}, std::tuple{j, j, -1.0}})
+      r.matrix.block<3, 3>(3 * Eigen::Index{a}, 3 * Eigen::Index{b}) += sign * B;
+    const Vector3d q = Jx * (p.segment<3>(3 * Eigen::Index{j}) - p.segment<3>(3 * Eigen::Index{i}));
+    r.product.segment<3>(3 * Eigen::Index{i}) += q;
+    r.product.segment<3>(3 * Eigen::Index{j}) -= q;
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("the symmetric spring Jacobian (a·I + b·UUᵀ per spring) equals the 3×3 formulas to round-off") {
+  for (SpringDamping model : {SpringDamping::none, SpringDamping::viscous, SpringDamping::stiffness_proportional})
+    for (bool clamp : {true, false}) {
+      CAPTURE(static_cast<int>(model));
+      CAPTURE(clamp);
+      System sys;
+      std::mt19937 rng(31);
+      // 300 springs: more than one chunk of the one-thread assembly
+      Springs& sp = random_scene(sys, rng, 40, 300, model);
+      sp.remove(7);  // a tombstone
+      sys.nodes().set_position(sp.node_j(11), sys.nodes().position(sp.node_i(11)));  // no direction
+      const double cx = -2.5e-5, cv = -4e-3;
+      const JacobianOptions opt{true, clamp};
+      REQUIRE(sp.jacobian_symmetric(opt));
+      const Eigen::MatrixXd A = assembled(sys, cx, cv, opt);
+      Eigen::VectorXd p = Eigen::VectorXd::Random(A.cols());
+      std::vector<double> out(static_cast<std::size_t>(A.rows()), 0.0);
+      JacobianRequest r;
+      r.product_in = std::span<const double>(p.data(), static_cast<std::size_t>(p.size()));
+      r.product_out = out;
+      r.options = opt;
+      sys.add_jacobians(r);
+      const Reference ref = reference_jacobian(sys, sp, cx, cv, clamp, p);
+      CHECK(max_abs(ref.matrix) > 0);
+      CHECK(max_abs(A - ref.matrix) <= 1e-14 * max_abs(ref.matrix));
+      const Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(out.data(), static_cast<Eigen::Index>(out.size()));
+      CHECK(max_abs(q - ref.product) <= 1e-14 * max_abs(ref.product));
+      CHECK(A.allFinite());
+    }
+}
+
+}  // namespace test_springs_fast_jacobian

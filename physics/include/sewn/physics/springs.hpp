@@ -109,12 +109,31 @@ class Springs final : public ForceTerm {
   // The AoS path: every spring from rows of 4 doubles per node.
   void forces_by_rows(const StateView& s, std::span<double> f, bool accumulate) const;
   [[nodiscard]] detail::SpringArrays arrays() const;
+  // The assembly (spring_jacobian.cpp) runs in two phases: each spring's block and product
+  // into per-spring arrays, then those added into the matrix and product_out.
+  // Phase one over springs [s0, s1) (s0 a multiple of 8) for the symmetric Jacobians (every case but viscous damping
+  // with its position terms kept): B = a·I + b·UUᵀ. Blocks are stored column-major, 9 a spring.
+  void symmetric_blocks(const StateView& st, const JacobianRequest& req, Index s0, Index s1, double* blocks,
+                        double* products, std::uint8_t* ok) const;
+  // symmetric_blocks for springs [s, s + 8) in 512-bit vectors (AVX-512 builds).
+  void symmetric_group(const StateView& st, const JacobianRequest& req, Index s, double* blocks, double* products,
+                       std::uint8_t* ok) const;
+  // Phase one for the general (non-symmetric) Jacobian.
+  void general_blocks(const StateView& st, const JacobianRequest& req, Index s0, Index s1, double* blocks,
+                      double* products, std::uint8_t* ok) const;
   bool spring_jacobian(const StateView& st, const JacobianRequest& req, Index s, Eigen::Matrix3d& Jx, Eigen::Matrix3d& B) const;
   [[nodiscard]] Eigen::Vector3d spring_product(const JacobianRequest& req, Index s, const Eigen::Matrix3d& Jx) const;
-  // add_jacobians on `parts` threads (springs.cpp): the same result, bitwise.
+  // Phase two on one thread: chunk by chunk of springs, each block added spring by spring.
+  template <bool Symmetric>
+  void add_jacobians_serial(const StateView& st, const JacobianRequest& req) const;
+  // Both phases on `parts` threads: the same result as one thread, bitwise.
+  template <bool Symmetric>
   void add_jacobians_threads(const StateView& st, const JacobianRequest& req, int parts) const;
+  void build_incidence(Index nodes) const;
   // Springs per thread below which add_jacobians uses fewer threads.
   static constexpr Index jacobian_grain = 4096;
+  // Springs per chunk of the one-thread assembly (its buffers stay in the L1 cache).
+  static constexpr Index jacobian_chunk = 128;
 
   // Structure of arrays: the force loop streams these in order.
   AlignedVector<Index> ni_, nj_;
