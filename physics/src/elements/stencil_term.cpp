@@ -95,8 +95,8 @@ void StencilTerm<N>::add_jacobians(const StateView& s, const JacobianRequest& re
   if (req.cx == 0.0 && !product) return;
   for (Index e = 0; e < size(); ++e) {
     if (alive_[e] == 0) continue;
-    Hessian H = element_hessian(e, gather(s, e));
-    if (req.options.project_element_hessians) project_psd(H);
+    const Positions x = gather(s, e);
+    const Hessian H = req.options.project_element_hessians ? element_hessian_psd(e, x) : element_hessian(e, x);
     const Nodes& n = nodes_[e];
     if (req.matrix != nullptr && req.cx != 0.0)
       for (int a = 0; a < N; ++a)
@@ -117,6 +117,8 @@ template <int N>
 void StencilTerm<N>::add_stability_rows(const StateView& s, StabilityRows& rows) const {
   for (Index e = 0; e < size(); ++e) {
     if (alive_[e] == 0) continue;
+    // The eigen-projection of the exact Hessian, not element_hessian_psd: the closed forms may
+    // drop stiffness (Gauss-Newton bending), and a stable-step bound must not shrink with them.
     Hessian H = element_hessian(e, gather(s, e));
     project_psd(H);
     const Nodes& n = nodes_[e];

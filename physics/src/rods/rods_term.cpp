@@ -226,9 +226,9 @@ void Rods::for_each_block(const Entry& e, const Points& x, bool project, Visit&&
   const int n = e.rod.num_vertices();
   for (int j = 0; j < e.rod.num_edges(); ++j) {
     const int v[2] = {j, (j + 1) % n};
-    const StretchEval st = stretch(x.col(v[0]), x.col(v[1]), e.rod.section().EA, e.rod.rest_length(j), true);
-    Eigen::Matrix<double, 6, 6> H = st.hessian;
-    if (project) H = projected<6>(H);
+    const Eigen::Matrix<double, 6, 6> H =
+        project ? stretch_hessian_psd(x.col(v[0]), x.col(v[1]), e.rod.section().EA, e.rod.rest_length(j))
+                : stretch(x.col(v[0]), x.col(v[1]), e.rod.section().EA, e.rod.rest_length(j), true).hessian;
     for (int a = 0; a < 2; ++a)
       for (int c = 0; c < 2; ++c, ++slot) visit(v[a], v[c], Eigen::Matrix3d(H.block<3, 3>(3 * a, 3 * c)), slot);
   }
@@ -280,9 +280,11 @@ void Rods::add_jacobians_with_angles(const StateView& s, const JacobianRequest& 
     const int n = e.rod.num_vertices();
     for (int j = 0; j < e.rod.num_edges(); ++j, slot += 4) {
       const int v[2] = {j, (j + 1) % n};
-      const StretchEval st = stretch(x.col(v[0]), x.col(v[1]), e.rod.section().EA, e.rod.rest_length(j), true);
+      const double EA = e.rod.section().EA, rest = e.rod.rest_length(j);
       const std::array<Index, 2> block{e.nodes[static_cast<std::size_t>(v[0])], e.nodes[static_cast<std::size_t>(v[1])]};
-      scatter_hessian<6>(project_ ? projected<6>(st.hessian) : st.hessian, block, edge_comp, edge_group, slots.subspan(slot), req);
+      scatter_hessian<6>(project_ ? stretch_hessian_psd(x.col(v[0]), x.col(v[1]), EA, rest)
+                                  : stretch(x.col(v[0]), x.col(v[1]), EA, rest, true).hessian,
+                         block, edge_comp, edge_group, slots.subspan(slot), req);
     }
   }
 }

@@ -1,5 +1,6 @@
 #include "sewn/physics/rods/stencils.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -174,6 +175,19 @@ StretchEval stretch(const Vec3& x0, const Vec3& x1, double EA, double rest_lengt
     out.hessian << K, -K, -K, K;
   }
   return out;
+}
+
+Eigen::Matrix<double, 6, 6> stretch_hessian_psd(const Vec3& x0, const Vec3& x1, double EA, double rest_length) {
+  const Vec3 e = x1 - x0;
+  const double l = e.norm();
+  const Vec3 t = e / l;
+  // [[K, -K], [-K, K]] has the eigenvalues 2·eig(K) and 0; K's are EA/l̄ along t and
+  // EA·strain/l across it, so clamping the transverse one at 0 is the nearest PSD matrix.
+  const double across = std::max(0.0, EA * (l / rest_length - 1) / l);
+  const Eigen::Matrix3d K = (EA / rest_length) * t * t.transpose() + across * (Eigen::Matrix3d::Identity() - t * t.transpose());
+  Eigen::Matrix<double, 6, 6> H;
+  H << K, -K, -K, K;
+  return H;
 }
 
 BendTwistEval bend_twist(const Vec3& x0, const Vec3& x1, const Vec3& x2, double theta0, double theta1,

@@ -120,4 +120,10 @@ Mat12 hinge_hessian(const HingePositions& x, const HingeRest& rest, double k_b) 
   return 2.0 * k_b * rest.weight * (g * g.transpose() + d * dihedral_hessian(x));
 }
 
+Mat12 hinge_hessian_gauss_newton(const HingePositions& x, const HingeRest& rest, double k_b) {
+  if (!well_shaped(x)) return Mat12::Zero();
+  const Vec12 g = angle_gradient<double>(x);
+  return (2.0 * k_b * rest.weight) * (g * g.transpose());
+}
+
 }  // namespace sewn::physics::shells

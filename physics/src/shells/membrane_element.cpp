@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include <Eigen/Geometry>
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
 #include "sewn/physics/errors.hpp"
@@ -13,6 +14,13 @@ namespace sewn::physics::shells {
 
 namespace {
 using Mat32 = Eigen::Matrix<double, 3, 2>;
+
+// Second Piola-Kirchhoff stress S = 2μE + λ_ps tr(E) I.
+Eigen::Matrix2d membrane_stress(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m) {
+  const Eigen::Matrix2d E = membrane_strain(x, rest);
+  return 2.0 * m.mu * E + m.lambda_ps * E.trace() * Eigen::Matrix2d::Identity();
+}
+
 }  // namespace
 
 void check_shell_material(std::string_view model, double young, double poisson, double thickness) {
@@ -73,8 +81,7 @@ double membrane_energy(const TriPositions& x, const TriRest& rest, const Membran
 
 Vec9 membrane_gradient(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m) {
   const Mat32 F = membrane_deformation(x, rest);
-  const Eigen::Matrix2d E = membrane_strain(x, rest);
-  const Eigen::Matrix2d S = 2.0 * m.mu * E + m.lambda_ps * E.trace() * Eigen::Matrix2d::Identity();
+  const Eigen::Matrix2d S = membrane_stress(x, rest, m);
   const Mat32 H = m.thickness * rest.area * F * S * rest.Dm_inv.transpose();
   Vec9 g;
   g.segment<3>(0) = -H.rowwise().sum();
@@ -83,23 +90,46 @@ Vec9 membrane_gradient(const TriPositions& x, const TriRest& rest, const Membran
   return g;
 }
 
-Mat9 membrane_hessian(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m) {
-  const Mat32 F = membrane_deformation(x, rest);
+namespace {
+
+// h·Ā·Bᵀ D B with D = ∂vec(P)/∂vec(F) for the stress S_geo in the geometric term:
+// dP = dF·S_geo + F(2μ dE + λ_ps tr(dE) I), dE = sym(Fᵀ dF), one column per unit dF.
+Mat9 membrane_hessian_with(const Mat32& F, const Eigen::Matrix2d& S_geo, const TriRest& rest,
+                           const MembraneMaterial& m) {
   const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
-  const Eigen::Matrix2d E = membrane_strain(x, rest);
-  const Eigen::Matrix2d S = 2.0 * m.mu * E + m.lambda_ps * E.trace() * I;
-  // ∂vec(P)/∂vec(F), one column per unit dF: dP = dF·S + F(2μ dE + λ_ps tr(dE) I).
   elements::Mat<6> D;
   for (int c = 0; c < 6; ++c) {
     Mat32 dF = Mat32::Zero();
     dF(c % 3, c / 3) = 1.0;
     const Eigen::Matrix2d dE = 0.5 * (dF.transpose() * F + F.transpose() * dF);
-    const Mat32 dP = dF * S + F * (2.0 * m.mu * dE + m.lambda_ps * dE.trace() * I);
+    const Mat32 dP = dF * S_geo + F * (2.0 * m.mu * dE + m.lambda_ps * dE.trace() * I);
     D.col(c) = Eigen::Map<const elements::Vec<6>>(dP.data());
   }
   const auto B = elements::deformation_jacobian<2>(rest.Dm_inv);
   const Mat9 H = m.thickness * rest.area * (B.transpose() * D * B);
   return 0.5 * (H + H.transpose());
+}
+
+}  // namespace
+
+Mat9 membrane_hessian(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m) {
+  const Mat32 F = membrane_deformation(x, rest);
+  return membrane_hessian_with(F, membrane_stress(x, rest, m), rest, m);
+}
+
+Mat9 membrane_hessian_psd(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m) {
+  const Mat32 F = membrane_deformation(x, rest);
+  const Eigen::Matrix2d S = membrane_stress(x, rest, m);
+  // S = Σ σ_i s_i s_iᵀ (2×2, closed form); the geometric term dF:(dF S) = Σ_rows r S rᵀ is
+  // PSD with S⁺ = Σ max(σ_i, 0) s_i s_iᵀ, and the material term dE:C:dE is PSD for every
+  // admissible (μ > 0, μ + λ_ps > 0) material. Exact wherever both principal stresses are ≥ 0.
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig;
+  eig.computeDirect(S);
+  const Eigen::Vector2d sigma = eig.eigenvalues();
+  if (sigma.minCoeff() >= 0.0) return membrane_hessian_with(F, S, rest, m);
+  const Eigen::Matrix2d V = eig.eigenvectors();
+  const Eigen::Matrix2d S_plus = V * sigma.cwiseMax(0.0).asDiagonal() * V.transpose();
+  return membrane_hessian_with(F, S_plus, rest, m);
 }
 
 }  // namespace sewn::physics::shells

@@ -147,6 +147,16 @@ elements::Vec<3 * N> patch_gradient(const PatchPositions<N>& x, const PatchRest&
   return g;
 }
 
+namespace {
+
+// Scatters a hinge's 12 entries (row vector) into a 3N row at the hinge's columns.
+template <int N>
+void scatter_row(Eigen::Matrix<double, 3, 3 * N>& J, int k, const std::array<int, 4>& cols, const Vec12& gk) {
+  for (int a = 0; a < 4; ++a) J.row(k).template segment<3>(3 * cols[static_cast<std::size_t>(a)]) += gk.segment<3>(3 * a).transpose();
+}
+
+}  // namespace
+
 template <int N>
 elements::Mat<3 * N> patch_hessian(const PatchPositions<N>& x, const PatchRest& rest) {
   const Eigen::Vector3d Sd = rest.stiffness * heights<N>(x, rest);
@@ -157,15 +167,26 @@ elements::Mat<3 * N> patch_hessian(const PatchPositions<N>& x, const PatchRest& 
     const auto cols = hinge_columns<N>(rest, k);
     const HingePositions h = hinge_of<N>(x, cols);
     const double lever = rest.lever[static_cast<std::size_t>(k)];
-    const Vec12 gk = dihedral_gradient(h) * lever;
+    scatter_row<N>(J, k, cols, dihedral_gradient(h) * lever);
     const Mat12 hk = dihedral_hessian(h) * (Sd[k] * lever);
     for (int a = 0; a < 4; ++a) {
       const int A = cols[static_cast<std::size_t>(a)];
-      J.row(k).template segment<3>(3 * A) += gk.segment<3>(3 * a).transpose();
       for (int b = 0; b < 4; ++b) H.template block<3, 3>(3 * A, 3 * cols[static_cast<std::size_t>(b)]) += hk.block<3, 3>(3 * a, 3 * b);
     }
   }
   H += J.transpose() * rest.stiffness * J;
+  return 0.5 * (H + H.transpose());
+}
+
+template <int N>
+elements::Mat<3 * N> patch_hessian_gauss_newton(const PatchPositions<N>& x, const PatchRest& rest) {
+  Eigen::Matrix<double, 3, 3 * N> J = Eigen::Matrix<double, 3, 3 * N>::Zero();
+  for (int k = 0; k < rest.count; ++k) {
+    const auto cols = hinge_columns<N>(rest, k);
+    scatter_row<N>(J, k, cols, dihedral_gradient(hinge_of<N>(x, cols)) * rest.lever[static_cast<std::size_t>(k)]);
+  }
+  // S is symmetric positive definite (patch_rest refuses an ill-conditioned one), so JᵀSJ is PSD.
+  const elements::Mat<3 * N> H = J.transpose() * rest.stiffness * J;
   return 0.5 * (H + H.transpose());
 }
 
@@ -174,7 +195,8 @@ elements::Mat<3 * N> patch_hessian(const PatchPositions<N>& x, const PatchRest& 
                                    const std::array<std::uint8_t, N - 3>&, const PlateMaterial&);                     \
   template double patch_energy<N>(const PatchPositions<N>&, const PatchRest&);                                         \
   template elements::Vec<3 * N> patch_gradient<N>(const PatchPositions<N>&, const PatchRest&);                          \
-  template elements::Mat<3 * N> patch_hessian<N>(const PatchPositions<N>&, const PatchRest&);
+  template elements::Mat<3 * N> patch_hessian<N>(const PatchPositions<N>&, const PatchRest&);                         \
+  template elements::Mat<3 * N> patch_hessian_gauss_newton<N>(const PatchPositions<N>&, const PatchRest&);
 SEWN_PATCH_INSTANTIATE(4)
 SEWN_PATCH_INSTANTIATE(5)
 SEWN_PATCH_INSTANTIATE(6)

@@ -3,7 +3,9 @@
 #include <cmath>
 #include <sstream>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <Eigen/SVD>
 
 #include "sewn/physics/errors.hpp"
 
@@ -91,22 +93,104 @@ Eigen::Matrix3d first_piola(TetLaw law, const Eigen::Matrix3d& F, const Lame& m)
   return m.mu * F + p.lambda * (F.determinant() - p.alpha) * cofactor(F);
 }
 
+namespace {
+
+// StVK's ∂vec(P)/∂vec(F) with the stress S_geo in the geometric term:
+// dP = dF·S_geo + F·(2μ dE + λ tr(dE) I), dE = ½(dFᵀF + FᵀdF), one column per unit dF.
+elements::Mat<9> stvk_tangent(const Eigen::Matrix3d& F, const Eigen::Matrix3d& S_geo, const Lame& m) {
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  elements::Mat<9> D;
+  for (int c = 0; c < 9; ++c) {
+    Eigen::Matrix3d dF = Eigen::Matrix3d::Zero();
+    dF(c % 3, c / 3) = 1.0;
+    const Eigen::Matrix3d dE = 0.5 * (dF.transpose() * F + F.transpose() * dF);
+    const Eigen::Matrix3d dP = dF * S_geo + F * (2.0 * m.mu * dE + m.lambda * dE.trace() * I);
+    D.col(c) = Eigen::Map<const elements::Vec<9>>(dP.data());
+  }
+  return D;
+}
+
+Eigen::Matrix3d stvk_stress(const Eigen::Matrix3d& F, const Lame& m) {
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d E = 0.5 * (F.transpose() * F - I);
+  return 2.0 * m.mu * E + m.lambda * E.trace() * I;
+}
+
+// The stable neo-Hookean tangent μI + λ' g gᵀ + s ∂²J/∂F² (s = λ'(J - α)) in the signed SVD's
+// frame, dF = U E Vᵀ (an orthogonal change of basis of the 9 entries): J's second variation
+// is Σ_{i<j} σ_k (E_ii E_jj - E_ij E_ji) (k the third index), so each off-diagonal pair
+// (E_ij, E_ji) is an eigen-pair of its own, twist (1, -1)/√2 with μ + sσ_k and flip (1, 1)/√2
+// with μ - sσ_k; g = diag(σ1σ2, σ0σ2, σ0σ1) and the rest stay in the 3×3 block of the
+// diagonal entries. Clamps the negative eigenvalues and maps the result back; when none is
+// negative, returns exact() (the tangent as piola_derivative forms it) instead.
+template <class Exact>
+elements::Mat<9> snh_tangent_psd(const Eigen::Matrix3d& F, const Lame& m, double lambda_p, double alpha, Exact exact) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d U = svd.matrixU(), V = svd.matrixV();
+  Eigen::Vector3d sigma = svd.singularValues();
+  // rotations only: a reflection's sign goes to the smallest singular value
+  if (U.determinant() < 0.0) {
+    U.col(2) = -U.col(2);
+    sigma[2] = -sigma[2];
+  }
+  if (V.determinant() < 0.0) {
+    V.col(2) = -V.col(2);
+    sigma[2] = -sigma[2];
+  }
+  const double s = lambda_p * (sigma.prod() - alpha);
+  const Eigen::Vector3d c(sigma[1] * sigma[2], sigma[0] * sigma[2], sigma[0] * sigma[1]);
+  Eigen::Matrix3d A = m.mu * Eigen::Matrix3d::Identity() + lambda_p * c * c.transpose();
+  A(0, 1) += s * sigma[2];
+  A(1, 0) += s * sigma[2];
+  A(0, 2) += s * sigma[1];
+  A(2, 0) += s * sigma[1];
+  A(1, 2) += s * sigma[0];
+  A(2, 1) += s * sigma[0];
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> block;
+  block.computeDirect(A);
+  const double lowest_pair = m.mu - std::abs(s) * sigma.cwiseAbs().maxCoeff();
+  if (block.eigenvalues().minCoeff() >= 0.0 && lowest_pair >= 0.0) return exact();
+  elements::Mat<9> D = elements::Mat<9>::Zero();
+  const auto add = [&](double eigenvalue, const Eigen::Matrix3d& E) {
+    if (eigenvalue <= 0.0) return;
+    const Eigen::Matrix3d Q = U * E * V.transpose();
+    const Eigen::Map<const elements::Vec<9>> q(Q.data());
+    D.noalias() += eigenvalue * q * q.transpose();
+  };
+  for (int e = 0; e < 3; ++e) add(block.eigenvalues()[e], Eigen::Matrix3d(block.eigenvectors().col(e).asDiagonal()));
+  const double r = std::sqrt(0.5);
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    Eigen::Matrix3d twist = Eigen::Matrix3d::Zero(), flip = Eigen::Matrix3d::Zero();
+    twist(i, j) = r;
+    twist(j, i) = -r;
+    flip(i, j) = r;
+    flip(j, i) = r;
+    add(m.mu + s * sigma[k], twist);
+    add(m.mu - s * sigma[k], flip);
+  }
+  return D;
+}
+
+}  // namespace
+
+elements::Mat<9> piola_derivative_psd(TetLaw law, const Eigen::Matrix3d& F, const Lame& m) {
+  if (law == TetLaw::stvk) {
+    const Eigen::Matrix3d S = stvk_stress(F, m);
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+    eig.computeDirect(S);
+    if (eig.eigenvalues().minCoeff() >= 0.0) return stvk_tangent(F, S, m);
+    const Eigen::Matrix3d S_plus =
+        eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+    return stvk_tangent(F, S_plus, m);
+  }
+  const SnhParams p = snh(m);
+  return snh_tangent_psd(F, m, p.lambda, p.alpha, [&] { return piola_derivative(law, F, m); });
+}
+
 elements::Mat<9> piola_derivative(TetLaw law, const Eigen::Matrix3d& F, const Lame& m) {
   elements::Mat<9> D;
-  if (law == TetLaw::stvk) {
-    // dP = dF·S + F·(2μ dE + λ tr(dE) I), dE = ½(dFᵀF + FᵀdF), one column per unit dF.
-    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-    const Eigen::Matrix3d E = 0.5 * (F.transpose() * F - I);
-    const Eigen::Matrix3d S = 2.0 * m.mu * E + m.lambda * E.trace() * I;
-    for (int c = 0; c < 9; ++c) {
-      Eigen::Matrix3d dF = Eigen::Matrix3d::Zero();
-      dF(c % 3, c / 3) = 1.0;
-      const Eigen::Matrix3d dE = 0.5 * (dF.transpose() * F + F.transpose() * dF);
-      const Eigen::Matrix3d dP = dF * S + F * (2.0 * m.mu * dE + m.lambda * dE.trace() * I);
-      D.col(c) = Eigen::Map<const elements::Vec<9>>(dP.data());
-    }
-    return D;
-  }
+  if (law == TetLaw::stvk) return stvk_tangent(F, stvk_stress(F, m), m);
   // μI + λ' g gᵀ + λ'(J - α) ∂²J/∂F², g = vec(cof F); ∂²J/∂f_a∂f_b are ±skew(f_c).
   const SnhParams p = snh(m);
   const Eigen::Matrix3d C = cofactor(F);
@@ -136,11 +220,22 @@ Vec12 tet_gradient(TetLaw law, const TetPositions& x, const TetRest& rest, const
   return g;
 }
 
-Mat12 tet_hessian(TetLaw law, const TetPositions& x, const TetRest& rest, const Lame& m) {
+namespace {
+
+Mat12 tet_hessian_from(const elements::Mat<9>& D, const TetRest& rest) {
   const auto B = elements::deformation_jacobian<3>(rest.Dm_inv);
-  const elements::Mat<9> D = piola_derivative(law, deformation_gradient(x, rest), m);
-  Mat12 H = rest.volume * (B.transpose() * D * B);
+  const Mat12 H = rest.volume * (B.transpose() * D * B);
   return 0.5 * (H + H.transpose());
+}
+
+}  // namespace
+
+Mat12 tet_hessian(TetLaw law, const TetPositions& x, const TetRest& rest, const Lame& m) {
+  return tet_hessian_from(piola_derivative(law, deformation_gradient(x, rest), m), rest);
+}
+
+Mat12 tet_hessian_psd(TetLaw law, const TetPositions& x, const TetRest& rest, const Lame& m) {
+  return tet_hessian_from(piola_derivative_psd(law, deformation_gradient(x, rest), m), rest);
 }
 
 }  // namespace sewn::physics::solids

@@ -4,10 +4,10 @@
 // 4, patch bending: 4 to 6). A derived term supplies the element's energy, gradient and
 // Hessian over its stencil (DOF order [x0 y0 z0 x1 ...]); this class turns them into the
 // ForceTerm interface:
-//   forces = -gradient, ∂F/∂x = -Hessian (PSD-projected per element when
-//   JacobianOptions::project_element_hessians is set), no velocity dependence,
-//   stability rows from the projected Hessian, pattern pairs, slot caching, node checks and
-//   renumbering.
+//   forces = -gradient, ∂F/∂x = -Hessian (its PSD stand-in element_hessian_psd per element
+//   when JacobianOptions::project_element_hessians is set), no velocity dependence,
+//   stability rows from the eigen-projected exact Hessian, pattern pairs, slot caching, node
+//   checks and renumbering.
 // Cost per pass: one element evaluation per element plus a scatter of 3N values (forces) or
 // N² 3×3 blocks (Jacobians). Memory: N node indices and N² block slots per element.
 
@@ -61,6 +61,16 @@ class StencilTerm : public ForceTerm {
   [[nodiscard]] virtual double element_energy(Index e, const Positions& x) const = 0;
   [[nodiscard]] virtual Gradient element_gradient(Index e, const Positions& x) const = 0;
   [[nodiscard]] virtual Hessian element_hessian(Index e, const Positions& x) const = 0;
+  /// A positive-semidefinite stand-in for the Hessian, used where Newton asks for projected
+  /// element Hessians (the stability rows keep the eigen-projection of the exact one).
+  /// Default: element_hessian with its negative eigenvalues clamped (project_psd, one
+  /// eigendecomposition); a term with a cheaper closed form that is PSD by construction
+  /// overrides it (and says how it differs from the exact one).
+  [[nodiscard]] virtual Hessian element_hessian_psd(Index e, const Positions& x) const {
+    Hessian H = element_hessian(e, x);
+    project_psd(H);
+    return H;
+  }
 
  protected:
   /// Appends an element; throws InputError (naming the term) if a node repeats. Returns its index.

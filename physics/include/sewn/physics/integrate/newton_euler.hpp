@@ -16,7 +16,9 @@
 // when |p|∞/h < velocity_tolerance.
 //
 // The linear solve is the single function solve_linear() (block-Jacobi PCG on the block
-// matrix, or Eigen's SimplicialLDLT on its sparse copy), so a solver layer can replace it.
+// matrix, or a sparse direct solve: CHOLMOD's supernodal Cholesky through solve::LinearSolver
+// when the build has it, else, or once CHOLMOD finds the matrix not positive definite,
+// Eigen's SimplicialLDLT on its sparse copy).
 //
 // Failure (no descent direction or line search exhausted, too many iterations, a non-finite
 // energy, gradient or state) throws NewtonError naming what failed, with the node table
@@ -49,7 +51,7 @@ namespace sewn::physics::integrate {
 
 enum class LinearSolver {
   cg,    ///< block-Jacobi PCG on the block matrix to a relative tolerance (inexact Newton)
-  ldlt,  ///< Eigen SimplicialLDLT on the filtered sparse copy (exact; symbolic step cached)
+  ldlt,  ///< sparse direct: CHOLMOD when built, else Eigen SimplicialLDLT (exact; symbolic step cached)
 };
 
 struct NewtonEulerOptions {
@@ -60,6 +62,13 @@ struct NewtonEulerOptions {
   LinearSolver solver = LinearSolver::cg;
   double cg_tolerance = 1e-4;        ///< η: relative residual of each Newton system
   int cg_max_iterations = 5000;
+  /// With the direct solve (ldlt): each iteration first factors the exact Hessian (no element
+  /// projection) and keeps its step when the factorization finds the matrix positive definite
+  /// and the step is a descent direction; otherwise it assembles the projected Hessian and
+  /// solves again. Near an equilibrium the exact Hessian gives Newton's quadratic convergence
+  /// where the projected one converges linearly (a bent helix's indefinite bend-twist
+  /// stencils, compressed membranes). Ignored with CG (which cannot tell).
+  bool exact_hessian_first = true;
 };
 
 /// What a step did.
@@ -68,6 +77,7 @@ struct NewtonReport {
   int line_search_steps = 0;  ///< halvings of α, summed over iterations
   int linear_iterations = 0;  ///< CG iterations, summed (0 with LDLT)
   int steepest_fallbacks = 0; ///< iterations whose solve gave no descent and used -D⁻¹g instead
+  int projected_retries = 0;  ///< iterations whose exact Hessian was indefinite (exact_hessian_first)
   double step_velocity = 0.0; ///< |p|∞/h of the last iteration, m/s
   double phi_decrease = 0.0;  ///< Φ(q̂) - Φ(q_{n+1}) ≥ 0
 };
@@ -109,9 +119,11 @@ class NewtonEuler {
   [[nodiscard]] std::string describe_dof(std::size_t k) const;
   // Φ and its gradient at q (velocities (q - q_n)/h); returns Φ, fills g_. O(elements).
   double evaluate(const System& sys, std::span<const double> q, bool want_gradient);
-  void assemble(System& sys);
-  // Solves H p = -g on the free axes into p_; returns CG iterations (0 for LDLT).
-  int solve_linear(const BlockMatrix& A);
+  // H into sys.matrix(), the element Hessians PSD-projected or exact.
+  void assemble(System& sys, bool project);
+  // Solves H p = -g on the free axes into p_; returns CG iterations (0 for LDLT). With
+  // need_definite (direct solves only), returns -1 with p_ = 0 when H is not positive definite.
+  int solve_linear(const BlockMatrix& A, bool need_definite = false);
   [[nodiscard]] std::size_t dof_count() const { return inertia_.size(); }
 
   NewtonEulerOptions opt_;

@@ -76,6 +76,9 @@ struct StretchEval {
 };
 /// Cost O(1). Throws nothing; a zero-length edge gives non-finite values (callers check).
 [[nodiscard]] StretchEval stretch(const Vec3& x0, const Vec3& x1, double EA, double rest_length, bool want_hessian);
+/// The nearest PSD matrix to stretch()'s Hessian in closed form: the transverse stiffness
+/// EA·strain/l clamped at 0 (a compressed edge), no eigendecomposition. O(1).
+[[nodiscard]] Eigen::Matrix<double, 6, 6> stretch_hessian_psd(const Vec3& x0, const Vec3& x1, double EA, double rest_length);
 
 /// Constants of one interior vertex i (between edges i−1 and i).
 struct BendTwistRest {

@@ -49,5 +49,10 @@ struct HingeRest {
 [[nodiscard]] Vec12 hinge_gradient(const HingePositions& x, const HingeRest& rest, double k_b);
 /// Exact Hessian (symmetric, indefinite in general).
 [[nodiscard]] Mat12 hinge_hessian(const HingePositions& x, const HingeRest& rest, double k_b);
+/// The Gauss-Newton part of the hinge Hessian, 2·k_b·w·∇θ∇θᵀ: PSD (rank one) by construction,
+/// no eigendecomposition and no second derivative of θ (hinge_hessian needs both). It drops the curvature
+/// term 2·k_b·w·(θ-θ̄)·∇²θ, so it is exact at the rest angle and Newton's steps with it are
+/// Gauss-Newton steps (the gradient, hence the converged state, is unchanged).
+[[nodiscard]] Mat12 hinge_hessian_gauss_newton(const HingePositions& x, const HingeRest& rest, double k_b);
 
 }  // namespace sewn::physics::shells

@@ -50,5 +50,11 @@ struct TriRest {
 [[nodiscard]] Vec9 membrane_gradient(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m);
 /// Exact Hessian (symmetric, possibly indefinite under compression).
 [[nodiscard]] Mat9 membrane_hessian(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m);
+/// A PSD Hessian for Newton without an eigendecomposition of the 9×9: the exact Hessian with
+/// the stress of its geometric term (dF·S) clamped per principal stress to S⁺ ≥ 0 (2×2, closed
+/// form). Equal to membrane_hessian when both principal stresses are ≥ 0 (stretch); under
+/// compression it drops the negative part of the geometric stiffness. Not the nearest PSD
+/// matrix to the exact Hessian, but PSD by construction. Cost ~ membrane_hessian.
+[[nodiscard]] Mat9 membrane_hessian_psd(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m);
 
 }  // namespace sewn::physics::shells

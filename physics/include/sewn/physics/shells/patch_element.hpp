@@ -74,5 +74,11 @@ template <int N>
 /// Exact Hessian (symmetric, indefinite in general).
 template <int N>
 [[nodiscard]] elements::Mat<3 * N> patch_hessian(const PatchPositions<N>& x, const PatchRest& rest);
+/// The Gauss-Newton part of the Hessian, JᵀSJ (J's row k = ℓ_k ∇θ_k): PSD by construction
+/// (S is positive definite), with no angle Hessian and no eigendecomposition. It drops the
+/// curvature terms Σ_k (S d)_k ℓ_k ∇²θ_k, so it is exact where every d_k = 0 (the rest angles)
+/// and Newton's steps with it are Gauss-Newton steps (the gradient is unchanged).
+template <int N>
+[[nodiscard]] elements::Mat<3 * N> patch_hessian_gauss_newton(const PatchPositions<N>& x, const PatchRest& rest);
 
 }  // namespace sewn::physics::shells

@@ -4,9 +4,10 @@
 // bending energy of its own (its neighbours' patches hold its nodes). add_patch_bending builds
 // all three from a triangle list, each paid for only when some triangle needs it.
 // Forces = -gradient; ∂F/∂x = -Hessian (exact, or PSD-projected per element when
-// JacobianOptions::project_element_hessians is set); no damping of their own.
-// Cost per triangle: forces ~0.5 µs, Jacobians ~10 µs (three angle Hessians and an 18×18
-// eigen-projection).
+// JacobianOptions::project_element_hessians is set: the Gauss-Newton part, PSD by
+// construction); no damping of their own.
+// Cost per triangle: forces ~0.5 µs, exact Jacobians ~10 µs (three angle Hessians), projected
+// ones far less (three angle gradients and JᵀSJ, no eigen-projection).
 
 #include <array>
 #include <cstdint>
@@ -42,6 +43,10 @@ class PatchBending final : public elements::StencilTerm<N> {
     return patch_gradient<N>(x, rest_[e]);
   }
   [[nodiscard]] Hessian element_hessian(Index e, const Positions& x) const override { return patch_hessian<N>(x, rest_[e]); }
+  /// Gauss-Newton, PSD by construction (patch_hessian_gauss_newton).
+  [[nodiscard]] Hessian element_hessian_psd(Index e, const Positions& x) const override {
+    return patch_hessian_gauss_newton<N>(x, rest_[e]);
+  }
 
  private:
   std::vector<PatchRest> rest_;

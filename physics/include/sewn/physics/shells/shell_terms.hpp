@@ -3,8 +3,9 @@
 //   Membranes  CST membrane triangles (shells/membrane_element.hpp), material and thickness
 //              per element;
 //   Hinges     hinge bending over interior edges (shells/hinge_element.hpp), k_B per hinge.
-// Forces = -gradient; ∂F/∂x = -Hessian (exact, or PSD-projected per element when
-// JacobianOptions::project_element_hessians is set); no damping of their own.
+// Forces = -gradient; ∂F/∂x = -Hessian (exact, or, when JacobianOptions::
+// project_element_hessians is set, a PSD closed form per element: the membrane's with its
+// compressive stresses clamped, the hinge's Gauss-Newton part); no damping of their own.
 // Cost: membranes ~0.1 µs (forces) / ~1 µs (Jacobians) per triangle, hinges ~0.2 / ~3 µs.
 
 #include <array>
@@ -35,6 +36,11 @@ class Membranes final : public elements::StencilTerm<3> {
   }
   [[nodiscard]] Hessian element_hessian(Index e, const Positions& x) const override {
     return membrane_hessian(x, rest_[e], mat_[e]);
+  }
+  /// Closed form, no eigendecomposition: compressive principal stresses clamped in the
+  /// geometric term (membrane_hessian_psd).
+  [[nodiscard]] Hessian element_hessian_psd(Index e, const Positions& x) const override {
+    return membrane_hessian_psd(x, rest_[e], mat_[e]);
   }
 
  private:
@@ -72,6 +78,10 @@ class Hinges final : public elements::StencilTerm<4> {
   }
   [[nodiscard]] Hessian element_hessian(Index e, const Positions& x) const override {
     return hinge_hessian(x, rest_[e], k_[e]);
+  }
+  /// Gauss-Newton, PSD by construction (hinge_hessian_gauss_newton).
+  [[nodiscard]] Hessian element_hessian_psd(Index e, const Positions& x) const override {
+    return hinge_hessian_gauss_newton(x, rest_[e], k_[e]);
   }
 
  private:

@@ -61,10 +61,22 @@ enum class TetLaw { stvk, stable_neo_hookean };
 [[nodiscard]] double energy_density(TetLaw law, const Eigen::Matrix3d& H, const Lame& m);
 [[nodiscard]] Eigen::Matrix3d first_piola(TetLaw law, const Eigen::Matrix3d& F, const Lame& m);
 [[nodiscard]] elements::Mat<9> piola_derivative(TetLaw law, const Eigen::Matrix3d& F, const Lame& m);
+/// A PSD stand-in for piola_derivative with no 9×9 eigensolver.
+/// stable_neo_hookean: the nearest PSD matrix itself, from the tangent's closed-form
+/// eigensystem in the signed SVD F = U diag(σ) Vᵀ: μ ± λ'(J-α)σ_k on the twists and flips
+/// U (e_i e_jᵀ ∓ e_j e_iᵀ) Vᵀ/√2, and a 3×3 block on the scalings U diag(e) Vᵀ; negative
+/// eigenvalues are clamped to zero. stvk: the geometric term dF·S with S clamped to S⁺ ≥ 0 per
+/// principal stress (the material term is PSD), exact under tension, PSD by construction.
+/// piola_derivative is returned unchanged where it is PSD (neo-Hookean) or where all principal
+/// stresses are ≥ 0 (StVK). Cost: a 3×3 SVD or eigensolve.
+[[nodiscard]] elements::Mat<9> piola_derivative_psd(TetLaw law, const Eigen::Matrix3d& F, const Lame& m);
 
 /// V̄·Ψ, its gradient (12) and its Hessian (12×12, exact, symmetric, possibly indefinite).
 [[nodiscard]] double tet_energy(TetLaw law, const TetPositions& x, const TetRest& rest, const Lame& m);
 [[nodiscard]] Vec12 tet_gradient(TetLaw law, const TetPositions& x, const TetRest& rest, const Lame& m);
 [[nodiscard]] Mat12 tet_hessian(TetLaw law, const TetPositions& x, const TetRest& rest, const Lame& m);
+/// V̄ Bᵀ piola_derivative_psd B: PSD (B constant), the exact Hessian wherever the tangent is
+/// PSD, with no 12×12 eigendecomposition (what Newton's projected Jacobians use).
+[[nodiscard]] Mat12 tet_hessian_psd(TetLaw law, const TetPositions& x, const TetRest& rest, const Lame& m);
 
 }  // namespace sewn::physics::solids

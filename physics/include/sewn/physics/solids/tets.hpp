@@ -1,11 +1,12 @@
 #pragma once
 // Tets: a force term of elastic linear tetrahedra (solids/tet_element.hpp) with a material
 // and a rest shape per element, one law for the whole term (StVK or stable neo-Hookean).
-// Energy Σ_e V̄_e Ψ(F_e); forces = -gradient; ∂F/∂x = -Hessian (exact, or PSD-projected per
-// element when JacobianOptions::project_element_hessians is set). No damping of its own (add
+// Energy Σ_e V̄_e Ψ(F_e); forces = -gradient; ∂F/∂x = -Hessian (exact, or, when
+// JacobianOptions::project_element_hessians is set, tet_hessian_psd: PSD in closed form). No damping of its own (add
 // MassDamping, or let NewtonEuler's incremental potential dissipate). A scene without solids
 // does not instantiate it.
-// Cost: forces ~0.2 µs per element, Jacobians ~2 µs (projection included) per element.
+// Cost: forces ~0.2 µs per element, exact Jacobians ~2 µs per element; projected ones add a
+// 3×3 SVD (neo-Hookean) or eigensolve (StVK) instead of a 12×12 eigendecomposition.
 
 #include <array>
 #include <string_view>
@@ -38,6 +39,10 @@ class Tets final : public elements::StencilTerm<4> {
   }
   [[nodiscard]] Hessian element_hessian(Index e, const Positions& x) const override {
     return tet_hessian(law_, x, rest_[e], lame_[e]);
+  }
+  /// Closed form, no 12×12 eigendecomposition (tet_hessian_psd).
+  [[nodiscard]] Hessian element_hessian_psd(Index e, const Positions& x) const override {
+    return tet_hessian_psd(law_, x, rest_[e], lame_[e]);
   }
 
  private:
