@@ -39,6 +39,7 @@ set(expect_s04_anglerfish        "231;653;0.07")   # 592 tetrahedra, 41 fin tria
 # under the sanitizers): counts = particles and live hexahedra the criterion has made by then.
 set(expect_refine_fig09_spike    "1421;884;0.25")  # 100 hexahedra, 112 of them refined by t = 0.25 s
 set(expect_refine_fig11_beam     "1045;744;0.5")   # 2 roots pre-refined to 16, then 104 of those and their children
+set(expect_refine_fig08_cut_path "540;463")        # 441 points + the path's 14 inner points duplicated + 85 from 21 quads refined 1:4 (400 - 21 + 84 quads)
 set(expect_refine_fig10_rabbit   "3460;2480")       # bunny00.off voxelized, 324 hexahedra refined; skipped without the file
 
 # Under the sanitizers (-DSANITIZED=ON) these scenes are left to the release run of this test: a
