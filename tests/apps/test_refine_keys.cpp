@@ -230,6 +230,17 @@ double live_volume(const sewn::physics::MssModel<3>& m, bool rest) {
   return v;
 }
 
+// After a topology edit: the map valid, the refinement hierarchy sound, the mass kept exactly.
+void require_sound(const sewn::physics::MssModel<3>& m, double mass0) {
+  const auto report = m.map().validate();
+  INFO(report.str());
+  REQUIRE(report.ok());
+  const auto h = sewn::refine::check_hierarchy(m);
+  INFO(h.str());
+  REQUIRE(h.ok());
+  REQUIRE(std::abs(m.node_mass() - mass0) <= 1e-12 * mass0);
+}
+
 // The relative volume change of a soft 0.2 m cube on a clamped base under gravity after 0.4 s,
 // built as `sewn run` builds it (the volume term, then the refinement with its pre-refinement),
 // refined again after every step by a region criterion. Checks validate() and the hierarchy
@@ -258,14 +269,8 @@ double refined_cube_volume_change(double kappa) {
   for (int s = 0; s < 200; ++s) {
     (void)euler.step(m.system(), scene.step);
     if (refinement.after_step(m, scene.step * (s + 1))) {
-      const auto report = m.map().validate();
-      INFO(report.str());
-      REQUIRE(report.ok());
-      const auto h = sewn::refine::check_hierarchy(m);
-      INFO(h.str());
-      REQUIRE(h.ok());
+      require_sound(m, mass0);
       REQUIRE(std::abs(live_volume(m, true) - v0) <= 1e-12 * v0);
-      REQUIRE(std::abs(m.node_mass() - mass0) <= 1e-12 * mass0);
     }
   }
   CHECK(refinement.refined() > 2);
@@ -330,15 +335,7 @@ TEST_CASE("scenes/refine_fig08_cut_path.json: membrane quads refined where the c
   const auto& last = a.mesh.points[scene.cuts[0].faces.back()[1]];
   path.emplace_back(last[0], last[1], last[2]);
   const double mass0 = m.node_mass();
-  auto check_model = [&] {
-    const auto report = m.map().validate();
-    INFO(report.str());
-    REQUIRE(report.ok());
-    const auto h = sewn::refine::check_hierarchy(m);
-    INFO(h.str());
-    REQUIRE(h.ok());
-    REQUIRE(std::abs(m.node_mass() - mass0) <= 1e-12 * mass0);
-  };
+  auto check_model = [&] { require_sound(m, mass0); };
   sewn::physics::LinearlyImplicitEuler euler;
   const int cut_step = static_cast<int>(std::lround(scene.cuts[0].time / scene.step));
   for (int s = 0; s < 400; ++s) {
