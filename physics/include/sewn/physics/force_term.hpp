@@ -82,8 +82,8 @@ class StabilityRows {
   using SymBlock = std::array<double, 6>;
   /// A two-node term (a spring) whose stiffness and damping Hessians are [[B, -B], [-B, B]]
   /// for symmetric B = K and B = C: both diagonal blocks and the pair's off-diagonal block, in
-  /// one call. The same rows as add_diagonal and add_offdiagonal would give; inline and
-  /// branch-free when neither node is a slave, since it runs once per spring.
+  /// one call. The same rows as add_diagonal and add_offdiagonal would give; inline, with no
+  /// 3×3 temporaries when neither node is a slave, since it runs once per spring.
   void add_pair(Index i, Index j, const SymBlock& K, const SymBlock& C) {
     if (fold_ != nullptr && (fold_is_slave(i) || fold_is_slave(j))) {
       add_pair_folded(i, j, K, C);
