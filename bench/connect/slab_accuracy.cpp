@@ -18,10 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "sewn/apps/connections.hpp"
-#include "sewn/apps/continuum.hpp"
-#include "sewn/apps/paper_shapes.hpp"
-#include "sewn/io/cleanup.hpp"
+#include "sewn/apps/fig18_slab_model.hpp"
 #include "sewn/physics/basic_terms.hpp"
 #include "sewn/physics/integrate/newton_euler.hpp"
 #include "sewn_bench.hpp"
@@ -33,42 +30,29 @@ namespace {
 constexpr const char* suite = "connect";
 constexpr double L = 0.2, W = 0.04, T = 0.02, E = 1e7, nu = 0.3, rho = 1000, g = 9.81, simulated = 0.5;
 
-// The slab of cells of c (m): all tetrahedra, or (mixed) its second half the shell.
-IndexedMesh slab(double c, bool mixed) {
-  const auto n = static_cast<std::uint32_t>(std::lround(L / c)), ny = static_cast<std::uint32_t>(std::lround(W / c)),
-             nz = static_cast<std::uint32_t>(std::lround(T / c));
-  return app::fig18_slab(mixed ? n / 2 : n, mixed ? n - n / 2 : 0, ny, nz, c);
-}
-
 struct SlabRun {
   double sag = 0, cpu = 0, newton_per_step = 0;
 };
 
-// Runs the slab with `steps` steps of h from rest, critically damped; or, `quasi_static`, with
-// the velocities zeroed before each step (Newton on the static problem) until the sag settles.
+// Runs the slab of cells of c (m) — all tetrahedra, or (mixed) its second half the shell — with
+// `steps` steps of h from rest, critically damped; or, `quasi_static`, with the velocities
+// zeroed before each step (Newton on the static problem) until the sag settles.
 SlabRun run_slab(double c, bool mixed, double h, int steps, bool quasi_static) {
-  const IndexedMesh mesh = slab(c, mixed);
-  std::vector<physics::MaterialParams> materials{{E, nu, rho, T, 1e-4, physics::ElongatedPolicy::refuse}};
-  app::Scene s;
-  s.file = "slab";
-  s.model = "mixed";
-  s.damping = "none";
-  s.integrator = "newton";
-  s.connections.enabled = mixed;
-  s.connections.rigid = true;
-  physics::MssOptions mo;
-  mo.gravity = Eigen::Vector3d(0, 0, -g);
-  mo.damping = physics::DampingModel::none;
-  physics::MssModel<3> model(mesh, materials, std::vector<std::uint32_t>{}, mo);
-  const auto models = app::cell_models(mesh, io::embedded_cells(mesh), s, "slab");
-  const auto parts = app::build_continuum(s, materials, mesh, models, std::vector<int>(mesh.num_cells(), -1), model);
-  (void)app::build_connections(s, mesh, models, materials, parts, model);
-  std::vector<physics::Index> tip;
-  for (physics::Index i = 0; i < model.nodes().size(); ++i) {
-    const Eigen::Vector3d x = model.rest_position(i);
-    if (x.x() < 1e-9) model.nodes().fix(i, physics::all_axes);
-    if (x.x() > L - 1e-9) tip.push_back(i);
-  }
+  const auto n = static_cast<std::uint32_t>(std::lround(L / c));
+  app::Fig18SlabSpec spec;
+  spec.solid = mixed ? n / 2 : n;
+  spec.shell = mixed ? n - n / 2 : 0;
+  spec.ny = static_cast<std::uint32_t>(std::lround(W / c));
+  spec.nz = static_cast<std::uint32_t>(std::lround(T / c));
+  spec.cell = c;
+  spec.young = E;
+  spec.poisson = nu;
+  spec.density = rho;
+  spec.gravity = g;
+  spec.connections = mixed;
+  spec.rigid = true;
+  const app::Fig18SlabModel slab = app::build_fig18_slab_model(spec);
+  physics::MssModel<3>& model = *slab.model;
   // critical damping of the Euler–Bernoulli first mode, ω₁ = 1.875² √(EI / (ρA L⁴))
   const double omega1 = 1.8751 * 1.8751 * std::sqrt(E * W * T * T * T / 12 / (rho * W * T * std::pow(L, 4)));
   if (!quasi_static) model.system().add<physics::MassDamping>(2 * omega1);
@@ -77,11 +61,6 @@ SlabRun run_slab(double c, bool mixed, double h, int steps, bool quasi_static) {
   no.velocity_tolerance = quasi_static ? 1e-12 : 1e-8;
   no.solver = physics::integrate::LinearSolver::ldlt;
   physics::integrate::NewtonEuler newton(no);
-  auto sag = [&] {
-    double z = 0;
-    for (physics::Index i : tip) z += model.nodes().position(i).z() - model.rest_position(i).z();
-    return -z / static_cast<double>(tip.size());
-  };
   SlabRun out;
   int iterations = 0, taken = 0;
   const std::clock_t c0 = std::clock();
@@ -90,14 +69,14 @@ SlabRun run_slab(double c, bool mixed, double h, int steps, bool quasi_static) {
       for (double& v : model.nodes().v()) v = 0;
     iterations += newton.step(model.system(), h).iterations;
     // quasi-static: until the sag stops changing (to 1e-12 m)
-    if (quasi_static && std::abs(sag() - last) < 1e-12) {
+    if (quasi_static && std::abs(slab.sag() - last) < 1e-12) {
       ++taken;
       break;
     }
-    last = sag();
+    last = slab.sag();
   }
   out.cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
-  out.sag = sag();
+  out.sag = slab.sag();
   out.newton_per_step = static_cast<double>(iterations) / taken;
   return out;
 }

@@ -5,71 +5,46 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
-#include <memory>
 
-#include "sewn/apps/connections.hpp"
-#include "sewn/apps/continuum.hpp"
-#include "sewn/apps/paper_shapes.hpp"
-#include "sewn/io/cleanup.hpp"
+#include "sewn/apps/fig18_slab_model.hpp"
 #include "sewn/physics/integrate/newton_euler.hpp"
 
 namespace test_connection_slab {
 namespace {
 
-using sewn::physics::Index;
-
 constexpr double h = 0.01;                 // cell size (m)
 constexpr std::uint32_t ny = 4, nz = 2;    // slab 0.04 m wide, 0.02 m thick
-constexpr double E = 1e7, nu = 0.3, rho = 1000, g = 9.81;
-
-// `solid` cells of tetrahedra along x from x = 0, then `shell` cells of triangles on the
-// mid-surface z = h, their first column the solid's end-face nodes at z = h.
-sewn::IndexedMesh slab(std::uint32_t solid, std::uint32_t shell) { return sewn::app::fig18_slab(solid, shell, ny, nz, h); }
+constexpr double E = 1e7, rho = 1000, g = 9.81;
 
 // The static tip deflection (mean z displacement of the nodes at x = L) of the slab clamped at
-// x = 0 under gravity: backward Euler steps of 100 s from rest (the inertia term is then
-// 1e-4 of the slab's stiffness: Newton on the static problem), until the tip stops moving.
+// x = 0 under gravity, `solid` cells of tetrahedra along x from x = 0, then `shell` cells of the
+// mid-surface shell: backward Euler steps of 100 s from rest (the inertia term is then 1e-4 of
+// the slab's stiffness: Newton on the static problem), until the tip stops moving.
 double tip_sag(std::uint32_t solid, std::uint32_t shell, bool connections, bool rigid) {
-  const sewn::IndexedMesh mesh = slab(solid, shell);
-  std::vector<sewn::physics::MaterialParams> materials{{E, nu, rho, nz * h, 1e-4, sewn::physics::ElongatedPolicy::refuse}};
-  sewn::app::Scene s;
-  s.file = "slab.json";
-  s.model = "mixed";
-  s.damping = "none";
-  s.integrator = "newton";
-  s.connections.enabled = connections;
-  s.connections.rigid = rigid;
-  sewn::physics::MssOptions mo;
-  mo.gravity = Eigen::Vector3d(0, 0, -g);
-  mo.damping = sewn::physics::DampingModel::none;
-  sewn::physics::MssModel<3> model(mesh, materials, std::vector<std::uint32_t>{}, mo);
-  const auto models = sewn::app::cell_models(mesh, sewn::io::embedded_cells(mesh), s, "m");
-  const auto parts = sewn::app::build_continuum(s, materials, mesh, models, std::vector<int>(mesh.num_cells(), -1), model);
-  const auto joints = sewn::app::build_connections(s, mesh, models, materials, parts, model);
-  if (connections) REQUIRE(joints.curve_joints == ny);
-  const double L = (solid + shell) * h;
-  std::vector<Index> tip;
-  for (Index i = 0; i < model.nodes().size(); ++i) {
-    const Eigen::Vector3d x = model.rest_position(i);
-    if (x.x() < 1e-9) model.nodes().fix(i, sewn::physics::all_axes);
-    if (x.x() > L - 1e-9) tip.push_back(i);
-  }
-  auto sag = [&] {
-    double z = 0;
-    for (Index i : tip) z += model.nodes().position(i).z() - model.rest_position(i).z();
-    return -z / static_cast<double>(tip.size());
-  };
+  sewn::app::Fig18SlabSpec spec;
+  spec.solid = solid;
+  spec.shell = shell;
+  spec.ny = ny;
+  spec.nz = nz;
+  spec.cell = h;
+  spec.young = E;
+  spec.density = rho;
+  spec.gravity = g;
+  spec.connections = connections;
+  spec.rigid = rigid;
+  const sewn::app::Fig18SlabModel slab = sewn::app::build_fig18_slab_model(spec);
+  if (connections) REQUIRE(slab.curve_joints == ny);
   sewn::physics::integrate::NewtonEulerOptions no;
   no.max_iterations = 200;
   sewn::physics::integrate::NewtonEuler newton(no);
   double last = 0;
   for (int step = 0; step < 20; ++step) {
-    for (double& v : model.nodes().v()) v = 0;
-    (void)newton.step(model.system(), 100.0);
-    if (std::abs(sag() - last) < 1e-9) break;
-    last = sag();
+    for (double& v : slab.model->nodes().v()) v = 0;
+    (void)newton.step(slab.model->system(), 100.0);
+    if (std::abs(slab.sag() - last) < 1e-9) break;
+    last = slab.sag();
   }
-  return sag();
+  return slab.sag();
 }
 
 TEST_CASE("Fig. 18: a slab half solid, half shell, joined by a stiff curve connection, bends like the all-solid slab") {
