@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "parallel/ranges.hpp"
+#include "sewn/physics/force_term.hpp"
 #include "spring_frame.hpp"
 
 #if defined(__AVX512F__)
@@ -239,6 +240,78 @@ void chunk_range(const Soa& s, const Chunk* chunks, const std::uint8_t* masks, c
 #endif
 }
 
+#ifdef SEWN_RUNS_AVX512
+// The stable-step rows of chunks of eight springs (i0 + q, j0 + q): the chunk form of
+// Springs::add_stability_rows (its formulas: K = k (U Uᵀ + c (I − U Uᵀ)), c = max(0, 1 − l/d),
+// k I for a spring with no direction; C = γ U Uᵀ or β K), added to eight consecutive nodes'
+// accumulators at once. Dead lanes get k = γ = 0 and add zeros.
+template <RunDamping D, class Chunk>
+void stability_chunks(const double* __restrict x, const double* __restrict y, const double* __restrict z,
+                      const Chunk* __restrict chunks, const std::uint8_t* __restrict masks, std::size_t count,
+                      const double* __restrict k8, const double* __restrict l8, const double* __restrict g8, double beta,
+                      const StabilityRows::Lanes& L) {
+  const __m512d one = _mm512_set1_pd(1.0), zero = _mm512_setzero_pd(), tiny = _mm512_set1_pd(degenerate_ratio_sq);
+  const auto add = [](double* p, __m512d v) { _mm512_storeu_pd(p, _mm512_add_pd(_mm512_loadu_pd(p), v)); };
+  // Both nodes' diagonal blocks += B, and their off-diagonal row sums += |B| over the other
+  // node's free axes, scaled by 1/sqrt(mi mj).
+  const auto add_rows = [&](int w, std::size_t i, std::size_t j, const __m512d (&B)[6]) {
+    for (int e = 0; e < 6; ++e) {
+      add(L.diag[w][e] + i, B[e]);
+      add(L.diag[w][e] + j, B[e]);
+    }
+    const __m512d scale = _mm512_mul_pd(_mm512_loadu_pd(L.inv_sqrt_mass + i), _mm512_loadu_pd(L.inv_sqrt_mass + j));
+    __m512d a[6];
+    for (int e = 0; e < 6; ++e) a[e] = _mm512_abs_pd(B[e]);
+    // row r's entries (r, 0..2) in the SymBlock's order
+    static constexpr int row[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
+    for (int r = 0; r < 3; ++r) {
+      __m512d si = zero, sj = zero;
+      for (int c = 0; c < 3; ++c) {
+        si = _mm512_fmadd_pd(_mm512_loadu_pd(L.free[c] + j), a[row[r][c]], si);
+        sj = _mm512_fmadd_pd(_mm512_loadu_pd(L.free[c] + i), a[row[r][c]], sj);
+      }
+      add(L.off[w][r] + i, _mm512_mul_pd(scale, si));
+      add(L.off[w][r] + j, _mm512_mul_pd(scale, sj));
+    }
+  };
+  for (std::size_t c = 0; c < count; ++c) {
+    const std::size_t i = chunks[c].i0, j = chunks[c].j0;
+    const __mmask8 mk = masks[c];
+    const auto diff = [&](const double* p) { return _mm512_sub_pd(_mm512_loadu_pd(p + j), _mm512_loadu_pd(p + i)); };
+    const __m512d dx = diff(x), dy = diff(y), dz = diff(z);
+    const __m512d d2 = _mm512_fmadd_pd(dz, dz, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dx, dx)));
+    const __m512d l = _mm512_load_pd(l8 + 8 * c), k = _mm512_maskz_mov_pd(mk, _mm512_load_pd(k8 + 8 * c));
+    // A direction where d² is above the degenerate ratio (ordered: not for a NaN) and 1/d
+    // does not underflow to 0 (an overflowing d²), as the scalar path decides.
+    __mmask8 ok = _mm512_cmp_pd_mask(d2, _mm512_mul_pd(tiny, _mm512_mul_pd(l, l)), _CMP_GT_OQ);
+    __m512d w = _mm512_maskz_mov_pd(ok, inv_sqrt(d2));
+    ok &= _mm512_cmp_pd_mask(w, zero, _CMP_GT_OQ);
+    w = _mm512_maskz_mov_pd(ok, w);
+    const __m512d u0 = _mm512_maskz_mul_pd(ok, dx, w), u1 = _mm512_maskz_mul_pd(ok, dy, w), u2 = _mm512_maskz_mul_pd(ok, dz, w);
+    // U Uᵀ, or I's diagonal for a spring with no direction
+    const __m512d UU[6] = {_mm512_mask_blend_pd(ok, one, _mm512_mul_pd(u0, u0)), _mm512_mask_blend_pd(ok, one, _mm512_mul_pd(u1, u1)),
+                           _mm512_mask_blend_pd(ok, one, _mm512_mul_pd(u2, u2)), _mm512_mul_pd(u0, u1),
+                           _mm512_mul_pd(u0, u2),                                 _mm512_mul_pd(u1, u2)};
+    const __m512d cl = _mm512_maskz_max_pd(0xFF, _mm512_fnmadd_pd(l, w, one), zero);
+    const __m512d kc = _mm512_mul_pd(k, cl), k1c = _mm512_mul_pd(k, _mm512_sub_pd(one, cl));
+    __m512d K[6];
+    for (int e = 0; e < 6; ++e) K[e] = e < 3 ? _mm512_fmadd_pd(k1c, UU[e], kc) : _mm512_mul_pd(k1c, UU[e]);
+    add_rows(StabilityRows::stiffness, i, j, K);
+    if constexpr (D != RunDamping::none) {
+      __m512d C[6];
+      if constexpr (D == RunDamping::viscous) {
+        const __m512d g = _mm512_maskz_mov_pd(mk, _mm512_load_pd(g8 + 8 * c));
+        for (int e = 0; e < 6; ++e) C[e] = _mm512_mul_pd(g, UU[e]);
+      } else {
+        const __m512d b = _mm512_set1_pd(beta);
+        for (int e = 0; e < 6; ++e) C[e] = _mm512_mul_pd(b, K[e]);
+      }
+      add_rows(StabilityRows::damping, i, j, C);
+    }
+  }
+}
+#endif
+
 }  // namespace
 
 void SpringRuns::ensure_lane_index(Index count) {
@@ -389,20 +462,24 @@ void SpringRuns::refresh_parameters(const SpringArrays& a) {
   }
 }
 
-void SpringRuns::forces(const SpringArrays& a, RunDamping damping, double beta, std::span<const double> x,
-                        std::span<const double> v, std::span<double> f, bool accumulate, Index n) const {
+void SpringRuns::ensure_arrays(Index n, std::size_t arrays) const {
   // Room for an unmasked 8-lane access starting at the last node, and a quarter of headroom
   // when the arrays grow, so that a cut adding particles does not re-allocate (and fault in)
   // all twelve arrays before its first step.
-  const int parts = chunks_.size() >= 2 * thread_grain_chunks ? detail::parts_for(chunks_.size(), thread_grain_chunks) : 1;
-  // Threads past the first accumulate into three arrays of their own.
-  const std::size_t arrays = num_arrays + 3 * static_cast<std::size_t>(parts - 1);
   const std::size_t needed = (std::size_t{n} + 2 * lanes - 1) / lanes * lanes;
   if (needed > stride_ || needed + needed / 2 < stride_ || soa_.size() < arrays * stride_) {
     const std::size_t stride = (needed + needed / 4 + lanes - 1) / lanes * lanes;
     soa_.assign(arrays * stride, 0.0);
     stride_ = stride;
   }
+}
+
+void SpringRuns::forces(const SpringArrays& a, RunDamping damping, double beta, std::span<const double> x,
+                        std::span<const double> v, std::span<double> f, bool accumulate, Index n) const {
+  const int parts = chunks_.size() >= 2 * thread_grain_chunks ? detail::parts_for(chunks_.size(), thread_grain_chunks) : 1;
+  // Threads past the first accumulate into three arrays of their own.
+  const std::size_t arrays = num_arrays + 3 * static_cast<std::size_t>(parts - 1);
+  ensure_arrays(n, arrays);
   const std::size_t stride = stride_;
   if (parts > 1) {
     forces_threads(a, damping, beta, x, v, f, accumulate, n, parts);
@@ -451,6 +528,28 @@ void SpringRuns::forces(const SpringArrays& a, RunDamping damping, double beta, 
   }
   // Every spring is done: the nodes not joined yet are final.
   join_axes(s, f.data(), joined_to, n, accumulate);
+}
+
+bool SpringRuns::stability_rows(RunDamping damping, double beta, std::span<const double> x, Index n, StabilityRows& rows) const {
+#ifdef SEWN_RUNS_AVX512
+  if (rows.folds()) return false;
+  ensure_arrays(n, num_arrays);
+  const Soa s = soa_view(soa_.data(), stride_);
+  split_axes(x.data(), s.a[X], s.a[Y], s.a[Z], n);
+  const StabilityRows::Lanes L = rows.lanes();
+  const auto run = [&]<RunDamping D>() {
+    stability_chunks<D>(s.a[X], s.a[Y], s.a[Z], chunks_.data(), mask_.data(), chunks_.size(), k_.data(), l_.data(), g_.data(), beta, L);
+  };
+  switch (damping) {
+    case RunDamping::none: run.template operator()<RunDamping::none>(); break;
+    case RunDamping::viscous: run.template operator()<RunDamping::viscous>(); break;
+    case RunDamping::stiffness_proportional: run.template operator()<RunDamping::stiffness_proportional>(); break;
+  }
+  return true;
+#else
+  (void)damping, (void)beta, (void)x, (void)n, (void)rows;
+  return false;
+#endif
 }
 
 // The threaded force pass: the chunks split into `parts` ranges, each thread accumulating into

@@ -11,13 +11,28 @@ namespace sewn::physics {
 // ------------------------------------------------------------------ StabilityRows
 
 StabilityRows::StabilityRows(std::span<const double> mass, std::span<const AxisMask> fixed, const SlaveExpansion* fold)
-    : mass_(mass), fold_(fold), fixed_(fixed) {
+    : mass_(mass), fold_(fold), fixed_(fixed), stride_(mass.size() + 8) {
   for (int w = 0; w < 2; ++w) {
-    diag_[w].assign(9 * mass.size(), 0.0);
-    off_[w].assign(3 * mass.size(), 0.0);
+    diag_[w].assign(6 * stride_, 0.0);
+    off_[w].assign(3 * stride_, 0.0);
   }
-  inv_sqrt_mass_.resize(mass.size());
-  for (std::size_t i = 0; i < mass.size(); ++i) inv_sqrt_mass_[i] = mass[i] > 0 ? 1.0 / std::sqrt(mass[i]) : 0.0;
+  inv_sqrt_mass_.assign(stride_, 0.0);
+  free_.assign(3 * stride_, 0.0);
+  for (std::size_t i = 0; i < mass.size(); ++i) {
+    inv_sqrt_mass_[i] = mass[i] > 0 ? 1.0 / std::sqrt(mass[i]) : 0.0;
+    for (int a = 0; a < 3; ++a) free_[a * stride_ + i] = ((fixed[i] >> a) & 1u) != 0 ? 0.0 : 1.0;
+  }
+}
+
+StabilityRows::Lanes StabilityRows::lanes() {
+  Lanes l{};
+  for (int w = 0; w < 2; ++w) {
+    for (int e = 0; e < 6; ++e) l.diag[w][e] = diag_[w].data() + e * stride_;
+    for (int a = 0; a < 3; ++a) l.off[w][a] = off_[w].data() + a * stride_;
+  }
+  l.inv_sqrt_mass = inv_sqrt_mass_.data();
+  for (int a = 0; a < 3; ++a) l.free[a] = free_.data() + a * stride_;
+  return l;
 }
 
 void StabilityRows::add_diagonal(Which w, Index i, const Eigen::Matrix3d& B) {
@@ -67,9 +82,13 @@ void StabilityRows::add_pair_folded(Index i, Index j, const SymBlock& K, const S
 }
 
 void StabilityRows::diagonal_block(Which w, Index i, const Eigen::Matrix3d& B) {
-  double* d = diag_[w].data() + 9 * std::size_t{i};
-  for (int c = 0; c < 3; ++c)
-    for (int r = 0; r < 3; ++r) d[3 * c + r] += B(r, c);
+  double* d = diag_[w].data() + i;
+  d[0] += B(0, 0);
+  d[stride_] += B(1, 1);
+  d[2 * stride_] += B(2, 2);
+  d[3 * stride_] += 0.5 * (B(0, 1) + B(1, 0));
+  d[4 * stride_] += 0.5 * (B(0, 2) + B(2, 0));
+  d[5 * stride_] += 0.5 * (B(1, 2) + B(2, 1));
 }
 
 void StabilityRows::offdiagonal_block(Which w, Index i, Index j, const Eigen::Matrix3d& B) {
@@ -82,24 +101,29 @@ void StabilityRows::offdiagonal_block(Which w, Index i, Index j, const Eigen::Ma
       if (((fixed_[j] >> b) & 1u) == 0) row_i += std::abs(B(a, b));
       if (((fixed_[i] >> b) & 1u) == 0) row_j += std::abs(B(b, a));
     }
-    off_[w][3 * std::size_t{i} + a] += scale * row_i;
-    off_[w][3 * std::size_t{j} + a] += scale * row_j;
+    off_[w][a * stride_ + i] += scale * row_i;
+    off_[w][a * stride_ + j] += scale * row_j;
   }
+}
+
+double StabilityRows::row(Which w, Index i, int axis) const {
+  if (!(mass_[i] > 0) || ((fixed_[i] >> axis) & 1u) != 0) return 0.0;
+  const double* d = diag_[w].data() + i;
+  double row = 0;
+  for (int b = 0; b < 3; ++b)
+    if (((fixed_[i] >> b) & 1u) == 0) row += std::abs(d[sym_entry[3 * b + axis] * stride_]);
+  return row / mass_[i] + off_[w][axis * stride_ + i];
 }
 
 StabilityRows::Bound StabilityRows::bound(Which w) const {
   Bound out;
   for (Index i = 0; i < mass_.size(); ++i) {
     if (!(mass_[i] > 0)) continue;
-    const double* d = diag_[w].data() + 9 * std::size_t{i};
     for (int a = 0; a < 3; ++a) {
       if ((fixed_[i] >> a) & 1u) continue;
-      double row = 0;
-      for (int b = 0; b < 3; ++b)
-        if (((fixed_[i] >> b) & 1u) == 0) row += std::abs(d[3 * b + a]);
-      row = row / mass_[i] + off_[w][3 * std::size_t{i} + a];
-      if (row > out.value || (std::isnan(row) && out.node == invalid_index)) {
-        out.value = row;
+      const double r = row(w, i, a);
+      if (r > out.value || (std::isnan(r) && out.node == invalid_index)) {
+        out.value = r;
         out.node = i;
       }
     }

@@ -172,6 +172,46 @@ TEST_CASE("stability rows: a spring pair added at once gives the rows of its blo
   }
 }
 
+TEST_CASE("stability rows: the springs' eight-lane kernel gives the rows of the one-by-one path") {
+  // Rows that fold slaves take every spring one by one (an empty fold folds nothing); plain rows
+  // take the chunked springs eight at a time. Stretched, compressed and collapsed springs,
+  // removed springs inside chunks, fixed axes and a massless node, each damping model.
+  for (SpringDamping model : {SpringDamping::none, SpringDamping::viscous, SpringDamping::stiffness_proportional}) {
+    CAPTURE(static_cast<int>(model));
+    System sys;
+    const BoxLattice L = cube_lattice(sys, 8, 0.1, 1e5, 0.3, 1000, model);
+    if (model == SpringDamping::stiffness_proportional) L.springs->set_damping(model, 2e-3);
+    for (Index j = 0; j <= 8; ++j) sys.nodes().fix(L.node(0, j, 0), axis_x | axis_z);
+    sys.nodes().fix(L.node(8, 8, 8), all_axes);
+    for (Index s = 0; s < L.springs->size(); s += 37) L.springs->remove(s);
+    perturb(sys, 0.3 * 0.1 / 8, 0.0, 5);
+    const Index removed = L.node(4, 4, 4);
+    for (Index s = 0; s < L.springs->size(); ++s)
+      if (L.springs->is_alive(s) && (L.springs->node_i(s) == removed || L.springs->node_j(s) == removed)) L.springs->remove(s);
+    sys.nodes().remove(removed);
+    // one spring collapsed to a point: no direction
+    sys.nodes().set_position(L.node(3, 2, 1), sys.nodes().position(L.node(4, 2, 1)));
+    sys.refresh();
+    sys.compute_forces();  // the chunk plan is built
+    REQUIRE(L.springs->num_in_runs() > L.springs->size() / 2);
+    const SlaveExpansion none;
+    StabilityRows lanes(sys.nodes().masses(), sys.nodes().fixed_masks());
+    StabilityRows one_by_one(sys.nodes().masses(), sys.nodes().fixed_masks(), &none);
+    L.springs->add_stability_rows(sys.state(), lanes);
+    L.springs->add_stability_rows(sys.state(), one_by_one);
+    for (auto w : {StabilityRows::stiffness, StabilityRows::damping}) {
+      int differing = 0;
+      for (Index i = 0; i < sys.nodes().size(); ++i)
+        for (int a = 0; a < 3; ++a)
+          differing += lanes.row(w, i, a) == Approx(one_by_one.row(w, i, a)).epsilon(1e-13) ? 0 : 1;
+      CHECK(differing == 0);
+      CHECK(lanes.bound(w).value == Approx(one_by_one.bound(w).value).epsilon(1e-13));
+    }
+    CHECK(lanes.bound(StabilityRows::stiffness).value > 0);
+    CHECK((lanes.bound(StabilityRows::damping).value > 0) == (model != SpringDamping::none));
+  }
+}
+
 TEST_CASE("semi-implicit steps above the bound are refused with the bound in the message") {
   System sys;
   cube_lattice(sys, 3, 0.1, 1e5, 0.3, 1000, SpringDamping::viscous);

@@ -74,7 +74,8 @@ class StabilityRows {
     Index node = invalid_index;  ///< node whose row gives the bound
   };
   StabilityRows(std::span<const double> mass, std::span<const AxisMask> fixed, const SlaveExpansion* fold = nullptr);
-  /// Block (i,i) of K or C receives +B.
+  /// Block (i,i) of K or C receives +B; its symmetric part is kept (the bound is on the
+  /// symmetric K and C whose spectra set the stable step).
   void add_diagonal(Which w, Index i, const Eigen::Matrix3d& B);
   /// Blocks (i,j) = B and (j,i) = Bᵀ (sign irrelevant: absolute values are summed).
   void add_offdiagonal(Which w, Index i, Index j, const Eigen::Matrix3d& B);
@@ -89,37 +90,48 @@ class StabilityRows {
       add_pair_folded(i, j, K, C);
       return;
     }
-    // 1 for a free axis of a node with fixed-axis mask m, 0 for a fixed one
-    static constexpr double free_axis[8][3] = {{1, 1, 1}, {0, 1, 1}, {1, 0, 1}, {0, 0, 1},
-                                               {1, 1, 0}, {0, 1, 0}, {1, 0, 0}, {0, 0, 0}};
     const double scale = inv_sqrt_mass_[i] * inv_sqrt_mass_[j];
-    const double* fi = free_axis[fixed_[i] & 7u];
-    const double* fj = free_axis[fixed_[j] & 7u];
+    const double fi[3] = {free_[i], free_[stride_ + i], free_[2 * stride_ + i]};
+    const double fj[3] = {free_[j], free_[stride_ + j], free_[2 * stride_ + j]};
     for (int w = 0; w < 2; ++w) {
       const SymBlock& B = w == stiffness ? K : C;
-      // column-major 3×3 from the six entries
-      const double full[9] = {B[0], B[3], B[4], B[3], B[1], B[5], B[4], B[5], B[2]};
-      double* di = diag_[w].data() + 9 * std::size_t{i};
-      double* dj = diag_[w].data() + 9 * std::size_t{j};
-      for (int e = 0; e < 9; ++e) {
-        di[e] += full[e];
-        dj[e] += full[e];
+      double* d = diag_[w].data();
+      for (int e = 0; e < 6; ++e) {
+        d[e * stride_ + i] += B[e];
+        d[e * stride_ + j] += B[e];
       }
       if (scale == 0) continue;  // a removed node: no row, no column
       const double a0 = std::abs(B[0]), a1 = std::abs(B[1]), a2 = std::abs(B[2]);
       const double a3 = std::abs(B[3]), a4 = std::abs(B[4]), a5 = std::abs(B[5]);
-      double* oi = off_[w].data() + 3 * std::size_t{i};
-      double* oj = off_[w].data() + 3 * std::size_t{j};
-      oi[0] += scale * (fj[0] * a0 + fj[1] * a3 + fj[2] * a4);
-      oi[1] += scale * (fj[0] * a3 + fj[1] * a1 + fj[2] * a5);
-      oi[2] += scale * (fj[0] * a4 + fj[1] * a5 + fj[2] * a2);
-      oj[0] += scale * (fi[0] * a0 + fi[1] * a3 + fi[2] * a4);
-      oj[1] += scale * (fi[0] * a3 + fi[1] * a1 + fi[2] * a5);
-      oj[2] += scale * (fi[0] * a4 + fi[1] * a5 + fi[2] * a2);
+      double* o = off_[w].data();
+      o[i] += scale * (fj[0] * a0 + fj[1] * a3 + fj[2] * a4);
+      o[stride_ + i] += scale * (fj[0] * a3 + fj[1] * a1 + fj[2] * a5);
+      o[2 * stride_ + i] += scale * (fj[0] * a4 + fj[1] * a5 + fj[2] * a2);
+      o[j] += scale * (fi[0] * a0 + fi[1] * a3 + fi[2] * a4);
+      o[stride_ + j] += scale * (fi[0] * a3 + fi[1] * a1 + fi[2] * a5);
+      o[2 * stride_ + j] += scale * (fi[0] * a4 + fi[1] * a5 + fi[2] * a2);
     }
   }
   /// max over free axes of the scalar Gershgorin row sum. O(n).
   [[nodiscard]] Bound bound(Which w) const;
+  /// The Gershgorin row sum of node i's `axis` row (0 for a fixed axis or a removed node).
+  [[nodiscard]] double row(Which w, Index i, int axis) const;
+
+  /// Entry (r, c) of a 3×3 block, at 3 c + r, -> its index in a SymBlock.
+  static constexpr int sym_entry[9] = {0, 3, 4, 3, 1, 5, 4, 5, 2};
+  /// The accumulators as per-entry arrays over the nodes, for a kernel that adds the rows of
+  /// eight consecutive nodes at once (the springs' chunks, which pass no slave). Each array
+  /// has room for eight values past the last node; what is added there is never read.
+  struct Lanes {
+    double* diag[2][6];         ///< diagonal blocks, entries in SymBlock order
+    double* off[2][3];          ///< off-diagonal row sums, scaled by 1/sqrt(mi mj)
+    const double* inv_sqrt_mass;  ///< 0 for a removed node
+    const double* free[3];      ///< 1 for a free axis, 0 for a fixed one
+  };
+  /// True if the rows fold slaves onto their masters: then only add_pair and the block calls
+  /// apply, never a lane kernel.
+  [[nodiscard]] bool folds() const { return fold_ != nullptr; }
+  [[nodiscard]] Lanes lanes();
 
  private:
   void diagonal_block(Which w, Index i, const Eigen::Matrix3d& B);
@@ -127,11 +139,14 @@ class StabilityRows {
   void add_pair_folded(Index i, Index j, const SymBlock& K, const SymBlock& C);
   [[nodiscard]] bool fold_is_slave(Index i) const;
   std::span<const double> mass_;
-  std::vector<double> inv_sqrt_mass_;  // 1/sqrt(m), 0 for a removed node (no row, no column)
   const SlaveExpansion* fold_ = nullptr;
   std::span<const AxisMask> fixed_;
-  std::vector<double> diag_[2];  // 9 per node, column-major
-  std::vector<double> off_[2];   // 3 per node, already scaled by 1/sqrt(mi mj)
+  // Per-entry arrays over the nodes, each stride_ long (the node count, then eight spare).
+  std::size_t stride_ = 0;
+  std::vector<double> inv_sqrt_mass_;  // 1/sqrt(m), 0 for a removed node (no row, no column)
+  std::vector<double> free_;           // 3 arrays: 1 for a free axis, 0 for a fixed one
+  std::vector<double> diag_[2];        // 6 arrays: the diagonal blocks' entries, in SymBlock order
+  std::vector<double> off_[2];         // 3 arrays: off-diagonal row sums, scaled by 1/sqrt(mi mj)
 };
 
 /// Whether a term's potential is internal (elastic) or due to an external field (gravity):

@@ -38,7 +38,7 @@ struct StepReport {
 struct SymplecticEulerOptions {
   /// Refuse (StabilityError) a step h ≥ the stable-step bound. Opt out for cost benchmarks
   /// or when stability is ensured otherwise: an unguarded run then evaluates the bound (a
-  /// Gershgorin pass costing 15–25 steps of a spring grid) only to suggest a step when the
+  /// Gershgorin pass costing 5–10 steps of a spring grid) only to suggest a step when the
   /// watchdog stops it, never after a cut.
   bool enforce_stable_step = true;
   /// Steps between re-evaluations of the bound (it is also re-evaluated whenever the system

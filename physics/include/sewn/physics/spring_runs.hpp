@@ -18,6 +18,10 @@
 #include "sewn/physics/aligned.hpp"
 #include "sewn/physics/types.hpp"
 
+namespace sewn::physics {
+class StabilityRows;
+}
+
 namespace sewn::physics::detail {
 
 /// The spring arrays as the plan reads them (one entry per spring slot).
@@ -53,6 +57,8 @@ class SpringRuns {
   }
   [[nodiscard]] Index num_chunked() const { return chunked_; }
   [[nodiscard]] Index num_rest() const { return static_cast<Index>(rest_.size()); }
+  /// The springs in no chunk (some may be dead since they were listed), each listed once.
+  [[nodiscard]] std::span<const Index> rest() const { return rest_; }
 
   // ---- O(1) edits, called by Springs after it changed its own arrays (no-ops without a plan)
   /// Spring slot s was added (or reused): it joins the rest list.
@@ -70,6 +76,10 @@ class SpringRuns {
   /// f (3n). β is the Rayleigh factor (stiffness_proportional only). O(n + m).
   void forces(const SpringArrays& a, RunDamping damping, double beta, std::span<const double> x,
               std::span<const double> v, std::span<double> f, bool accumulate, Index n) const;
+  /// Adds the stable-step rows of the chunked springs at x (3n) to rows, eight springs at a
+  /// time; the rest list is the caller's. Returns false, adding nothing, where there is no
+  /// vector kernel (a build without AVX-512) or the rows fold slaves. O(n + chunks).
+  bool stability_rows(RunDamping damping, double beta, std::span<const double> x, Index n, StabilityRows& rows) const;
 
  private:
   struct Chunk {
@@ -78,6 +88,8 @@ class SpringRuns {
   // forces() on `parts` threads (spring_runs.cpp).
   void forces_threads(const SpringArrays& a, RunDamping damping, double beta, std::span<const double> x,
                       std::span<const double> v, std::span<double> f, bool accumulate, Index n, int parts) const;
+  // Sizes soa_ for n nodes and `arrays` per-axis arrays, keeping it if it fits.
+  void ensure_arrays(Index n, std::size_t arrays) const;
   void ensure_lane_index(Index count);
   void to_rest(Index s);
   // Switches off spring s's lane, if it has one.

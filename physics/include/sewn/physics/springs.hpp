@@ -108,6 +108,8 @@ class Springs final : public ForceTerm {
   void forces(const StateView& s, std::span<double> f, bool accumulate) const;
   // The AoS path: every spring from rows of 4 doubles per node.
   void forces_by_rows(const StateView& s, std::span<double> f, bool accumulate) const;
+  // The stable-step rows of the listed springs (dead ones skipped), one spring at a time.
+  void stability_rows_of(std::span<const Index> springs, const StateView& s, StabilityRows& rows) const;
   [[nodiscard]] detail::SpringArrays arrays() const;
   // The assembly (spring_jacobian.cpp) runs in two phases: each spring's block and product
   // into per-spring arrays, then those added into the matrix and product_out.
