@@ -1,4 +1,4 @@
-// bench_refine (issue 13): the 2014 paper's Table 1. Cases, all "ours" (no peer yet):
+// bench_refine (issue 13): the 2014 paper's Table 1. Cases (one with a CGAL peer):
 //   refine/table1/<config>/implicit   ms per step of the beam of Table 1 (two 1 m hexahedra side
 //       by side, 2 m x 1 m x 1 m, E = 100 kPa, nu = 0.3, rho = 100, g = 9.81, per-spring viscous
 //       damping, clamped at x = 0), linearly implicit Euler, h = 1 ms, CG to 1e-6 (block-Jacobi,
@@ -9,6 +9,8 @@
 //       Euler at 0.9x the system's stable-step bound, with the criterion pass.
 //   refine/subdivision/hex            one hexahedron of the settled adaptive 2-4 beam refined 1:8,
 //       T-junction constraints rebuilt (coarsened back, untimed, between repetitions).
+//   refine/subdivision/all/<beam>     every hexahedron of the beam refined 1:8 (refine_all, with the
+//       physics), against the same subdivision with CGAL LCC's insertions (cgal_subdivide.cpp).
 //   refine/t_junctions/forces         the T-junction force distribution of one step on the
 //       adaptive 2-4 state (SlaveNodes::pass_forces: forces of slaves passed to their masters).
 //   The implicit cases also carry "top-edge error (mm)": after 10 000 implicit steps from rest
@@ -37,6 +39,7 @@
 #include "sewn/refine/subdivide.hpp"
 #include "mss_setup.hpp"
 #include "sewn_bench.hpp"
+#include "subdivision_cases.hpp"
 
 namespace sewn::bench::refine_suite {
 namespace {
@@ -57,9 +60,7 @@ struct Config {
 };
 
 std::unique_ptr<MssModel<3>> beam(int refined) {
-  const std::uint32_t n = 1u << refined;
-  const double a = 1.0 / n;
-  auto m = viscous_model(hex_grid(2 * n, n, n, {{a, a, a}, {0, 0, 0}}), kE, kNu, kRho, kG, "table1 beam");
+  auto m = viscous_model(beam_mesh(refined), kE, kNu, kRho, kG, "table1 beam");
   for (Index i = 0; i < m->nodes().size(); ++i)
     if (m->rest_position(i).x() == 0) m->nodes().fix(i);
   return m;
@@ -255,6 +256,33 @@ void subdivision(benchmark::State& st) {
   count(st, *m);
 }
 
+// Every hexahedron of a beam refined 1:8 by refine_all (particles, masses, springs and hierarchy
+// included), on a beam built afresh with the clock paused; the CGAL-LCC peer subdivides the same
+// beam's map (cgal_subdivide.cpp).
+void subdivide_all(benchmark::State& st, const SubdivisionCase& c) {
+  std::unique_ptr<MssModel<3>> m;
+  for (auto _ : st) {
+    {
+      Untimed pause(st);
+      m.reset();
+      m = beam(c.refined);
+    }
+    benchmark::DoNotOptimize(refine::refine_all(*m, {}));
+  }
+  st.counters["hexahedra"] = static_cast<double>(m->num_live_elements());
+  if (first_time("subdivision/ours/" + c.name)) {
+    const Index want = Index{16} << (3 * c.refined);
+    const auto map_report = m->map().validate();
+    const refine::HierarchyReport hierarchy = refine::check_hierarchy(*m);
+    if (m->num_live_elements() != want)
+      st.SkipWithError(("refine_all left " + std::to_string(m->num_live_elements()) + " hexahedra, expected " + std::to_string(want)).c_str());
+    else if (!map_report.ok())
+      st.SkipWithError(("refine_all: " + map_report.str(3)).c_str());
+    else if (!hierarchy.ok())
+      st.SkipWithError(("refine_all: " + hierarchy.str()).c_str());
+  }
+}
+
 void t_junction_forces(benchmark::State& st) {
   MssModel<3>* m = &cached({"adaptive 2-4", 0, 4});
   m->system().compute_forces();
@@ -278,6 +306,8 @@ void register_all() {
     ours(kSuite, "subdivision/hex", subdivision);
     ours(kSuite, "t_junctions/forces", t_junction_forces);
   }
+  for (const SubdivisionCase& c : subdivision_cases())
+    ours(kSuite, "subdivision/" + c.name, [c](benchmark::State& st) { subdivide_all(st, c); });
 }
 
 const Registration reg(&register_all);

@@ -212,6 +212,25 @@ double sym_multiply(const CgWorkspace& ws, const double* __restrict p, double* _
   return hsum(pq);
 }
 
+// q = S A p, or with W the reduced product q = S Wᵀ A W p (p zero on the slaves); returns p·q.
+double packed_product(CgWorkspace& ws, const double* __restrict p, double* __restrict q, const double* __restrict s,
+                      Index n, const PaddedReduction* W) {
+  if (W == nullptr) return sym_multiply(ws, p, q, s, n);
+  const std::size_t n4 = 4 * std::size_t{n};
+  double* __restrict pe = ws.expanded.data();
+  std::copy(p, p + n4, pe);
+  W->expand4(pe);
+  (void)sym_multiply(ws, pe, q, ws.ones4.data(), n);
+  W->reduce4(q);
+  __m256d pq = _mm256_setzero_pd();
+  for (std::size_t o = 0; o < n4; o += 4) {
+    const __m256d qi = _mm256_mul_pd(_mm256_load_pd(q + o), _mm256_load_pd(s + o));
+    _mm256_store_pd(q + o, qi);
+    pq = _mm256_fmadd_pd(qi, _mm256_load_pd(p + o), pq);
+  }
+  return hsum(pq);
+}
+
 // z_i = S_i P_i S_i r_i for one node (pre: that block packed as a symmetric one).
 inline __m256d precond_row(const double* pre, __m256d r) {
   __m256d c0, c1, c2;
@@ -225,10 +244,16 @@ inline __m256d precond_row(const double* pre, __m256d r) {
 // pass, then p. The filter is folded into the preconditioner, S P S, as r and z vanish on fixed
 // axes; its blocks are stored as symmetric ones (P's upper triangle: the inverse of a symmetric
 // block is symmetric up to round-off).
+// With W, the same on the reduced system (packed_product).
 CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
-                    std::span<const double> P, double b_norm, double stop, int max_iterations, CgWorkspace& ws) {
+                    std::span<const double> P, double b_norm, double stop, int max_iterations, CgWorkspace& ws,
+                    const PaddedReduction* W = nullptr) {
   const std::size_t n = b.size() / 3, n4 = 4 * n;
   for (auto* v : {&ws.r, &ws.z, &ws.p, &ws.q, &ws.x4, &ws.free4}) v->assign(n4, 0.0);
+  if (W != nullptr) {
+    ws.expanded.assign(n4, 0.0);
+    ws.ones4.assign(n4, 1.0);
+  }
   ws.pre.resize(6 * n);
   for (std::size_t i = 0; i < n; ++i) {
     const double* f = free_dof.data() + 3 * i;
@@ -253,7 +278,7 @@ CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<co
   const double* __restrict pre = ws.pre.data();
   const double* __restrict s = ws.free4.data();
   const auto nodes = static_cast<Index>(n);
-  (void)sym_multiply(ws, xv, q, s, nodes);
+  (void)packed_product(ws, xv, q, s, nodes, W);
   __m256d rr_acc = _mm256_setzero_pd(), rz_acc = _mm256_setzero_pd();
   for (std::size_t i = 0; i < n; ++i) {
     const __m256d ri = _mm256_sub_pd(_mm256_mul_pd(_mm256_maskz_loadu_pd(0x7, b.data() + 3 * i), _mm256_load_pd(s + 4 * i)),
@@ -270,7 +295,7 @@ CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<co
   CgResult out;
   int it = 0;
   while (r_norm > stop && it < max_iterations) {
-    const double pq = sym_multiply(ws, p, q, s, nodes);
+    const double pq = packed_product(ws, p, q, s, nodes, W);
     if (!(pq > 0.0)) {
       out.breakdown = true;
       break;
@@ -405,6 +430,29 @@ CgResult filtered_pcg(const BlockMatrix& A, std::span<const double> b, std::span
   out.relative_residual = r_norm / b_norm;
   out.converged = !out.breakdown && std::isfinite(r_norm) && r_norm <= stop;
   return out;
+}
+
+bool reduced_pcg_packed(const BlockMatrix& A, std::span<const double> rb, std::span<double> x,
+                        std::span<const double> free_dof, std::span<const double> P, double tolerance,
+                        int max_iterations, CgWorkspace& ws, const PaddedReduction& W, CgResult& out) {
+#ifdef SEWN_CG_AVX512
+  if (!pack_symmetric(A, ws)) return false;
+  out = CgResult{};
+  double b_norm2 = 0;
+  for (std::size_t k = 0; k < rb.size(); ++k) b_norm2 += free_dof[k] * rb[k] * rb[k];
+  if (b_norm2 == 0.0) {  // as filtered_pcg: the free part of the solution is zero
+    for (std::size_t k = 0; k < rb.size(); ++k)
+      if (free_dof[k] != 0.0) x[k] = 0.0;
+    out.converged = true;
+    return true;
+  }
+  const double b_norm = std::sqrt(b_norm2);
+  out = pcg_packed(rb, x, free_dof, P, b_norm, tolerance * b_norm, max_iterations, ws, &W);
+  return true;
+#else
+  (void)A, (void)rb, (void)x, (void)free_dof, (void)P, (void)tolerance, (void)max_iterations, (void)ws, (void)W, (void)out;
+  return false;
+#endif
 }
 
 }  // namespace sewn::physics

@@ -1,12 +1,16 @@
 #include "sewn/refine/cut.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <map>
 #include <set>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <utility>
+
+#include <Eigen/Geometry>
 
 #include "hierarchy/bilinear.hpp"
 #include "hierarchy/neighbours.hpp"
@@ -46,19 +50,61 @@ std::vector<std::uint32_t> facet_points(const MssModel<D>& m, const Facet& f) {
   return pts;
 }
 
+// Rest positions of a facet's vertices (an edge: both ends).
+template <int D>
+std::vector<Vec3> facet_rest_vertices(const MssModel<D>& m, const Facet& f) {
+  std::vector<Vec3> out;
+  for (Dart x : facet_darts(m, f)) out.push_back(m.rest_position(m.node_of(x)));
+  if (f.index == 2) out.push_back(m.rest_position(m.node_of(m.map().beta(f.dart, 1))));
+  return out;
+}
+
 template <int D>
 Vec3 facet_centroid(const MssModel<D>& m, const Facet& f) {
   Vec3 c = Vec3::Zero();
-  std::size_t n = 0;
-  for (Dart x : facet_darts(m, f)) {
-    c += m.rest_position(m.node_of(x));
-    ++n;
+  const std::vector<Vec3> v = facet_rest_vertices(m, f);
+  for (const Vec3& p : v) c += p;
+  return c / static_cast<double>(v.size());
+}
+
+// True if the rest position q lies on the facet with these rest corners (2: a segment; more: a
+// planar convex polygon, corners in order, as every face of a mesh cell), to round-off of its size.
+bool on_facet(std::span<const Vec3> c, const Vec3& q) {
+  double size = 0;
+  for (const Vec3& p : c) size = std::max(size, (p - c[0]).norm());
+  const double tol = 1e-9 * size;
+  if (c.size() == 2) {
+    const Vec3 d = c[1] - c[0];
+    const double t = d.dot(q - c[0]) / d.squaredNorm();
+    return t >= -1e-9 && t <= 1 + 1e-9 && (c[0] + t * d - q).norm() <= tol;
   }
-  if (f.index == 2) {
-    c += m.rest_position(m.node_of(m.map().beta(f.dart, 1)));
-    ++n;
+  Vec3 n = Vec3::Zero();  // Newell's normal
+  for (std::size_t i = 0; i < c.size(); ++i) n += c[i].cross(c[(i + 1) % c.size()]);
+  n.normalize();
+  if (std::abs(n.dot(q - c[0])) > tol) return false;
+  for (std::size_t i = 0; i < c.size(); ++i)
+    if ((c[(i + 1) % c.size()] - c[i]).cross(q - c[i]).dot(n) < -tol * size) return false;
+  return true;
+}
+
+// The inner facets lying on the mesh facet whose points are `points`: the pieces refinement
+// split it into (their particles, made by refinement, have no mesh point to be named by).
+template <int D>
+std::vector<Facet> pieces_of(const MssModel<D>& m, std::span<const Facet> inner, std::span<const std::uint32_t> points) {
+  std::vector<Vec3> corners;
+  for (std::uint32_t p : points) {
+    const Index n = m.node_of_point(p);
+    if (n == invalid_index) return {};
+    corners.push_back(m.rest_position(n));
   }
-  return c / static_cast<double>(n);
+  std::vector<Facet> out;
+  if (corners.size() < 2 || !(corners[1] - corners[0]).allFinite()) return out;
+  for (const Facet& f : inner) {
+    if ((f.index == 2) != (corners.size() == 2)) continue;
+    const std::vector<Vec3> v = facet_rest_vertices(m, f);
+    if (std::all_of(v.begin(), v.end(), [&](const Vec3& q) { return on_facet(corners, q); })) out.push_back(f);
+  }
+  return out;
 }
 
 std::string point_list(std::span<const std::uint32_t> pts) {
@@ -345,7 +391,8 @@ std::vector<Facet> inner_facets(const MssModel<D>& m) {
 template <int D>
 std::vector<Facet> facets_with_points(const MssModel<D>& m, std::span<const std::vector<std::uint32_t>> faces) {
   std::map<std::vector<std::uint32_t>, Facet> by_points;
-  for (const Facet& f : inner_facets(m)) by_points.emplace(facet_points(m, f), f);
+  const std::vector<Facet> inner = inner_facets(m);
+  for (const Facet& f : inner) by_points.emplace(facet_points(m, f), f);
   // facets some cut already separated: both sides still name the same mesh points
   std::map<std::vector<std::uint32_t>, int> free_sides;  // a cut facet has two, a boundary facet one
   auto record_free = [&](Dart x, int index) {
@@ -369,8 +416,14 @@ std::vector<Facet> facets_with_points(const MssModel<D>& m, std::span<const std:
       continue;
     }
     if (const auto it = free_sides.find(key); it != free_sides.end() && it->second >= 2) continue;  // already cut
+    // refined since the scene named it: the pieces on it, matched by rest position
+    if (const std::vector<Facet> pieces = pieces_of(m, inner, faces[k]); !pieces.empty()) {
+      out.insert(out.end(), pieces.begin(), pieces.end());
+      continue;
+    }
     throw InputError("face " + std::to_string(k) + " (points " + point_list(faces[k]) +
-                     ") is not a face between two elements: no such face, or it lies on the boundary");
+                     ") is not a face between two elements: no such face, or it lies on the boundary" +
+                     " (or every piece refinement split it into is already cut)");
   }
   return out;
 }

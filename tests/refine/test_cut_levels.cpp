@@ -223,6 +223,46 @@ TEST_CASE("cut across a level jump, 3D: the coarser hexahedron is refined first"
   CHECK(std::abs(m.node_mass() - mass0) <= 1e-13 * mass0);
 }
 
+TEST_CASE("a facet named by its mesh points after refinement split it: the cut takes its pieces") {
+  // 2D: the inner edge x = 0.1 of two quads (points 1 and 4), split by refining one or both
+  for (bool both : {false, true}) {
+    MssModel<2> m(quads(2, 1), {material}, {}, refine_test::no_gravity());
+    (void)(both ? sewn::refine::refine_all(m) : sewn::refine::refine_element(m, 0));
+    const std::vector<std::vector<std::uint32_t>> edge{{1, 4}};
+    const std::vector<Facet> pieces = sewn::refine::facets_with_points(m, std::span(edge));
+    REQUIRE(pieces.size() == 2);
+    for (const Facet& f : pieces) CHECK(std::abs(m.rest_position(m.node_of(f.dart)).x() - 0.1) < 1e-15);
+    const sewn::refine::CutReport r = sewn::refine::cut(m, pieces);
+    refine_test::check_all(m);
+    CHECK(r.facets == 2);
+    CHECK(m.map().count_components() == 2);
+    CHECK(unweighed(m) == 0);
+    CHECK_THROWS_WITH_AS(sewn::refine::facets_with_points(m, std::span(edge)), doctest::Contains("already cut"),
+                         sewn::physics::InputError);
+  }
+  // 3D: the face x = 0.3 between two hexahedra (points 1, 4, 10, 7), the first refined: its 4
+  // pieces, the coarser side refined by the cut to meet them
+  MssModel<3> m(hexes(2, 1, 1), {material}, {}, refine_test::no_gravity());
+  (void)sewn::refine::refine_element(m, 0);
+  affine_velocities(m);
+  const double mass0 = m.node_mass();
+  const Vector3d p0 = momentum(m);
+  const std::vector<std::vector<std::uint32_t>> face{{1, 4, 10, 7}}, other{{0, 1, 7, 6}};
+  const std::vector<Facet> pieces = sewn::refine::facets_with_points(m, std::span(face));
+  REQUIRE(pieces.size() == 4);
+  const sewn::refine::CutReport r = sewn::refine::cut(m, pieces);
+  refine_test::check_all(m);
+  CHECK(r.facets == 4);
+  CHECK(r.refined == 1);
+  CHECK(m.map().count_components() == 2);
+  CHECK(unweighed(m) == 0);
+  CHECK(std::abs(m.node_mass() - mass0) <= 1e-13 * mass0);
+  CHECK((momentum(m) - p0).norm() <= 1e-13 * p0.norm());
+  // a boundary face of the refined hexahedron is still no face between two elements
+  CHECK_THROWS_WITH_AS(sewn::refine::facets_with_points(m, std::span(other)), doctest::Contains("boundary"),
+                       sewn::physics::InputError);
+}
+
 TEST_CASE("coarsening is refused where a cut ends at a side midpoint a coarser neighbour shares") {
   MssModel<2> m(quads(2, 1), {material}, {}, refine_test::no_gravity());
   (void)sewn::refine::refine_element(m, 0);

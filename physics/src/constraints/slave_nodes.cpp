@@ -19,6 +19,47 @@ void put(std::span<double> a, Index i, const Vec3& v) {
   for (int k = 0; k < 3; ++k) a[3 * i + k] = v[k];
 }
 
+// y ← Wᵀ y on node rows of `stride` doubles (3, or 4 padded): fine to coarse, a slave master
+// passes its share on.
+template <std::size_t stride>
+void reduce_rows(std::span<const SlaveNode> slaves, double* y) {
+  for (std::size_t i = slaves.size(); i-- > 0;) {
+    const SlaveNode& s = slaves[i];
+    double* v = y + stride * s.node;
+    for (int k = 0; k < s.masters; ++k) {
+      double* c = y + stride * s.master[static_cast<std::size_t>(k)];
+      const double w = s.weight[static_cast<std::size_t>(k)];
+      for (std::size_t a = 0; a < 3; ++a) c[a] += w * v[a];
+    }
+    for (std::size_t a = 0; a < 3; ++a) v[a] = 0;
+  }
+}
+
+// z ← W z on node rows of `stride` doubles: coarse to fine, a slave master is set before it is used.
+template <std::size_t stride>
+void expand_rows(std::span<const SlaveNode> slaves, double* z) {
+  for (const SlaveNode& s : slaves) {
+    double v[3] = {0, 0, 0};
+    for (int k = 0; k < s.masters; ++k) {
+      const double* c = z + stride * s.master[static_cast<std::size_t>(k)];
+      const double w = s.weight[static_cast<std::size_t>(k)];
+      for (std::size_t a = 0; a < 3; ++a) v[a] += w * c[a];
+    }
+    for (std::size_t a = 0; a < 3; ++a) z[stride * s.node + a] = v[a];
+  }
+}
+
+// W and Wᵀ for the packed CG's padded rows.
+class Padded final : public PaddedReduction {
+ public:
+  explicit Padded(std::span<const SlaveNode> slaves) : slaves_(slaves) {}
+  void expand4(double* v) const override { expand_rows<4>(slaves_, v); }
+  void reduce4(double* v) const override { reduce_rows<4>(slaves_, v); }
+
+ private:
+  std::span<const SlaveNode> slaves_;
+};
+
 }  // namespace
 
 void SlaveNodes::set(std::vector<SlaveNode> slaves, std::vector<std::vector<std::pair<Index, double>>> shares) {
@@ -66,22 +107,9 @@ void SlaveNodes::pass_forces(std::span<double> f) const {
   reduce(f);
 }
 
-void SlaveNodes::reduce(std::span<double> y) const {
-  for (std::size_t i = slaves_.size(); i-- > 0;) {  // fine to coarse: a slave master passes its share on
-    const SlaveNode& s = slaves_[i];
-    const Vec3 yv = at(y, s.node);
-    for (int k = 0; k < s.masters; ++k) put(y, s.master[k], at(y, s.master[k]) + s.weight[k] * yv);
-    put(y, s.node, Vec3::Zero());
-  }
-}
+void SlaveNodes::reduce(std::span<double> y) const { reduce_rows<3>(slaves_, y.data()); }
 
-void SlaveNodes::expand(std::span<double> z) const {
-  for (const SlaveNode& s : slaves_) {  // coarse to fine: a slave master is set before it is used
-    Vec3 v = Vec3::Zero();
-    for (int k = 0; k < s.masters; ++k) v += s.weight[k] * at(z, s.master[k]);
-    put(z, s.node, v);
-  }
-}
+void SlaveNodes::expand(std::span<double> z) const { expand_rows<3>(slaves_, z.data()); }
 
 std::vector<double> SlaveNodes::lumped_masses(const NodeTable& nodes) const {
   std::vector<double> lumped;
@@ -208,6 +236,14 @@ CgResult SlaveNodes::solve_reduced(const BlockMatrix& A, std::span<const double>
   free_.assign(free_dof.begin(), free_dof.end());
   for (const SlaveNode& s : slaves_)
     for (int a = 0; a < 3; ++a) free_[3 * s.node + a] = 0;
+  std::vector<double> rb(b.begin(), b.end());
+  reduce(rb);
+  for (std::size_t k = 0; k < n3; ++k) rb[k] *= free_[k];
+  // the fast path: the solver layer's packed symmetric product with W and Wᵀ folded in
+  if (CgResult fast; reduced_pcg_packed(A, rb, x, free_, precond_inverse, tolerance, max_iterations, ws_, Padded(slaves_), fast)) {
+    expand(x);
+    return fast;
+  }
   r_.assign(n3, 0.0);
   z_.assign(n3, 0.0);
   p_.assign(n3, 0.0);
@@ -228,10 +264,8 @@ CgResult SlaveNodes::solve_reduced(const BlockMatrix& A, std::span<const double>
         out[3 * i + a] = free_[3 * i + a] * (m[a] * in[3 * i] + m[3 + a] * in[3 * i + 1] + m[6 + a] * in[3 * i + 2]);
     }
   };
-  std::vector<double> rb(b.begin(), b.end());
-  reduce(rb);
   double bnorm = 0;
-  for (std::size_t k = 0; k < n3; ++k) bnorm += (rb[k] *= free_[k]) * rb[k];
+  for (std::size_t k = 0; k < n3; ++k) bnorm += rb[k] * rb[k];
   bnorm = std::sqrt(bnorm);
   apply(x, ap_);
   for (std::size_t k = 0; k < n3; ++k) r_[k] = rb[k] - ap_[k];

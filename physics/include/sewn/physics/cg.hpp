@@ -38,7 +38,29 @@ struct CgWorkspace {
   AlignedVector<double> sym_val;                  // 6 per block: a00 a01 a02 a11 a12 a22
   AlignedVector<double> x4, free4;                // 4 per node
   AlignedVector<double> pre;                      // the filtered preconditioner, 6 per node
+  AlignedVector<double> expanded, ones4;          // a reduced solve's W p, and a filter of ones
 };
+
+/// W and Wᵀ of a reduced system on node vectors padded to 4 doubles (SlaveNodes: the
+/// T-junctions' interpolation): expand4 sets each slave's row from its masters, reduce4 adds it
+/// to them and zeroes it.
+class PaddedReduction {
+ public:
+  virtual void expand4(double* v) const = 0;
+  virtual void reduce4(double* v) const = 0;
+
+ protected:
+  ~PaddedReduction() = default;
+};
+
+/// The packed fast path of filtered_pcg (one thread) on the reduced system S Wᵀ A W S, W's
+/// products folded into each matrix product: rb = S Wᵀ b, free_dof 0 on the slaves' axes too,
+/// x the warm start (its slave rows are overwritten by nothing: expand x afterwards). Returns
+/// false, x untouched, when that path cannot run (a build without AVX-512, or a block of A not
+/// exactly symmetric): the caller then solves another way. O(iterations · blocks).
+bool reduced_pcg_packed(const BlockMatrix& A, std::span<const double> rb, std::span<double> x,
+                        std::span<const double> free_dof, std::span<const double> precond_inverse, double tolerance,
+                        int max_iterations, CgWorkspace& ws, const PaddedReduction& W, CgResult& out);
 
 /// Solves A x = b on the free axes with x fixed to its incoming values on the others (pass
 /// the warm start there too). Stops when ‖S(b - Ax)‖ ≤ max(tolerance · ‖Sb‖, absolute_floor)

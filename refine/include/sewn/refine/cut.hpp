@@ -44,10 +44,12 @@ using Region = std::function<bool(const Eigen::Vector3d&)>;
 template <int D>
 std::vector<Facet> inner_facets(const MssModel<D>& m);
 
-/// The inner facets given by their mesh point indices (3 or 4 per face, 2 per edge of a 2D
-/// mesh); a facet an earlier cut already separated is skipped. Throws physics::InputError
-/// naming the first list that is no facet between two elements (no such face, or a boundary
-/// face). O(darts + faces).
+/// The inner facets given by their mesh point indices (3 or 4 per face, in order around it; 2
+/// per edge of a 2D mesh); a facet an earlier cut already separated is skipped. A facet that
+/// refinement has split since gives its pieces: the inner facets whose particles all lie on it
+/// at rest. Throws physics::InputError naming the first list that is no facet between two
+/// elements (no such face, a boundary face, or a refined one whose pieces are all cut already).
+/// O(darts + faces), plus O(darts) for each refined one.
 template <int D>
 std::vector<Facet> facets_with_points(const MssModel<D>& m, std::span<const std::vector<std::uint32_t>> faces);
 

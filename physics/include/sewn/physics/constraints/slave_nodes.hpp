@@ -117,6 +117,7 @@ class SlaveNodes {
   void lump(const NodeTable& nodes, std::vector<double>& lumped) const;  // lumped_masses into a buffer
 
   std::vector<double> inv_mass_, lumped_, r_, z_, p_, q_, ap_, free_, blocks_;
+  CgWorkspace ws_;  // solve_reduced's packed path
 };
 
 }  // namespace sewn::physics
