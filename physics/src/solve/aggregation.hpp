@@ -1,11 +1,13 @@
 #pragma once
-// Internal: the hierarchy of the sa-pcg backend, smoothed aggregation (algebraic multigrid
-// built on the rigid-body modes), and its symmetric V-cycle. Our own method, after the
-// classical recipe: aggregates of strongly coupled neighbouring nodes; on each aggregate the
-// near-null space (three translations and three rotations of its nodes at the fine level; the
-// coarse representation of those six modes further down) orthonormalised into the tentative
-// prolongator T; P = (I - ω D⁻¹ K) T, one damped block-Jacobi smoothing of it; the Galerkin
-// coarse matrix Pᵀ K P; recursively until a level is small enough for a dense Cholesky.
+// Internal: the hierarchy of the sa-pcg backend, aggregation multigrid built on the rigid-body
+// modes, and its symmetric V-cycle. Our own method, after the classical smoothed-aggregation
+// recipe: aggregates of strongly coupled neighbouring nodes; on each aggregate the near-null
+// space (three translations and three rotations of its nodes at the fine level; the coarse
+// representation of those six modes further down) orthonormalised into the tentative
+// prolongator T; the Galerkin coarse matrix Pᵀ K P; recursively until a level is small enough
+// for a dense Cholesky. P = (I - ω D⁻¹ K) T, the smoothing that gives the method its name, is
+// built in but off: measured, it made the coarse matrices denser than the fine one for no
+// fewer iterations once the fine level is smoothed three times (aggregation.cpp).
 //
 // Level 0 is the filtered fine matrix K = S A S + (I - S). The V-cycle applies it through A
 // itself (BlockMatrix::multiply, threaded) so that the fine smoothing follows the matrix of the
