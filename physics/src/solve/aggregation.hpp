@@ -7,7 +7,9 @@
 // prolongator T; the Galerkin coarse matrix Pᵀ K P; recursively until a level is small enough
 // for a dense Cholesky. P = (I - ω D⁻¹ K) T, the smoothing that gives the method its name, is
 // built in but off: measured, it made the coarse matrices denser than the fine one for no
-// fewer iterations once the fine level is smoothed three times (aggregation.cpp).
+// fewer iterations once the fine level is smoothed well (aggregation.cpp). The fine level is
+// smoothed by a Chebyshev polynomial in D⁻¹K (D: its 3×3 diagonal blocks), the coarse ones by
+// one damped block-Jacobi sweep, the same before and after: the V-cycle is symmetric.
 //
 // Level 0 is the filtered fine matrix K = S A S + (I - S). The V-cycle applies it through A
 // itself (BlockMatrix::multiply, threaded) so that the fine smoothing follows the matrix of the
@@ -72,7 +74,7 @@ class SaHierarchy {
   Eigen::LLT<Eigen::MatrixXd> coarsest_;
   // work vectors of the V-cycle, per level
   std::vector<Eigen::VectorXd> rc_, zc_, tc_, uc_;
-  AlignedVector<double> t0_, u0_;
+  AlignedVector<double> t0_, u0_, d0_;
 };
 
 }  // namespace sewn::physics::solve::detail

@@ -26,7 +26,7 @@
 //   sa-pcg       the same CG and refresh rule, preconditioned by one V-cycle of our own
 //                aggregation multigrid (coarse spaces from the rigid-body modes of aggregates of
 //                neighbouring nodes; set_coordinates() gives the positions they need): set-up
-//                O(entries of the Galerkin products), V-cycle ~7 fine block-sparse products;
+//                O(entries of the Galerkin products), V-cycle 7 fine block-sparse products;
 //   petsc        PETSc's KSP (CG, GAMG preconditioner) on every MPI rank of the program, each
 //                rank owning a contiguous range of rows: the solve distributed, A assembled on
 //                every rank (docs/scaling.md).
