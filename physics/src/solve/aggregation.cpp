@@ -261,7 +261,7 @@ void SaHierarchy::clear() {
   fine_omega_ = 0;
   fine_unknowns_ = 0;
   fine_entries_ = 0;
-  coarsest_ = Eigen::LLT<Eigen::MatrixXd>();
+  coarsest_dense_ = false;  // (a default LLT copied in would carry an uninitialised status)
 }
 
 void SaHierarchy::build(const FineInput& in, const char* who) {
@@ -306,6 +306,7 @@ void SaHierarchy::build(const FineInput& in, const char* who) {
           throw SolverError(std::string(who) + ": the matrix is not positive definite on the free axes (its coarsest "
                                                "multigrid level of " + std::to_string(n) + " unknowns is not)",
                             0, 0);
+        coarsest_dense_ = true;
       }
       break;
     }
@@ -367,7 +368,7 @@ void SaHierarchy::descend(std::size_t l) {
   const CoarseLevel& c = levels_[l - 1];
   Eigen::VectorXd &r = rc_[l], &z = zc_[l], &t = tc_[l], &u = uc_[l];
   if (l == levels_.size()) {
-    if (coarsest_.rows() == r.size() && r.size() > 0) {
+    if (coarsest_dense_) {
       z = coarsest_.solve(r);
       return;
     }

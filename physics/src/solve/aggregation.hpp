@@ -72,6 +72,7 @@ class SaHierarchy {
   std::int64_t fine_unknowns_ = 0;
   double fine_omega_ = 0, fine_entries_ = 0;
   Eigen::LLT<Eigen::MatrixXd> coarsest_;
+  bool coarsest_dense_ = false;  // the last level is factored in coarsest_ (else smoothed only)
   // work vectors of the V-cycle, per level
   std::vector<Eigen::VectorXd> rc_, zc_, tc_, uc_;
   AlignedVector<double> t0_, u0_, d0_;
