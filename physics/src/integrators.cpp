@@ -279,6 +279,7 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
       sr.relative_residual = cg.relative_residual;
       sr.converged = cg.converged;
     } else {
+      solver_->set_coordinates(nodes.x());
       sr = solver_->solve(A, b_, dv_, free_, mass3_);
       solved_topology_ = sys.topology_key();
     }

@@ -31,7 +31,7 @@ using namespace sewn::physics::test::solve_helpers;
 // The backends that keep a preconditioner (a factorization, an AMG hierarchy) across solves.
 std::vector<solve::Backend> kept_preconditioner_backends() {
   std::vector<solve::Backend> out;
-  for (auto b : {solve::Backend::cholmod_pcg, solve::Backend::hypre_pcg})
+  for (auto b : {solve::Backend::cholmod_pcg, solve::Backend::hypre_pcg, solve::Backend::sa_pcg})
     if (solve::available(b)) out.push_back(b);
   return out;
 }
@@ -203,8 +203,45 @@ TEST_CASE("a reused factorization is refreshed when the matrix changes, and the 
   CHECK(relative_residual(B, p3, z) <= 1e-9);
 }
 
+TEST_CASE("sa-pcg builds its hierarchy from the nodes' positions, and again on a new pattern") {
+  auto mp = beam_8x8x10();
+  MssModel<3>& m = *mp;
+  assemble(m.system(), 1e-3);
+  const BlockMatrix& A = m.system().matrix();
+  const Problem p = random_problem(A, &m.nodes(), 0.0, 11);
+  solve::SolverOptions o;
+  o.absolute_tolerance = 0;
+  o.tolerance = 1e-9;
+  // with rotations (positions given) and with translations only: both solve to tolerance
+  for (const bool positions : {true, false}) {
+    CAPTURE(positions);
+    auto s = solve::make_solver(solve::Backend::sa_pcg, o);
+    if (positions) s->set_coordinates(m.nodes().x());
+    std::vector<double> x = p.x0;
+    const auto r = s->solve(A, p.b, x, p.free_dof);
+    CHECK(r.converged);
+    CHECK(r.factorizations == 1);
+    CHECK(relative_residual(A, p, x) <= 1e-9);
+    // the positions are part of the kept state (a resumed run sets up on the same modes)
+    CHECK(s->state().factored.size() == 9 * std::size_t(A.num_blocks()) + (positions ? 6 : 3) * std::size_t(A.size()));
+    // a new pattern (what a cut does): set up afresh, still right; positions of the old node
+    // count are ignored (translations only)
+    BlockMatrix B;
+    random_spd(B, 200, 9);
+    const Problem p3 = random_problem(B, nullptr, 0.1, 5);
+    std::vector<double> z = p3.x0;
+    const auto q = s->solve(B, p3.b, z, p3.free_dof);
+    CHECK(q.factorizations == 1);
+    CHECK(relative_residual(B, p3, z) <= 1e-9);
+  }
+}
+
 TEST_CASE("cholmod-pcg and hypre-pcg refresh their preconditioner once the iteration count grows") {
   for (auto backend : kept_preconditioner_backends()) {
+    // sa-pcg smooths its fine level with the matrix of the solve itself: scaling the diagonal
+    // (below) does not make its kept hierarchy stale (6 iterations against 8 fresh, measured);
+    // the drifting beam of the refresh-rule test below refreshes it.
+    if (backend == solve::Backend::sa_pcg) continue;
     CAPTURE(solve::to_string(backend));
     RefreshingPcg f(backend, 21, 0.0);
     BlockMatrix& A = f.A;

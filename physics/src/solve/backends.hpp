@@ -11,6 +11,7 @@
 namespace sewn::physics::solve::detail {
 
 std::unique_ptr<LinearSolver> make_jacobi(SolverOptions o);
+std::unique_ptr<LinearSolver> make_sa_pcg(SolverOptions o);
 #ifdef SEWN_HAVE_CHOLMOD
 std::unique_ptr<LinearSolver> make_cholmod(SolverOptions o);
 std::unique_ptr<LinearSolver> make_cholmod_pcg(SolverOptions o);

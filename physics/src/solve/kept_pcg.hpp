@@ -43,6 +43,9 @@ PcgOutcome pcg_with(const BlockMatrix& A, std::span<const double> b, std::span<d
 ///   double setup_cost()            the per-values set-up's cost in CG iterations (deterministic)
 ///   bool valid(); const std::vector<double>& factored_values()
 ///   void factor_values(A, values, who); void forget(); void solve(r, z)
+/// and may offer (SaPreconditioner in sa_pcg.cpp):
+///   void set_coordinates(xyz)       the nodes' positions, for the next set-up
+///   void bind(A, free_dof)          the matrix of the solve about to run
 template <class P>
 class KeptPcg final : public LinearSolver {
  public:
@@ -68,6 +71,9 @@ class KeptPcg final : public LinearSolver {
     cycle_solves_ = s.cycle_solves;
     cycle_iterations_ = s.cycle_iterations;
   }
+  void set_coordinates(std::span<const double> xyz) override {
+    if constexpr (requires { p_.set_coordinates(xyz); }) p_.set_coordinates(xyz);
+  }
 
   SolveReport solve(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
                     std::span<const double> mass_scale) override {
@@ -76,6 +82,7 @@ class KeptPcg final : public LinearSolver {
     rep.backend = tag_;
     const double floor = absolute_floor(opt_, free_dof, mass_scale);
     if (p_.sync_pattern(A) || !p_.valid() || stale_) refresh(A, free_dof, rep);
+    if constexpr (requires { p_.bind(A, free_dof); }) p_.bind(A, free_dof);  // a preconditioner that also uses A itself
     x0_.assign(x.begin(), x.end());
     auto t = Clock::now();
     PcgOutcome out = run(A, b, x, free_dof, floor);

@@ -15,12 +15,14 @@ std::string_view to_string(Backend b) {
     case Backend::cholmod_pcg: return "cholmod-pcg";
     case Backend::hypre_pcg: return "hypre-pcg";
     case Backend::petsc: return "petsc";
+    case Backend::sa_pcg: return "sa-pcg";
   }
   return "?";
 }
 
 namespace {
-constexpr Backend all_backends[] = {Backend::jacobi, Backend::cholmod, Backend::cholmod_pcg, Backend::hypre_pcg, Backend::petsc};
+constexpr Backend all_backends[] = {Backend::jacobi, Backend::cholmod, Backend::cholmod_pcg, Backend::hypre_pcg,
+                                   Backend::petsc, Backend::sa_pcg};
 
 // The library a backend needs at build time, for the message when it is missing.
 const char* library_of(Backend b) {
@@ -37,7 +39,8 @@ const char* library_of(Backend b) {
 bool available(Backend b) {
   switch (b) {
     case Backend::automatic:
-    case Backend::jacobi: return true;
+    case Backend::jacobi:
+    case Backend::sa_pcg: return true;
     case Backend::cholmod:
     case Backend::cholmod_pcg:
 #ifdef SEWN_HAVE_CHOLMOD
@@ -123,6 +126,7 @@ std::unique_ptr<LinearSolver> make_solver(Backend b, SolverOptions options, std:
 #ifdef SEWN_HAVE_PETSC
     case Backend::petsc: return detail::make_petsc(options);
 #endif
+    case Backend::sa_pcg: return detail::make_sa_pcg(options);
     default: return detail::make_jacobi(options);
   }
 }

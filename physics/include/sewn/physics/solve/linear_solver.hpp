@@ -23,6 +23,10 @@
 //                (and Newton iterations) while CG needs few iterations, refreshed when they grow;
 //   hypre-pcg    the same CG and refresh rule, preconditioned by one V-cycle of hypre's BoomerAMG
 //                (algebraic multigrid) set up on a recent A: set-up and V-cycle cost O(entries);
+//   sa-pcg       the same CG and refresh rule, preconditioned by one V-cycle of our own
+//                aggregation multigrid (coarse spaces from the rigid-body modes of aggregates of
+//                neighbouring nodes; set_coordinates() gives the positions they need): set-up
+//                O(entries of the Galerkin products), V-cycle 7 fine block-sparse products;
 //   petsc        PETSc's KSP (CG, GAMG preconditioner) on every MPI rank of the program, each
 //                rank owning a contiguous range of rows: the solve distributed, A assembled on
 //                every rank (docs/scaling.md).
@@ -41,9 +45,9 @@
 
 namespace sewn::physics::solve {
 
-enum class Backend { automatic, jacobi, cholmod, cholmod_pcg, hypre_pcg, petsc };
+enum class Backend { automatic, jacobi, cholmod, cholmod_pcg, hypre_pcg, petsc, sa_pcg };
 
-/// "auto", "jacobi", "cholmod", "cholmod-pcg", "hypre-pcg", "petsc". O(1).
+/// "auto", "jacobi", "cholmod", "cholmod-pcg", "hypre-pcg", "petsc", "sa-pcg". O(1).
 [[nodiscard]] std::string_view to_string(Backend b);
 /// The inverse of to_string; throws InputError listing the names (and saying which are not
 /// built in) for any other name. O(1).
@@ -125,6 +129,10 @@ class LinearSolver {
                             std::span<const double> free_dof, std::span<const double> mass_scale = {}) = 0;
   /// Forgets every factorization and analysis (the next solve starts afresh). O(1).
   virtual void reset() {}
+  /// The nodes' positions (3 per node), which sa-pcg's next set-up builds its rigid-body modes
+  /// from (without them: translations only, a weaker coarse space); other backends ignore them.
+  /// The integrators pass them before each solve. O(nodes).
+  virtual void set_coordinates(std::span<const double> xyz) { (void)xyz; }
   /// See SolverState. O(entries of the kept factorization).
   [[nodiscard]] virtual SolverState state() const { return {}; }
   /// Takes up state() of a solver of this backend, for A's current pattern (the one it was
