@@ -69,7 +69,9 @@ TEST_CASE("rod angle DOFs: torques and forces are minus the gradient, the Jacobi
   System sys;
   Rods& rods = hanging_helix(sys, 7);
   rods.use_angle_dofs(sys.angles(), 1e-6);
-  rods.set_project_hessians(false);
+  // The term keeps its default (project_hessians on): with angle DOFs it projects only when the
+  // request asks (project_element_hessians), so an unprojected request gets the exact Jacobian
+  // Newton's exact-first pass needs.
   std::mt19937 rng(16);
   std::normal_distribution<double> noise(0, 0.01);
   for (double& x : sys.nodes().x()) x += noise(rng);
@@ -114,6 +116,17 @@ TEST_CASE("rod angle DOFs: torques and forces are minus the gradient, the Jacobi
   CHECK(scale_f > 1e-3);
   CHECK(worst_f < 1e-6 * scale_f);
   CHECK(worst_j < 1e-5 * scale_j);
+  // Asked for the PSD stand-in, the term projects every stencil: −∂F/∂q is then PSD, where the
+  // exact one of this strained helix is not (so the two requests really differ).
+  req.options.project_element_hessians = true;
+  A.set_zero();
+  for (const auto& t : sys.terms()) t->add_jacobians(flat_view(sys, q0, zero), req);
+  const Eigen::MatrixXd Jp = Eigen::MatrixXd(A.to_sparse());
+  const double exact_min = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(-J).eigenvalues().minCoeff();
+  const double projected_min = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(-Jp).eigenvalues().minCoeff();
+  MESSAGE("smallest eigenvalue of -dF/dq: exact " << exact_min << ", projected " << projected_min);
+  CHECK(exact_min < -1e-6 * scale_j);
+  CHECK(projected_min > -1e-10 * scale_j);
   // An angle's torque is really there: the twist of the perturbed θ pushes back.
   double torque = 0;
   for (std::size_t a = 0; a < sys.angles().size(); ++a) torque = std::max(torque, std::abs(f0[3 * std::size_t{sys.nodes().size()} + a]));
