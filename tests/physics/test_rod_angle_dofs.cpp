@@ -5,6 +5,7 @@
 // Euler's exact recurrence; integrators that cannot integrate angles refuse them; NewtonEuler
 // tells the terms about every accepted step.
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <string>
@@ -204,6 +205,40 @@ TEST_CASE("rod angle DOFs with inertia: a twist oscillator follows backward Eule
   CHECK(std::abs(x - 0.3) > 0.1);  // it moved
   CHECK(worst < 1e-9);
   CHECK(sys.kinetic_energy() > 0);
+}
+
+TEST_CASE("rod angle DOFs: Newton turns no angle by more than max_angle_step per iteration") {
+  // Three fixed collinear vertices, θ^0 fixed, θ^1 free without inertia and twisted by 3 rad:
+  // E = GJ/(2D)(θ^1)² is quadratic, so one Newton iteration would turn it back by 3 rad. The
+  // trust region takes it there in steps of at most π/4: three limited ones, the rest, and
+  // the converged check; the answer is the same.
+  auto twisted = [](System& sys) {
+    std::vector<Index> ids;
+    for (int i = 0; i < 3; ++i) ids.push_back(sys.nodes().add(Vec3(0.1 * i, 0, 0), Vec3::Zero(), 1.0));
+    for (Index i : ids) sys.nodes().fix(i);
+    Rods& rods = sys.add<Rods>();
+    (void)rods.add_rod(ids, sys.nodes().x(), false, Section::circular(1e7, 0.3, 0.01));
+    rods.rod(0).fix_theta(0);
+    rods.use_angle_dofs(sys.angles(), 0.0);
+    sys.angles().values()[rods.angle_of(0, 1)] = 3.0;
+    return rods.angle_of(0, 1);
+  };
+  System limited, free;
+  const Index a = twisted(limited), b = twisted(free);
+  integrate::NewtonEulerOptions opt;
+  opt.velocity_tolerance = 1e-9;  // 1e-12 rad per step: above θ's round-off
+  const integrate::NewtonReport r = integrate::NewtonEuler(opt).step(limited, 1e-3);
+  opt.max_angle_step = std::numeric_limits<double>::infinity();
+  const integrate::NewtonReport u = integrate::NewtonEuler(opt).step(free, 1e-3);
+  MESSAGE("limited: " << r.iterations << " iterations, " << r.angle_step_limits << " limited; unlimited: " << u.iterations);
+  CHECK(r.angle_step_limits == 3);
+  CHECK(r.iterations == 5);
+  CHECK(u.angle_step_limits == 0);
+  CHECK(u.iterations == 2);
+  CHECK(std::abs(limited.angles().values()[a]) < 1e-12);
+  CHECK(std::abs(free.angles().values()[b]) < 1e-12);
+  opt.max_angle_step = 0.0;
+  CHECK_THROWS_WITH_AS((void)integrate::NewtonEuler(opt).step(limited, 1e-3), doctest::Contains("max_angle_step"), InputError);
 }
 
 TEST_CASE("rod angle DOFs: integrators that cannot integrate them refuse, NewtonEuler reports every accepted step") {

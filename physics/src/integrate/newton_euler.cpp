@@ -176,12 +176,27 @@ int NewtonEuler::solve_linear(const BlockMatrix& A, bool need_definite) {
   return 0;
 }
 
+void NewtonEuler::limit_angle_step(double& slope, double& pmax, NewtonReport& rep) {
+  const std::size_t n = dof_count();
+  double largest = 0.0;
+  for (std::size_t k = n3_; k < n; ++k) largest = std::max(largest, std::abs(p_[k]));
+  if (!(largest > opt_.max_angle_step)) return;
+  // Scaling the whole step keeps it a descent direction (gᵀp scales with it) and its shape.
+  const double s = opt_.max_angle_step / largest;
+  for (std::size_t k = 0; k < n; ++k) p_[k] *= s;
+  slope *= s;
+  pmax *= s;
+  ++rep.angle_step_limits;
+}
+
 double NewtonEuler::incremental_potential(const System& sys, std::span<const double> q) {
   return evaluate(sys, q, false);
 }
 
 NewtonReport NewtonEuler::step(System& sys, double h) {
   if (!std::isfinite(h) || h <= 0.0) throw InputError("newton euler: step h must be finite and > 0, got " + std::to_string(h));
+  if (!(opt_.max_angle_step > 0.0))
+    throw InputError("newton euler: max_angle_step must be > 0 rad (infinity: no limit), got " + std::to_string(opt_.max_angle_step));
   sys.refresh();
   prepare(sys, h);
   NewtonReport rep;
@@ -239,6 +254,7 @@ NewtonReport NewtonEuler::step(System& sys, double h) {
         pmax = std::max(pmax, std::abs(p_[k]));
       }
     }
+    limit_angle_step(slope, pmax, rep);
     rep.step_velocity = pmax / h;
     if (pmax == 0.0 || rep.step_velocity < opt_.velocity_tolerance) {
       // The Newton step is within tolerance: take it whole (it is smaller than what the
