@@ -241,6 +241,40 @@ TEST_CASE("rod angle DOFs: Newton turns no angle by more than max_angle_step per
   CHECK_THROWS_WITH_AS((void)integrate::NewtonEuler(opt).step(limited, 1e-3), doctest::Contains("max_angle_step"), InputError);
 }
 
+TEST_CASE("rod angle DOFs: Newton's stopping test counts a twist update as the distance it moves the section") {
+  // The twisted edge again (3 rad, no inertia, π/4 per iteration): rods give their angles the
+  // section's radius of gyration r/√2 as length, so the first (limited) iteration moves the
+  // section by r/√2 · π/4 = 5.55 mm; with h = 1 s and a tolerance of 10 mm/s that is converged,
+  // where the π/4 rad of the same update read as metres would not be.
+  System sys;
+  std::vector<Index> ids;
+  for (int i = 0; i < 3; ++i) ids.push_back(sys.nodes().add(Vec3(0.1 * i, 0, 0), Vec3::Zero(), 1.0));
+  for (Index i : ids) sys.nodes().fix(i);
+  Rods& rods = sys.add<Rods>();
+  const double r = 0.01;
+  (void)rods.add_rod(ids, sys.nodes().x(), false, Section::circular(1e7, 0.3, r));
+  rods.rod(0).fix_theta(0);
+  rods.use_angle_dofs(sys.angles(), 0.0);
+  for (double l : sys.angles().lengths()) CHECK(l == doctest::Approx(r / std::sqrt(2.0)).epsilon(1e-14));
+  sys.angles().values()[rods.angle_of(0, 1)] = 3.0;
+  integrate::NewtonEulerOptions opt;
+  opt.velocity_tolerance = 0.01;
+  const integrate::NewtonReport rep = integrate::NewtonEuler(opt).step(sys, 1.0);
+  CHECK(rep.iterations == 1);
+  CHECK(rep.step_velocity == doctest::Approx(r / std::sqrt(2.0) * std::numbers::pi / 4).epsilon(1e-12));
+  CHECK(sys.angles().values()[rods.angle_of(0, 1)] == doctest::Approx(3.0 - std::numbers::pi / 4).epsilon(1e-12));
+  // The table's own checks: lengths default to 1 m and must be finite and > 0, one per angle.
+  AngleTable t;
+  const double v[2] = {0, 0}, bad[2] = {0.1, 0.0}, inf[2] = {0.1, std::numeric_limits<double>::infinity()};
+  const unsigned char f[2] = {0, 0};
+  (void)t.add("plain", v, v, f);
+  CHECK(t.lengths().size() == 2);
+  CHECK(t.lengths()[1] == 1.0);
+  CHECK_THROWS_WITH_AS((void)t.add("zero", v, v, f, bad), doctest::Contains("length of angle 1"), InputError);
+  CHECK_THROWS_WITH_AS((void)t.add("infinite", v, v, f, inf), doctest::Contains("length of angle 1"), InputError);
+  CHECK_THROWS_WITH_AS((void)t.add("short", v, v, f, std::span<const double>(bad, 1)), doctest::Contains("1 lengths"), InputError);
+}
+
 TEST_CASE("rod angle DOFs: integrators that cannot integrate them refuse, NewtonEuler reports every accepted step") {
   System sys;
   Rods& rods = hanging_helix(sys, 5);

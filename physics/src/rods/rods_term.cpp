@@ -75,6 +75,10 @@ void Rods::use_angle_dofs(AngleTable& angles, double inertia_per_length) {
     Entry& e = rods_[r];
     const int m = e.rod.num_edges();
     std::vector<double> value(static_cast<std::size_t>(m)), inertia(value.size());
+    // θ turns the section about the centreline: its points move by their distance from it,
+    // whose root mean square is the radius of gyration √((I1 + I2)/A) (r/√2 for a circle).
+    const Section& sec = e.rod.section();
+    const std::vector<double> length(value.size(), std::sqrt((sec.EI1 + sec.EI2) / sec.EA));
     std::vector<unsigned char> fixed(value.size());
     for (int j = 0; j < m; ++j) {
       const auto k = static_cast<std::size_t>(j);
@@ -82,7 +86,7 @@ void Rods::use_angle_dofs(AngleTable& angles, double inertia_per_length) {
       inertia[k] = inertia_per_length * e.rod.rest_length(j);
       fixed[k] = e.rod.theta_fixed(j) ? 1 : 0;
     }
-    e.first_angle = angles.add("rod " + std::to_string(r), value, inertia, fixed);
+    e.first_angle = angles.add("rod " + std::to_string(r), value, inertia, fixed, length);
   }
   angle_dofs_ = true;
   quasi_static_ = false;

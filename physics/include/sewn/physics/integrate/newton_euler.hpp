@@ -14,7 +14,8 @@
 // solved on the free axes (fixed axes follow their prescribed velocity, q = q_n + h v_n, and
 // are filtered); a step turning an angle DOF by more than max_angle_step is scaled down to it;
 // Armijo backtracking α = 1, ½, ... until Φ(q + αp) ≤ Φ(q) + c α gᵀp; stop
-// when |p|∞/h < velocity_tolerance.
+// when |p|∞/h < velocity_tolerance, an angle's update counted as the distance it moves its
+// material (AngleTable::lengths() × Δθ: a rod's section radius of gyration), not in radians.
 //
 // The linear solve is the single function solve_linear() (block-Jacobi PCG on the block
 // matrix, or a sparse direct solve: CHOLMOD's supernodal Cholesky through solve::LinearSolver
@@ -56,7 +57,7 @@ enum class LinearSolver {
 };
 
 struct NewtonEulerOptions {
-  double velocity_tolerance = 1e-6;  ///< m/s: converged when |p|∞/h is below it
+  double velocity_tolerance = 1e-6;  ///< m/s: converged when |p|∞/h is below it (an angle's update counted as AngleTable::lengths() × Δθ)
   int max_iterations = 50;
   int max_line_search = 40;          ///< halvings of α before "no descent"
   double armijo = 1e-4;              ///< c of the sufficient-decrease test
@@ -87,7 +88,7 @@ struct NewtonReport {
   int steepest_fallbacks = 0; ///< iterations whose solve gave no descent and used -D⁻¹g instead
   int projected_retries = 0;  ///< iterations whose exact Hessian was indefinite (exact_hessian_first)
   int angle_step_limits = 0;  ///< iterations whose step was shortened by max_angle_step
-  double step_velocity = 0.0; ///< |p|∞/h of the last iteration, m/s
+  double step_velocity = 0.0; ///< |p|∞/h of the last iteration, m/s (angles as length × Δθ)
   double phi_decrease = 0.0;  ///< Φ(q̂) - Φ(q_{n+1}) ≥ 0
 };
 
@@ -141,7 +142,7 @@ class NewtonEuler {
   double h_ = 0.0;
   std::size_t n3_ = 0;  // position entries; angles follow
   bool damped_ = false;
-  AlignedVector<double> xn_, vn_, qhat_, q_, trial_, inertia_, free_, g_, f_, f0_, vel_, p_, rhs_, precond_, zeros_;
+  AlignedVector<double> xn_, vn_, qhat_, q_, trial_, inertia_, free_, length_, g_, f_, f0_, vel_, p_, rhs_, precond_, zeros_;
   CgWorkspace ws_;
   std::unique_ptr<LdltCache> ldlt_;
 };
