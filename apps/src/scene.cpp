@@ -229,7 +229,7 @@ Field build_schema() {
                 field("absolute_tolerance", Kind::number).unit("m/s").fallback(physics::solve::default_absolute_tolerance).at_least(0).at_most(1)
                     .doc("Floor of the residual as a velocity error on every free axis (implicit): a body at rest stops there instead of chasing round-off. 0: none."),
                 field("max_iterations", Kind::integer).fallback(physics::solve::default_max_iterations).at_least(1).at_most(1000000).doc("Iteration limit of the iterative solvers (implicit); reaching it is an error."),
-                field("newton_tolerance", Kind::number).unit("m/s").fallback(1e-6).above(0).doc("Newton stops when the largest update divided by h is below it (newton)."),
+                field("newton_tolerance", Kind::number).unit("m/s").fallback(1e-6).above(0).doc("Newton stops when the largest update divided by h is below it; a rod twist angle's update counts as the distance it turns the section, the section's radius of gyration times the angle (newton)."),
                 field("newton_iterations", Kind::integer).fallback(50).at_least(1).at_most(10000).doc("Newton iteration limit per step (newton); reaching it is an error."),
                 field("allow_unstable", Kind::boolean).fallback(false)
                     .doc("Run a semi-implicit step larger than the estimated stable bound (otherwise refused with the bound)."),

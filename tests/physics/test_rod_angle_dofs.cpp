@@ -5,6 +5,7 @@
 // Euler's exact recurrence; integrators that cannot integrate angles refuse them; NewtonEuler
 // tells the terms about every accepted step.
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <string>
@@ -69,7 +70,9 @@ TEST_CASE("rod angle DOFs: torques and forces are minus the gradient, the Jacobi
   System sys;
   Rods& rods = hanging_helix(sys, 7);
   rods.use_angle_dofs(sys.angles(), 1e-6);
-  rods.set_project_hessians(false);
+  // The term keeps its default (project_hessians on): with angle DOFs it projects only when the
+  // request asks (project_element_hessians), so an unprojected request gets the exact Jacobian
+  // Newton's exact-first pass needs.
   std::mt19937 rng(16);
   std::normal_distribution<double> noise(0, 0.01);
   for (double& x : sys.nodes().x()) x += noise(rng);
@@ -114,6 +117,17 @@ TEST_CASE("rod angle DOFs: torques and forces are minus the gradient, the Jacobi
   CHECK(scale_f > 1e-3);
   CHECK(worst_f < 1e-6 * scale_f);
   CHECK(worst_j < 1e-5 * scale_j);
+  // Asked for the PSD stand-in, the term projects every stencil: −∂F/∂q is then PSD, where the
+  // exact one of this strained helix is not (so the two requests really differ).
+  req.options.project_element_hessians = true;
+  A.set_zero();
+  for (const auto& t : sys.terms()) t->add_jacobians(flat_view(sys, q0, zero), req);
+  const Eigen::MatrixXd Jp = Eigen::MatrixXd(A.to_sparse());
+  const double exact_min = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(-J).eigenvalues().minCoeff();
+  const double projected_min = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(-Jp).eigenvalues().minCoeff();
+  MESSAGE("smallest eigenvalue of -dF/dq: exact " << exact_min << ", projected " << projected_min);
+  CHECK(exact_min < -1e-6 * scale_j);
+  CHECK(projected_min > -1e-10 * scale_j);
   // An angle's torque is really there: the twist of the perturbed θ pushes back.
   double torque = 0;
   for (std::size_t a = 0; a < sys.angles().size(); ++a) torque = std::max(torque, std::abs(f0[3 * std::size_t{sys.nodes().size()} + a]));
@@ -191,6 +205,74 @@ TEST_CASE("rod angle DOFs with inertia: a twist oscillator follows backward Eule
   CHECK(std::abs(x - 0.3) > 0.1);  // it moved
   CHECK(worst < 1e-9);
   CHECK(sys.kinetic_energy() > 0);
+}
+
+TEST_CASE("rod angle DOFs: Newton turns no angle by more than max_angle_step per iteration") {
+  // Three fixed collinear vertices, θ^0 fixed, θ^1 free without inertia and twisted by 3 rad:
+  // E = GJ/(2D)(θ^1)² is quadratic, so one Newton iteration would turn it back by 3 rad. The
+  // trust region takes it there in steps of at most π/4: three limited ones, the rest, and
+  // the converged check; the answer is the same.
+  auto twisted = [](System& sys) {
+    std::vector<Index> ids;
+    for (int i = 0; i < 3; ++i) ids.push_back(sys.nodes().add(Vec3(0.1 * i, 0, 0), Vec3::Zero(), 1.0));
+    for (Index i : ids) sys.nodes().fix(i);
+    Rods& rods = sys.add<Rods>();
+    (void)rods.add_rod(ids, sys.nodes().x(), false, Section::circular(1e7, 0.3, 0.01));
+    rods.rod(0).fix_theta(0);
+    rods.use_angle_dofs(sys.angles(), 0.0);
+    sys.angles().values()[rods.angle_of(0, 1)] = 3.0;
+    return rods.angle_of(0, 1);
+  };
+  System limited, free;
+  const Index a = twisted(limited), b = twisted(free);
+  integrate::NewtonEulerOptions opt;
+  opt.velocity_tolerance = 1e-9;  // 1e-12 rad per step: above θ's round-off
+  const integrate::NewtonReport r = integrate::NewtonEuler(opt).step(limited, 1e-3);
+  opt.max_angle_step = std::numeric_limits<double>::infinity();
+  const integrate::NewtonReport u = integrate::NewtonEuler(opt).step(free, 1e-3);
+  MESSAGE("limited: " << r.iterations << " iterations, " << r.angle_step_limits << " limited; unlimited: " << u.iterations);
+  CHECK(r.angle_step_limits == 3);
+  CHECK(r.iterations == 5);
+  CHECK(u.angle_step_limits == 0);
+  CHECK(u.iterations == 2);
+  CHECK(std::abs(limited.angles().values()[a]) < 1e-12);
+  CHECK(std::abs(free.angles().values()[b]) < 1e-12);
+  opt.max_angle_step = 0.0;
+  CHECK_THROWS_WITH_AS((void)integrate::NewtonEuler(opt).step(limited, 1e-3), doctest::Contains("max_angle_step"), InputError);
+}
+
+TEST_CASE("rod angle DOFs: Newton's stopping test counts a twist update as the distance it moves the section") {
+  // The twisted edge again (3 rad, no inertia, π/4 per iteration): rods give their angles the
+  // section's radius of gyration r/√2 as length, so the first (limited) iteration moves the
+  // section by r/√2 · π/4 = 5.55 mm; with h = 1 s and a tolerance of 10 mm/s that is converged,
+  // where the π/4 rad of the same update read as metres would not be.
+  System sys;
+  std::vector<Index> ids;
+  for (int i = 0; i < 3; ++i) ids.push_back(sys.nodes().add(Vec3(0.1 * i, 0, 0), Vec3::Zero(), 1.0));
+  for (Index i : ids) sys.nodes().fix(i);
+  Rods& rods = sys.add<Rods>();
+  const double r = 0.01;
+  (void)rods.add_rod(ids, sys.nodes().x(), false, Section::circular(1e7, 0.3, r));
+  rods.rod(0).fix_theta(0);
+  rods.use_angle_dofs(sys.angles(), 0.0);
+  for (double l : sys.angles().lengths()) CHECK(l == doctest::Approx(r / std::sqrt(2.0)).epsilon(1e-14));
+  sys.angles().values()[rods.angle_of(0, 1)] = 3.0;
+  integrate::NewtonEulerOptions opt;
+  opt.velocity_tolerance = 0.01;
+  const integrate::NewtonReport rep = integrate::NewtonEuler(opt).step(sys, 1.0);
+  CHECK(rep.iterations == 1);
+  CHECK(rep.step_velocity == doctest::Approx(r / std::sqrt(2.0) * std::numbers::pi / 4).epsilon(1e-12));
+  CHECK(sys.angles().values()[rods.angle_of(0, 1)] == doctest::Approx(3.0 - std::numbers::pi / 4).epsilon(1e-12));
+  // The table's own checks: lengths default to 1 m and must be finite and > 0, one per angle.
+  AngleTable t;
+  const double v[2] = {0, 0}, bad[2] = {0.1, 0.0}, inf[2] = {0.1, std::numeric_limits<double>::infinity()};
+  const unsigned char f[2] = {0, 0};
+  (void)t.add("plain", v, v, f);
+  CHECK(t.lengths().size() == 2);
+  CHECK(t.lengths()[1] == 1.0);
+  CHECK_THROWS_WITH_AS((void)t.add("zero", v, v, f, bad), doctest::Contains("length of angle 1"), InputError);
+  CHECK_THROWS_WITH_AS((void)t.add("infinite", v, v, f, inf), doctest::Contains("length of angle 1"), InputError);
+  CHECK_THROWS_WITH_AS((void)t.add("short", v, v, f, std::span<const double>(bad, 1)), doctest::Contains("1 lengths"), InputError);
 }
 
 TEST_CASE("rod angle DOFs: integrators that cannot integrate them refuse, NewtonEuler reports every accepted step") {

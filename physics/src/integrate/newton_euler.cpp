@@ -32,7 +32,7 @@ void NewtonEuler::prepare(System& sys, double h) {
   const std::size_t na = angles.size();
   // Angles follow the positions, padded to whole 3×3 blocks (AngleLayout); the padding is fixed.
   const std::size_t total = n3_ + 3 * std::size_t{AngleLayout::blocks_for(angles.size())};
-  for (auto* a : {&xn_, &vn_, &qhat_, &q_, &trial_, &inertia_, &free_, &g_, &f_, &f0_, &vel_, &p_, &rhs_})
+  for (auto* a : {&xn_, &vn_, &qhat_, &q_, &trial_, &inertia_, &free_, &length_, &g_, &f_, &f0_, &vel_, &p_, &rhs_})
     a->assign(total, 0.0);
   zeros_.assign(total, 0.0);
   precond_.resize(3 * total);
@@ -52,6 +52,7 @@ void NewtonEuler::prepare(System& sys, double h) {
     vn_[k] = v[k];
     inertia_[k] = m[k / 3];
     free_[k] = ((fixed[k / 3] >> (k % 3)) & 1) ? 0.0 : 1.0;
+    length_[k] = 1.0;
   }
   for (std::size_t a = 0; a < na; ++a) {
     const std::size_t k = n3_ + a;
@@ -62,6 +63,7 @@ void NewtonEuler::prepare(System& sys, double h) {
                         NewtonError::non_finite, {});
     inertia_[k] = angles.inertias()[a];
     free_[k] = angles.fixed(static_cast<Index>(a)) ? 0.0 : 1.0;
+    length_[k] = angles.lengths()[a];
   }
   for (std::size_t k = n3_ + na; k < total; ++k) inertia_[k] = 1.0;
   for (std::size_t k = 0; k < total; ++k) qhat_[k] = xn_[k] + h * vn_[k];
@@ -176,12 +178,27 @@ int NewtonEuler::solve_linear(const BlockMatrix& A, bool need_definite) {
   return 0;
 }
 
+void NewtonEuler::limit_angle_step(double& slope, double& pmax, NewtonReport& rep) {
+  const std::size_t n = dof_count();
+  double largest = 0.0;
+  for (std::size_t k = n3_; k < n; ++k) largest = std::max(largest, std::abs(p_[k]));
+  if (!(largest > opt_.max_angle_step)) return;
+  // Scaling the whole step keeps it a descent direction (gᵀp scales with it) and its shape.
+  const double s = opt_.max_angle_step / largest;
+  for (std::size_t k = 0; k < n; ++k) p_[k] *= s;
+  slope *= s;
+  pmax *= s;
+  ++rep.angle_step_limits;
+}
+
 double NewtonEuler::incremental_potential(const System& sys, std::span<const double> q) {
   return evaluate(sys, q, false);
 }
 
 NewtonReport NewtonEuler::step(System& sys, double h) {
   if (!std::isfinite(h) || h <= 0.0) throw InputError("newton euler: step h must be finite and > 0, got " + std::to_string(h));
+  if (!(opt_.max_angle_step > 0.0))
+    throw InputError("newton euler: max_angle_step must be > 0 rad (infinity: no limit), got " + std::to_string(opt_.max_angle_step));
   sys.refresh();
   prepare(sys, h);
   NewtonReport rep;
@@ -239,7 +256,12 @@ NewtonReport NewtonEuler::step(System& sys, double h) {
         pmax = std::max(pmax, std::abs(p_[k]));
       }
     }
-    rep.step_velocity = pmax / h;
+    limit_angle_step(slope, pmax, rep);
+    // The stopping test counts an angle's update as the distance it moves its material
+    // (length × Δθ), so it compares metres with metres.
+    double moved = 0.0;
+    for (std::size_t k = 0; k < n; ++k) moved = std::max(moved, length_[k] * std::abs(p_[k]));
+    rep.step_velocity = moved / h;
     if (pmax == 0.0 || rep.step_velocity < opt_.velocity_tolerance) {
       // The Newton step is within tolerance: take it whole (it is smaller than what the
       // line search could resolve against round-off in Φ).

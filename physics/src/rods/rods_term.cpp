@@ -75,6 +75,10 @@ void Rods::use_angle_dofs(AngleTable& angles, double inertia_per_length) {
     Entry& e = rods_[r];
     const int m = e.rod.num_edges();
     std::vector<double> value(static_cast<std::size_t>(m)), inertia(value.size());
+    // θ turns the section about the centreline: its points move by their distance from it,
+    // whose root mean square is the radius of gyration √((I1 + I2)/A) (r/√2 for a circle).
+    const Section& sec = e.rod.section();
+    const std::vector<double> length(value.size(), std::sqrt((sec.EI1 + sec.EI2) / sec.EA));
     std::vector<unsigned char> fixed(value.size());
     for (int j = 0; j < m; ++j) {
       const auto k = static_cast<std::size_t>(j);
@@ -82,7 +86,7 @@ void Rods::use_angle_dofs(AngleTable& angles, double inertia_per_length) {
       inertia[k] = inertia_per_length * e.rod.rest_length(j);
       fixed[k] = e.rod.theta_fixed(j) ? 1 : 0;
     }
-    e.first_angle = angles.add("rod " + std::to_string(r), value, inertia, fixed);
+    e.first_angle = angles.add("rod " + std::to_string(r), value, inertia, fixed, length);
   }
   angle_dofs_ = true;
   quasi_static_ = false;
@@ -260,6 +264,11 @@ void Rods::add_jacobians_with_angles(const StateView& s, const JacobianRequest& 
   static constexpr std::array<int, 11> stencil_group{0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 4};
   static constexpr std::array<int, 6> edge_group{0, 0, 0, 1, 1, 1};
   static constexpr std::array<int, 6> edge_comp{0, 1, 2, 0, 1, 2};
+  // Only the Newton integrator integrates angles, and it says per assembly whether it wants
+  // the PSD stand-in or the exact Hessian (exact_hessian_first): projecting regardless would
+  // hand its "exact" pass a Hessian without the bend-twist coupling of a bent rod, and Newton
+  // would converge linearly along the soft twist modes (the toy ball's helical spring).
+  const bool project = project_ && req.options.project_element_hessians;
   for (Index r = 0; r < num_rods(); ++r) {
     const Entry& e = rods_[r];
     const Points x = gather(r, s.x);
@@ -275,14 +284,14 @@ void Rods::add_jacobians_with_angles(const StateView& s, const JacobianRequest& 
       std::array<Index, 5> block{};
       std::array<int, 11> comp{};
       stencil_blocks(e, st, block, comp);
-      scatter_hessian<11>(project_ ? projected<11>(b.hessian) : b.hessian, block, comp, stencil_group, slots.subspan(slot), req);
+      scatter_hessian<11>(project ? projected<11>(b.hessian) : b.hessian, block, comp, stencil_group, slots.subspan(slot), req);
     }
     const int n = e.rod.num_vertices();
     for (int j = 0; j < e.rod.num_edges(); ++j, slot += 4) {
       const int v[2] = {j, (j + 1) % n};
       const double EA = e.rod.section().EA, rest = e.rod.rest_length(j);
       const std::array<Index, 2> block{e.nodes[static_cast<std::size_t>(v[0])], e.nodes[static_cast<std::size_t>(v[1])]};
-      scatter_hessian<6>(project_ ? stretch_hessian_psd(x.col(v[0]), x.col(v[1]), EA, rest)
+      scatter_hessian<6>(project ? stretch_hessian_psd(x.col(v[0]), x.col(v[1]), EA, rest)
                                   : stretch(x.col(v[0]), x.col(v[1]), EA, rest, true).hessian,
                          block, edge_comp, edge_group, slots.subspan(slot), req);
     }

@@ -29,10 +29,14 @@ class AngleTable {
  public:
   /// Appends `count` angles with the given values (rad), zero rates, inertia (kg·m², ≥ 0; 0: no
   /// inertia, the angle is solved with the positions in every Newton step) and fixed flags
-  /// (a fixed angle follows its rate). `owner` names them in errors. Returns the first index.
-  /// Throws InputError on a non-finite value or a negative or non-finite inertia. O(count).
+  /// (a fixed angle follows its rate) and lengths (m, > 0; empty: 1 m each): the displacement
+  /// per radian of what the angle turns, e.g. a rod section's radius of gyration, by which
+  /// the Newton integrator's stopping test counts an angle update as a distance, in the units
+  /// of the position updates beside it. `owner` names them in errors. Returns the first index.
+  /// Throws InputError on a non-finite value, a negative or non-finite inertia, a length not
+  /// finite and > 0, or sizes that differ. O(count).
   Index add(const std::string& owner, std::span<const double> values, std::span<const double> inertias,
-            std::span<const unsigned char> fixed);
+            std::span<const unsigned char> fixed, std::span<const double> lengths = {});
   [[nodiscard]] Index size() const { return static_cast<Index>(value_.size()); }
   [[nodiscard]] bool empty() const { return value_.empty(); }
   [[nodiscard]] std::span<double> values() { return value_; }
@@ -40,6 +44,7 @@ class AngleTable {
   [[nodiscard]] std::span<double> rates() { return rate_; }
   [[nodiscard]] std::span<const double> rates() const { return rate_; }
   [[nodiscard]] std::span<const double> inertias() const { return inertia_; }
+  [[nodiscard]] std::span<const double> lengths() const { return length_; }
   [[nodiscard]] bool fixed(Index a) const { return fixed_[a] != 0; }
   /// Fixes or frees angle a (a fixed angle moves at its rate). Throws InputError if out of range.
   void set_fixed(Index a, bool on);
@@ -47,7 +52,7 @@ class AngleTable {
   [[nodiscard]] std::uint64_t topology_version() const { return topology_version_; }
 
  private:
-  std::vector<double> value_, rate_, inertia_;
+  std::vector<double> value_, rate_, inertia_, length_;
   std::vector<unsigned char> fixed_;
   std::uint64_t topology_version_ = 0;
 };

@@ -12,8 +12,10 @@
 // Newton: g = M(q - q̂)/h² - F(q, v), H = M/h² - ∂F/∂x - (1/h)∂F/∂v with every element Hessian
 // PSD-projected (JacobianOptions::project_element_hessians, clamp_compression); H p = -g is
 // solved on the free axes (fixed axes follow their prescribed velocity, q = q_n + h v_n, and
-// are filtered); Armijo backtracking α = 1, ½, ... until Φ(q + αp) ≤ Φ(q) + c α gᵀp; stop
-// when |p|∞/h < velocity_tolerance.
+// are filtered); a step turning an angle DOF by more than max_angle_step is scaled down to it;
+// Armijo backtracking α = 1, ½, ... until Φ(q + αp) ≤ Φ(q) + c α gᵀp; stop
+// when |p|∞/h < velocity_tolerance, an angle's update counted as the distance it moves its
+// material (AngleTable::lengths() × Δθ: a rod's section radius of gyration), not in radians.
 //
 // The linear solve is the single function solve_linear() (block-Jacobi PCG on the block
 // matrix, or a sparse direct solve: CHOLMOD's supernodal Cholesky through solve::LinearSolver
@@ -55,7 +57,7 @@ enum class LinearSolver {
 };
 
 struct NewtonEulerOptions {
-  double velocity_tolerance = 1e-6;  ///< m/s: converged when |p|∞/h is below it
+  double velocity_tolerance = 1e-6;  ///< m/s: converged when |p|∞/h is below it (an angle's update counted as AngleTable::lengths() × Δθ)
   int max_iterations = 50;
   int max_line_search = 40;          ///< halvings of α before "no descent"
   double armijo = 1e-4;              ///< c of the sufficient-decrease test
@@ -69,6 +71,13 @@ struct NewtonEulerOptions {
   /// where the projected one converges linearly (a bent helix's indefinite bend-twist
   /// stencils, compressed membranes). Ignored with CG (which cannot tell).
   bool exact_hessian_first = true;
+  /// rad: a trust region on angle DOFs. A Newton step that turns some angle by more is scaled
+  /// as a whole until none turns by more than this, before the line search. The quadratic
+  /// model of a rod's twist is good for fractions of a radian only: a linearised helical
+  /// spring asks its twist angles for 15 rad in one iteration, which crosses the reference
+  /// twist's 2π branch (an energy jump the line search cannot get past) and the connections'
+  /// guard. π/4, as the rods' static solve. No effect on a system without angles.
+  double max_angle_step = 0.7853981633974483;
 };
 
 /// What a step did.
@@ -78,7 +87,8 @@ struct NewtonReport {
   int linear_iterations = 0;  ///< CG iterations, summed (0 with LDLT)
   int steepest_fallbacks = 0; ///< iterations whose solve gave no descent and used -D⁻¹g instead
   int projected_retries = 0;  ///< iterations whose exact Hessian was indefinite (exact_hessian_first)
-  double step_velocity = 0.0; ///< |p|∞/h of the last iteration, m/s
+  int angle_step_limits = 0;  ///< iterations whose step was shortened by max_angle_step
+  double step_velocity = 0.0; ///< |p|∞/h of the last iteration, m/s (angles as length × Δθ)
   double phi_decrease = 0.0;  ///< Φ(q̂) - Φ(q_{n+1}) ≥ 0
 };
 
@@ -124,13 +134,15 @@ class NewtonEuler {
   // Solves H p = -g on the free axes into p_; returns CG iterations (0 for LDLT). With
   // need_definite (direct solves only), returns -1 with p_ = 0 when H is not positive definite.
   int solve_linear(const BlockMatrix& A, bool need_definite = false);
+  // Scales p_ (and its slope gᵀp and |p|∞) so no angle turns by more than max_angle_step.
+  void limit_angle_step(double& slope, double& pmax, NewtonReport& rep);
   [[nodiscard]] std::size_t dof_count() const { return inertia_.size(); }
 
   NewtonEulerOptions opt_;
   double h_ = 0.0;
   std::size_t n3_ = 0;  // position entries; angles follow
   bool damped_ = false;
-  AlignedVector<double> xn_, vn_, qhat_, q_, trial_, inertia_, free_, g_, f_, f0_, vel_, p_, rhs_, precond_, zeros_;
+  AlignedVector<double> xn_, vn_, qhat_, q_, trial_, inertia_, free_, length_, g_, f_, f0_, vel_, p_, rhs_, precond_, zeros_;
   CgWorkspace ws_;
   std::unique_ptr<LdltCache> ldlt_;
 };

@@ -18,8 +18,9 @@
 // (System::angles()), with inertia J = ρ·J_section·|ē| or none, integrated by the Newton
 // integrator beside the positions. The term then reads θ from the state, writes the torques
 // −∂E/∂θ after the position forces, and assembles each stencil's full 11×11 Hessian (positions
-// and angles, projected to PSD unless set_project_hessians(false)): the exact Jacobian, so
-// Newton converges quadratically where the quasi-static mode's −H_xx does not. Connections
+// and angles, projected to PSD when the request asks, JacobianOptions::project_element_hessians,
+// and set_project_hessians has not turned projection off): the exact Jacobian, so Newton
+// converges quadratically where the quasi-static mode's −H_xx does not. Connections
 // (connect/) that hold a rod edge's frame need this mode: their θ gradient enters the same
 // Newton system. set_quasi_static(false) alone leaves θ to a caller (Rod::set_theta).
 //
