@@ -9,6 +9,7 @@
 #include <functional>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "../../bench/elastic/shell_strip.hpp"
 #include "elastic_helpers.hpp"
@@ -177,6 +178,38 @@ TEST_CASE("Morley bending: the strip cantilever converges to Euler-Bernoulli at 
       CHECK(order > 1.7);
       CHECK(order < 2.4);
     }
+  }
+}
+
+TEST_CASE("Morley bending: a one-row strip converges at second order in the cell's length and its height") {
+  // A one-row strip of fixed width stalls at 0.5 % (docs/elastic.md): Morley's tip error is a
+  // second-order term in each cell dimension, (a² + c²/2)/L² on these meshes (cell length a,
+  // height c), and a fixed-width row never shortens c. Not a boundary or clamp defect: the row
+  // converges once its width shrinks with the cells, and at fixed nx the part from the height
+  // falls 4x per halving of the width.
+  using sewn::shell_strip::Mesh;
+  using sewn::shell_strip::Shape;
+  const double exact = sewn::shell_strip::euler_bernoulli_m();
+  auto error = [&](int nx, double width) {
+    const auto r = sewn::shell_strip::solve(Mesh::row, sewn::shell_strip::Bending::morley, nx, Shape{width, 1});
+    return std::abs(r.tip_m - exact) / exact;
+  };
+  SUBCASE("triangles of aspect 4 (width 4 cells), nx = 10, 20, 40") {
+    std::vector<double> err;
+    for (int nx : {10, 20, 40}) err.push_back(error(nx, 4.0 / nx));
+    for (std::size_t k = 1; k < err.size(); ++k) {
+      const double order = std::log2(err[k - 1] / err[k]);
+      CAPTURE(order);
+      CHECK(order > 1.7);
+      CHECK(order < 2.4);
+    }
+  }
+  SUBCASE("nx = 40, width 0.2, 0.1, 0.05: the differences fall at second order in the height") {
+    const double e1 = error(40, 0.2), e2 = error(40, 0.1), e3 = error(40, 0.05);
+    const double order = std::log2((e1 - e2) / (e2 - e3));
+    CAPTURE(order);
+    CHECK(order > 1.7);
+    CHECK(order < 2.4);
   }
 }
 
