@@ -24,6 +24,7 @@ Index AngleTable::add(const std::string& owner, std::span<const double> values, 
   rate_.resize(value_.size(), 0.0);
   inertia_.insert(inertia_.end(), inertias.begin(), inertias.end());
   fixed_.insert(fixed_.end(), fixed.begin(), fixed.end());
+  lever_.resize(value_.size(), 1.0);
   ++topology_version_;
   return first;
 }
@@ -31,6 +32,14 @@ Index AngleTable::add(const std::string& owner, std::span<const double> values, 
 void AngleTable::set_fixed(Index a, bool on) {
   if (a >= size()) throw InputError("AngleTable::set_fixed: angle " + std::to_string(a) + " of " + std::to_string(size()));
   fixed_[a] = on ? 1 : 0;
+}
+
+void AngleTable::set_lever_arm(Index a, double metres) {
+  if (a >= size()) throw InputError("AngleTable::set_lever_arm: angle " + std::to_string(a) + " of " + std::to_string(size()));
+  if (!(std::isfinite(metres) && metres > 0.0))
+    throw InputError("AngleTable::set_lever_arm: angle " + std::to_string(a) + ": the lever arm must be finite and > 0, got " +
+                     detail::format_number(metres) + " m");
+  lever_[a] = metres;
 }
 
 }  // namespace sewn::physics

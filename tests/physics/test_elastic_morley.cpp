@@ -5,6 +5,7 @@
 // mid-normal), and the strip cantilever's convergence to Euler–Bernoulli on irregular meshes.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -13,6 +14,7 @@
 
 #include "../../bench/elastic/shell_strip.hpp"
 #include "elastic_helpers.hpp"
+#include "sewn/physics/integrate/newton_euler.hpp"
 #include "sewn/physics/shells/morley_terms.hpp"
 
 namespace test_elastic_morley {
@@ -211,6 +213,49 @@ TEST_CASE("Morley bending: a one-row strip converges at second order in the cell
     CHECK(order > 1.7);
     CHECK(order < 2.4);
   }
+}
+
+TEST_CASE("Morley bending: an edge angle's lever arm is its triangles' height, and Newton's step test weighs the angle by it") {
+  // A unit square cut along its diagonal: boundary edges 1 m from the opposite corner, the
+  // diagonal √2/2 m from both. Newton weighing a mid-normal's step in rad as if in m kept
+  // shell scenes iterating after their positions had converged (docs/elastic.md).
+  const std::vector<std::array<Index, 3>> tris{{0, 1, 2}, {0, 2, 3}};
+  const std::vector<double> rest{0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+  const std::vector<shells::PlateMaterial> mat(2, shells::plate_material(1e6, 0.3, 0.01));
+  sewn::physics::System sys;
+  for (Index i = 0; i < 4; ++i)
+    sys.nodes().add(Eigen::Vector3d(rest[3 * i], rest[3 * i + 1], i == 3 ? 0.1 : 0.0), Eigen::Vector3d::Zero(), 1.0);
+  for (Index i = 0; i < 4; ++i) sys.nodes().fix(i);  // bent and held: only the mid-normals move
+  const shells::MorleyTerms terms = shells::add_morley_bending(sys, tris, rest, mat);
+  REQUIRE(terms.angles == 5);
+  std::vector<double> levers(sys.angles().lever_arms().begin(), sys.angles().lever_arms().end());
+  std::sort(levers.begin(), levers.end());
+  CHECK(levers[0] == doctest::Approx(std::sqrt(0.5)).epsilon(1e-14));
+  for (std::size_t a = 1; a < levers.size(); ++a) CHECK(levers[a] == doctest::Approx(1.0).epsilon(1e-14));
+  CHECK_THROWS_AS(sys.angles().set_lever_arm(0, 0.0), sewn::physics::InputError);
+  CHECK_THROWS_AS(sys.angles().set_lever_arm(5, 1.0), sewn::physics::InputError);
+
+  // One Newton iteration (the energy is quadratic in the angles: the step is exact), refused
+  // for its tolerance: the reported |p|∞/h doubles when every lever arm does.
+  sewn::physics::integrate::NewtonEulerOptions opt;
+  opt.solver = sewn::physics::integrate::LinearSolver::ldlt;
+  opt.max_iterations = 1;
+  opt.velocity_tolerance = 1e-30;
+  auto step_velocity = [&] {
+    sewn::physics::integrate::NewtonEuler newton(opt);
+    try {
+      (void)newton.step(sys, 0.01);
+    } catch (const sewn::physics::integrate::NewtonError& e) {
+      return e.report().step_velocity;
+    }
+    return -1.0;
+  };
+  const double v1 = step_velocity();
+  for (Index a = 0; a < terms.angles; ++a)
+    sys.angles().set_lever_arm(terms.first_angle + a, 2.0 * sys.angles().lever_arms()[terms.first_angle + a]);
+  const double v2 = step_velocity();
+  CHECK(v1 > 0.0);
+  CHECK(v2 == doctest::Approx(2.0 * v1).epsilon(1e-10));
 }
 
 }  // namespace

@@ -34,6 +34,7 @@ void NewtonEuler::prepare(System& sys, double h) {
   const std::size_t total = n3_ + 3 * std::size_t{AngleLayout::blocks_for(angles.size())};
   for (auto* a : {&xn_, &vn_, &qhat_, &q_, &trial_, &inertia_, &free_, &g_, &f_, &f0_, &vel_, &p_, &rhs_})
     a->assign(total, 0.0);
+  reach_.assign(total, 1.0);
   zeros_.assign(total, 0.0);
   precond_.resize(3 * total);
   ws_.resize(total);
@@ -61,6 +62,7 @@ void NewtonEuler::prepare(System& sys, double h) {
       throw NewtonError("newton euler: angle " + std::to_string(a) + " or its rate is not finite before the step",
                         NewtonError::non_finite, {});
     inertia_[k] = angles.inertias()[a];
+    reach_[k] = angles.lever_arms()[a];
     free_[k] = angles.fixed(static_cast<Index>(a)) ? 0.0 : 1.0;
   }
   for (std::size_t k = n3_ + na; k < total; ++k) inertia_[k] = 1.0;
@@ -212,7 +214,7 @@ NewtonReport NewtonEuler::step(System& sys, double h) {
       slope = pmax = 0.0;
       for (std::size_t k = 0; k < n; ++k) {
         slope += g_[k] * p_[k];
-        pmax = std::max(pmax, std::abs(p_[k]));
+        pmax = std::max(pmax, std::abs(p_[k]) * reach_[k]);
       }
       return slope < 0.0 && std::isfinite(pmax);
     };
@@ -236,7 +238,7 @@ NewtonReport NewtonEuler::step(System& sys, double h) {
         const double d = A.block(A.diagonal(static_cast<Index>(k / 3)))(k % 3, k % 3);
         p_[k] = free_[k] * (-g_[k] / d);
         slope += g_[k] * p_[k];
-        pmax = std::max(pmax, std::abs(p_[k]));
+        pmax = std::max(pmax, std::abs(p_[k]) * reach_[k]);
       }
     }
     rep.step_velocity = pmax / h;

@@ -9,6 +9,7 @@
 // block (AngleLayout), so the block solvers need no second matrix type; a block's unused
 // components are fixed.
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -43,11 +44,19 @@ class AngleTable {
   [[nodiscard]] bool fixed(Index a) const { return fixed_[a] != 0; }
   /// Fixes or frees angle a (a fixed angle moves at its rate). Throws InputError if out of range.
   void set_fixed(Index a, bool on);
+  /// Angle a's lever arm (m/rad, 1 unless set): the length that turns a change of the angle
+  /// into the displacement it causes, so that Newton's step test (|p|∞/h, in m/s) weighs an
+  /// angle like the positions it moves. A Morley edge's mid-normal sets the height of its
+  /// triangles over the edge: taken as 1 m, a mid-normal that moves a 5 mm cell by 1e-7 m
+  /// kept Newton iterating long after the positions had converged.
+  [[nodiscard]] std::span<const double> lever_arms() const { return lever_; }
+  /// Throws InputError if a is out of range or metres is not finite and > 0.
+  void set_lever_arm(Index a, double metres);
   /// Changes whenever angles are added (the Jacobian pattern grows).
   [[nodiscard]] std::uint64_t topology_version() const { return topology_version_; }
 
  private:
-  std::vector<double> value_, rate_, inertia_;
+  std::vector<double> value_, rate_, inertia_, lever_;
   std::vector<unsigned char> fixed_;
   std::uint64_t topology_version_ = 0;
 };

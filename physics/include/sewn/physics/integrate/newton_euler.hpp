@@ -13,7 +13,8 @@
 // PSD-projected (JacobianOptions::project_element_hessians, clamp_compression); H p = -g is
 // solved on the free axes (fixed axes follow their prescribed velocity, q = q_n + h v_n, and
 // are filtered); Armijo backtracking α = 1, ½, ... until Φ(q + αp) ≤ Φ(q) + c α gᵀp; stop
-// when |p|∞/h < velocity_tolerance.
+// when |p|∞/h < velocity_tolerance, an angle's step counted times its lever arm
+// (AngleTable::lever_arms: the displacement it causes).
 //
 // The linear solve is the single function solve_linear() (block-Jacobi PCG on the block
 // matrix, or a sparse direct solve: CHOLMOD's supernodal Cholesky through solve::LinearSolver
@@ -55,7 +56,7 @@ enum class LinearSolver {
 };
 
 struct NewtonEulerOptions {
-  double velocity_tolerance = 1e-6;  ///< m/s: converged when |p|∞/h is below it
+  double velocity_tolerance = 1e-6;  ///< m/s: converged when |p|∞/h is below it (angles times their lever arm)
   int max_iterations = 50;
   int max_line_search = 40;          ///< halvings of α before "no descent"
   double armijo = 1e-4;              ///< c of the sufficient-decrease test
@@ -78,7 +79,7 @@ struct NewtonReport {
   int linear_iterations = 0;  ///< CG iterations, summed (0 with LDLT)
   int steepest_fallbacks = 0; ///< iterations whose solve gave no descent and used -D⁻¹g instead
   int projected_retries = 0;  ///< iterations whose exact Hessian was indefinite (exact_hessian_first)
-  double step_velocity = 0.0; ///< |p|∞/h of the last iteration, m/s
+  double step_velocity = 0.0; ///< |p|∞/h of the last iteration, m/s (angles times their lever arm, AngleTable)
   double phi_decrease = 0.0;  ///< Φ(q̂) - Φ(q_{n+1}) ≥ 0
 };
 
@@ -131,6 +132,7 @@ class NewtonEuler {
   std::size_t n3_ = 0;  // position entries; angles follow
   bool damped_ = false;
   AlignedVector<double> xn_, vn_, qhat_, q_, trial_, inertia_, free_, g_, f_, f0_, vel_, p_, rhs_, precond_, zeros_;
+  AlignedVector<double> reach_;  // per DOF, m per unit: 1 for positions, the lever arm for angles
   CgWorkspace ws_;
   std::unique_ptr<LdltCache> ldlt_;
 };
