@@ -6,6 +6,9 @@
 //       Timoshenko's 14.868 mm (PHYSICS_NOTES §4), Newton and CG iterations.
 //   elastic/step/N<n>/<solver>         one dynamic step (h = 10 ms) of the same beam swinging,
 //       ms per step and per Newton iteration.
+//   elastic/cantilever/static/N<n>/ours, elastic/cantilever/N<n>/implicit_h1e-2/ours
+//       the same beam as the mass-spring system of bench/mss (cubes of springs, the 2013
+//       paper's stiffnesses), its static tip and a run to rest (register_cantilever_springs).
 #include <cmath>
 #include <ctime>
 #include <string>
@@ -16,6 +19,8 @@
 #include "sewn/physics/basic_terms.hpp"
 #include "sewn/physics/integrate/newton_euler.hpp"
 #include "sewn/physics/solids/tets.hpp"
+#include "cantilever.hpp"
+#include "tet_cantilever.hpp"
 #include "sewn_bench.hpp"
 
 namespace {
@@ -23,65 +28,10 @@ namespace {
 using namespace sewn::physics;
 using Eigen::Vector3d;
 
-constexpr double E = 100e6, nu = 0.3, rho = 1000.0, g = 9.81, L = 1.0, b = 0.1;
-constexpr double timoshenko_mm = 14.868;
-
-struct Beam {
-  System sys;
-  std::vector<Index> tip;  // nodes at x = L
-  std::vector<double> rest_z;
-};
-
-// 10N×N×N cubes, 6 tetrahedra each around the cube's main diagonal; lumped masses ρV/4.
-void build(Beam& beam, int n) {
-  const int nx = 10 * n, ny = n, nz = n;
-  const double a = b / n;
-  auto id = [&](int i, int j, int k) { return static_cast<Index>(i + (nx + 1) * (j + (ny + 1) * k)); };
-  std::vector<Vector3d> x;
-  for (int k = 0; k <= nz; ++k)
-    for (int j = 0; j <= ny; ++j)
-      for (int i = 0; i <= nx; ++i) x.emplace_back(a * i, a * j, a * k);
-  static const int path[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  std::vector<std::array<Index, 4>> tets;
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i)
-        for (const auto& p : path) {
-          int c[3] = {i, j, k};
-          std::array<Index, 4> t{};
-          t[0] = id(c[0], c[1], c[2]);
-          for (int s = 0; s < 3; ++s) {
-            ++c[p[s]];
-            t[s + 1] = id(c[0], c[1], c[2]);
-          }
-          tets.push_back(t);
-        }
-  const double node_mass = rho * a * a * a / 6.0 / 4.0;  // per incident tetrahedron
-  std::vector<double> mass(x.size(), 0.0);
-  for (const auto& t : tets)
-    for (Index v : t) mass[v] += node_mass;
-  for (std::size_t i = 0; i < x.size(); ++i) beam.sys.nodes().add(x[i], Vector3d::Zero(), mass[i]);
-  auto& term = beam.sys.add<solids::Tets>(solids::TetLaw::stvk);
-  for (const auto& t : tets) {
-    solids::TetPositions X;
-    for (int c = 0; c < 4; ++c) X.col(c) = x[t[c]];
-    term.add(t, X, E, nu);
-  }
-  beam.sys.add<Gravity>(Vector3d(0, 0, -g));
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    if (x[i].x() == 0.0) beam.sys.nodes().fix(static_cast<Index>(i));
-    if (std::abs(x[i].x() - L) < 1e-12) {
-      beam.tip.push_back(static_cast<Index>(i));
-      beam.rest_z.push_back(x[i].z());
-    }
-  }
-}
-
-double tip_mm(const Beam& beam) {
-  double s = 0.0;
-  for (std::size_t k = 0; k < beam.tip.size(); ++k) s += beam.sys.nodes().position(beam.tip[k]).z() - beam.rest_z[k];
-  return -1e3 * s / static_cast<double>(beam.tip.size());
-}
+using sewn::tet_cantilever::Beam;
+using sewn::tet_cantilever::build;
+using sewn::tet_cantilever::timoshenko_mm;
+using sewn::tet_cantilever::tip_mm;
 
 const char* name(integrate::LinearSolver s) { return s == integrate::LinearSolver::cg ? "cg" : "ldlt"; }
 
@@ -169,6 +119,7 @@ void register_all() {
     for (int n : sizes)
       sewn::bench::ours("elastic", "step/N" + std::to_string(n) + "/" + name(solver),
                         [n, solver](benchmark::State& st) { dynamic_step(st, n, solver); });
+  sewn::bench::mss::register_cantilever_springs("elastic", scale);
 }
 
 const sewn::bench::Registration reg(&register_all);

@@ -3,6 +3,8 @@ and plot): family (answer, name, size label) -> {size: (error %, CPU ms per solv
 
 import re
 
+TIMOSHENKO_MM = 14.868  # the cantilever's answer, Euler-Bernoulli plus shear (PHYSICS_NOTES §4)
+
 
 def families(raw):
     out = {}
@@ -25,4 +27,17 @@ def families(raw):
         if m and "error vs Timoshenko %" in b:
             out.setdefault(("StVK tet cantilever vs Timoshenko", f"Kuhn tets, {m.group(2)}", "N"), {})[int(m.group(1))] = (
                 b["error vs Timoshenko %"], ms)
+        # the mass-spring beam (bench/mss/cantilever.cpp): its static tip, and runs to rest whose
+        # cost is per simulated second, both against the tets' continuum answer
+        m = re.match(r"elastic/cantilever/static/N(\d+)/", name)
+        if m and "_tip_mm" in b:
+            out.setdefault(("mass-spring cantilever vs Timoshenko", "cubes of springs, static", "N"), {})[int(m.group(1))] = (
+                100.0 * abs(b["_tip_mm"] - TIMOSHENKO_MM) / TIMOSHENKO_MM, ms)
+            continue
+        m = re.match(r"elastic/cantilever/N(\d+)/implicit_h1e-2/", name)
+        if m and "_tip_mm" in b and "_cpu_s_per_simulated_s" in b:
+            out.setdefault(("mass-spring cantilever vs Timoshenko", "cubes of springs, implicit h = 10 ms (ms per simulated s)",
+                            "N"), {})[int(m.group(1))] = (100.0 * abs(b["_tip_mm"] - TIMOSHENKO_MM) / TIMOSHENKO_MM,
+                                                          1e3 * b["_cpu_s_per_simulated_s"])
+            continue
     return out

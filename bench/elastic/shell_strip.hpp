@@ -69,11 +69,18 @@ struct Strip {
   std::vector<std::array<physics::Index, 3>> triangles;
 };
 
+/// The strip's width and rows of cells (rows = 0: the mesh's own, nx/10 or 1 for `row`; not
+/// used by `offset`). Euler–Bernoulli's tip does not depend on the width (ν = 0).
+struct Shape {
+  double width = shell_strip::width;
+  int rows = 0;
+};
+
 // The `offset` mesh (see the header comment).
-inline Strip offset_mesh(int nx) {
+inline Strip offset_mesh(int nx, double strip_width = width) {
   const double a = length / nx;
-  const int ny = std::max(1, static_cast<int>(std::lround(width / (a * std::sqrt(3.0) / 2))));
-  const double c = width / ny;
+  const int ny = std::max(1, static_cast<int>(std::lround(strip_width / (a * std::sqrt(3.0) / 2))));
+  const double c = strip_width / ny;
   std::mt19937 rng(777u + static_cast<unsigned>(nx));
   std::uniform_real_distribution<double> jitter(-0.25, 0.25);
   Strip s;
@@ -113,10 +120,10 @@ inline Strip offset_mesh(int nx) {
   return s;
 }
 
-inline Strip strip_mesh(Mesh mesh, int nx) {
-  if (mesh == Mesh::offset) return offset_mesh(nx);
-  const int ny = mesh == Mesh::row ? 1 : std::max(1, nx / 10);
-  const double a = length / nx, c = width / ny;
+inline Strip strip_mesh(Mesh mesh, int nx, const Shape& shape = {}) {
+  if (mesh == Mesh::offset) return offset_mesh(nx, shape.width);
+  const int ny = shape.rows > 0 ? shape.rows : (mesh == Mesh::row ? 1 : std::max(1, nx / 10));
+  const double a = length / nx, c = shape.width / ny;
   const int cols = nx + 2;  // x = -a, 0, a, ..., L
   auto id = [&](int i, int j) { return static_cast<physics::Index>(i + cols * j); };
   std::mt19937 rng(12345u + static_cast<unsigned>(nx));
@@ -149,9 +156,9 @@ inline Strip strip_mesh(Mesh mesh, int nx) {
 
 /// Builds the strip with `bending`, solves it and returns the tip deflection (positive down).
 /// Throws what Newton throws.
-inline Result solve(Mesh mesh, Bending bending, int nx) {
+inline Result solve(Mesh mesh, Bending bending, int nx, const Shape& shape = {}) {
   using physics::Index;
-  const Strip s = strip_mesh(mesh, nx);
+  const Strip s = strip_mesh(mesh, nx, shape);
   physics::System sys;
   const Index n = static_cast<Index>(s.rest.size() / 3);
   std::vector<double> mass(n, 0.0);

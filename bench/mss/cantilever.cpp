@@ -495,6 +495,17 @@ void register_cantilever(Scale scale) {
   register_family(suite, statics, false, runs);
 }
 
+void register_cantilever_springs(const char* in_suite, Scale scale) {
+  std::vector<std::uint32_t> statics = {2, 4};
+  std::vector<Run> runs = {{2, Integrator::implicit, 1e-2}};
+  if (scale != Scale::smoke) {
+    statics.push_back(8);
+    runs.push_back({4, Integrator::implicit, 1e-2});
+  }
+  if (scale == Scale::full) statics.push_back(16);
+  register_family(in_suite, statics, false, runs);
+}
+
 void register_cantilever_integrators(Scale scale) {
   // The implicit schemes at 10 and 1 ms, each with and without the volume term; the statics of
   // both families, whose three finest give each its own extrapolated reference.

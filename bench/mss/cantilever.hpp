@@ -9,6 +9,9 @@
 // The derive script (bench/mss/derive) turns the tips into errors against the extrapolated
 // reference and draws the Pareto plot.
 //
+// The elastic suite (issue 15) registers the statics and 10 ms implicit runs under its own name
+// (register_cantilever_springs), to compare them with the StVK tets against Timoshenko.
+//
 // The hard suite (issue 17) registers the same family extended with the implicit midpoint
 // integrator and the volume term (κ = E on every hexahedron corner), under its own name:
 //   hard/cantilever/static{,_volume}/N<n>/ours
@@ -20,5 +23,10 @@ namespace sewn::bench::mss {
 
 void register_cantilever(Scale scale);
 void register_cantilever_integrators(Scale scale);
+/// The elastic suite's mass-spring family (issue 15), beside its StVK tets and against the same
+/// Timoshenko answer: `<suite>/cantilever/static/N<n>/ours` (N = 2, 4, smoke; 8, small; 16,
+/// full) and implicit runs to rest at h = 10 ms (N = 2; 4 from small on) for the cost per
+/// simulated second.
+void register_cantilever_springs(const char* in_suite, Scale scale);
 
 }  // namespace sewn::bench::mss

@@ -41,4 +41,12 @@ void AngleTable::set_fixed(Index a, bool on) {
   fixed_[a] = on ? 1 : 0;
 }
 
+void AngleTable::set_length(Index a, double metres) {
+  if (a >= size()) throw InputError("AngleTable::set_length: angle " + std::to_string(a) + " of " + std::to_string(size()));
+  if (!(std::isfinite(metres) && metres > 0.0))
+    throw InputError("AngleTable::set_length: angle " + std::to_string(a) + ": the length must be finite and > 0, got " +
+                     detail::format_number(metres) + " m");
+  length_[a] = metres;
+}
+
 }  // namespace sewn::physics

@@ -11,7 +11,9 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <vector>
 
+#include "../../bench/elastic/tet_cantilever.hpp"
 #include "elastic_helpers.hpp"
 #include "helpers.hpp"
 #include "sewn/physics/integrate/newton_euler.hpp"
@@ -434,4 +436,29 @@ TEST_CASE("stiffness contrast 1e6 in one solid: Newton converges with CG and LDL
                                      << "largest displacement " << moved << " m, CG vs LDLT " << diff << " m");
   CHECK(moved > 1e-3);           // the soft half sags
   CHECK(diff < 1e-6 * moved);    // both solvers find the same states
+}
+
+TEST_CASE("StVK tet cantilever: linear FE's tips at small sizes, the error against Timoshenko falling at a rising order") {
+  // Linear tets lock in bending: before the asymptotic range the order rises towards 2. At a
+  // strain of 1e-4 StVK must give linear FE's tips (PHYSICS_NOTES §4: 7.49 mm at N = 2, 11.67
+  // at N = 4, same meshes) to about 0.1 %.
+  std::vector<double> tip, err;
+  for (int n : {1, 2, 4}) {
+    sewn::tet_cantilever::Beam beam;
+    sewn::tet_cantilever::build(beam, n);
+    NewtonEulerOptions opt;
+    opt.solver = integrate::LinearSolver::ldlt;
+    const double h = 1e3;  // quasi-static: inertia ~1e-9 of the stiffness
+    opt.velocity_tolerance = 1e-9 / h;
+    NewtonEuler newton(opt);
+    (void)newton.step(beam.sys, h);
+    tip.push_back(sewn::tet_cantilever::tip_mm(beam));
+    err.push_back(std::abs(tip.back() - sewn::tet_cantilever::timoshenko_mm) / sewn::tet_cantilever::timoshenko_mm);
+  }
+  CHECK(tip[1] == Approx(7.49).epsilon(2e-3));
+  CHECK(tip[2] == Approx(11.67).epsilon(2e-3));
+  const double order1 = std::log2(err[0] / err[1]), order2 = std::log2(err[1] / err[2]);
+  MESSAGE("StVK tets: tip " << tip[0] << ", " << tip[1] << ", " << tip[2] << " mm; orders " << order1 << ", " << order2);
+  CHECK(order1 > 0.0);
+  CHECK(order2 > order1);
 }

@@ -5,13 +5,16 @@
 // mid-normal), and the strip cantilever's convergence to Euler–Bernoulli on irregular meshes.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "../../bench/elastic/shell_strip.hpp"
 #include "elastic_helpers.hpp"
+#include "sewn/physics/integrate/newton_euler.hpp"
 #include "sewn/physics/shells/morley_terms.hpp"
 
 namespace test_elastic_morley {
@@ -178,6 +181,81 @@ TEST_CASE("Morley bending: the strip cantilever converges to Euler-Bernoulli at 
       CHECK(order < 2.4);
     }
   }
+}
+
+TEST_CASE("Morley bending: a one-row strip converges at second order in the cell's length and its height") {
+  // A one-row strip of fixed width stalls at 0.5 % (docs/elastic.md): Morley's tip error is a
+  // second-order term in each cell dimension, (a² + c²/2)/L² on these meshes (cell length a,
+  // height c), and a fixed-width row never shortens c. Not a boundary or clamp defect: the row
+  // converges once its width shrinks with the cells, and at fixed nx the part from the height
+  // falls 4x per halving of the width.
+  using sewn::shell_strip::Mesh;
+  using sewn::shell_strip::Shape;
+  const double exact = sewn::shell_strip::euler_bernoulli_m();
+  auto error = [&](int nx, double width) {
+    const auto r = sewn::shell_strip::solve(Mesh::row, sewn::shell_strip::Bending::morley, nx, Shape{width, 1});
+    return std::abs(r.tip_m - exact) / exact;
+  };
+  SUBCASE("triangles of aspect 4 (width 4 cells), nx = 10, 20, 40") {
+    std::vector<double> err;
+    for (int nx : {10, 20, 40}) err.push_back(error(nx, 4.0 / nx));
+    for (std::size_t k = 1; k < err.size(); ++k) {
+      const double order = std::log2(err[k - 1] / err[k]);
+      CAPTURE(order);
+      CHECK(order > 1.7);
+      CHECK(order < 2.4);
+    }
+  }
+  SUBCASE("nx = 40, width 0.2, 0.1, 0.05: the differences fall at second order in the height") {
+    const double e1 = error(40, 0.2), e2 = error(40, 0.1), e3 = error(40, 0.05);
+    const double order = std::log2((e1 - e2) / (e2 - e3));
+    CAPTURE(order);
+    CHECK(order > 1.7);
+    CHECK(order < 2.4);
+  }
+}
+
+TEST_CASE("Morley bending: an edge angle's lever arm is its triangles' height, and Newton's step test weighs the angle by it") {
+  // A unit square cut along its diagonal: boundary edges 1 m from the opposite corner, the
+  // diagonal √2/2 m from both. Newton weighing a mid-normal's step in rad as if in m kept
+  // shell scenes iterating after their positions had converged (docs/elastic.md).
+  const std::vector<std::array<Index, 3>> tris{{0, 1, 2}, {0, 2, 3}};
+  const std::vector<double> rest{0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+  const std::vector<shells::PlateMaterial> mat(2, shells::plate_material(1e6, 0.3, 0.01));
+  sewn::physics::System sys;
+  for (Index i = 0; i < 4; ++i)
+    sys.nodes().add(Eigen::Vector3d(rest[3 * i], rest[3 * i + 1], i == 3 ? 0.1 : 0.0), Eigen::Vector3d::Zero(), 1.0);
+  for (Index i = 0; i < 4; ++i) sys.nodes().fix(i);  // bent and held: only the mid-normals move
+  const shells::MorleyTerms terms = shells::add_morley_bending(sys, tris, rest, mat);
+  REQUIRE(terms.angles == 5);
+  std::vector<double> levers(sys.angles().lengths().begin(), sys.angles().lengths().end());
+  std::sort(levers.begin(), levers.end());
+  CHECK(levers[0] == doctest::Approx(std::sqrt(0.5)).epsilon(1e-14));
+  for (std::size_t a = 1; a < levers.size(); ++a) CHECK(levers[a] == doctest::Approx(1.0).epsilon(1e-14));
+  CHECK_THROWS_AS(sys.angles().set_length(0, 0.0), sewn::physics::InputError);
+  CHECK_THROWS_AS(sys.angles().set_length(5, 1.0), sewn::physics::InputError);
+
+  // One Newton iteration (the energy is quadratic in the angles: the step is exact), refused
+  // for its tolerance: the reported |p|∞/h doubles when every lever arm does.
+  sewn::physics::integrate::NewtonEulerOptions opt;
+  opt.solver = sewn::physics::integrate::LinearSolver::ldlt;
+  opt.max_iterations = 1;
+  opt.velocity_tolerance = 1e-30;
+  auto step_velocity = [&] {
+    sewn::physics::integrate::NewtonEuler newton(opt);
+    try {
+      (void)newton.step(sys, 0.01);
+    } catch (const sewn::physics::integrate::NewtonError& e) {
+      return e.report().step_velocity;
+    }
+    return -1.0;
+  };
+  const double v1 = step_velocity();
+  for (Index a = 0; a < terms.angles; ++a)
+    sys.angles().set_length(terms.first_angle + a, 2.0 * sys.angles().lengths()[terms.first_angle + a]);
+  const double v2 = step_velocity();
+  CHECK(v1 > 0.0);
+  CHECK(v2 == doctest::Approx(2.0 * v1).epsilon(1e-10));
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "sewn/physics/shells/morley_terms.hpp"
 
+#include <algorithm>
 #include <string>
 
 #include "sewn/physics/errors.hpp"
@@ -174,6 +175,9 @@ MorleyTerms add_morley_bending(System& sys, std::span<const std::array<Index, 3>
   }
   MorleyBending term;
   MorleyTerms out;
+  // per angle, the largest height of its triangles over the edge: a mid-normal turned by ψ
+  // moves its triangles by up to about ψ times that height (Newton's step test, AngleTable)
+  std::vector<double> lever(angles, 0.0);
   const Index first = sys.angles().size();
   for (Index t = 0; t < triangles.size(); ++t) {
     if (is_clamp(t)) continue;
@@ -194,6 +198,13 @@ MorleyTerms add_morley_bending(System& sys, std::span<const std::array<Index, 3>
     for (std::size_t c = 0; c < 6; ++c)
       if (e.nodes[c] != invalid_index)
         for (std::size_t a = 0; a < 3; ++a) X(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(c)) = rest_x[3 * e.nodes[c] + a];
+    for (std::size_t i = 0; i < 3; ++i) {
+      if (angle_of[t][i] == invalid_index) continue;
+      const Eigen::Vector3d a = X.col(static_cast<Eigen::Index>((i + 1) % 3)), b = X.col(static_cast<Eigen::Index>((i + 2) % 3));
+      const Eigen::Vector3d c = X.col(static_cast<Eigen::Index>(i));
+      const double len = (b - a).norm();  // degenerate triangles are refused below
+      if (len > 0.0) lever[angle_of[t][i]] = std::max(lever[angle_of[t][i]], (b - a).cross(c - a).norm() / len);
+    }
     try {
       e.rest = morley_rest(X, kind, material_of_triangle[t]);
       (void)term.add(e);
@@ -206,6 +217,8 @@ MorleyTerms add_morley_bending(System& sys, std::span<const std::array<Index, 3>
   const std::vector<double> zero(angles, 0.0);
   const std::vector<unsigned char> free(angles, 0);
   out.first_angle = sys.angles().add("Morley bending", zero, zero, free);
+  for (Index a = 0; a < angles; ++a)
+    if (lever[a] > 0.0) sys.angles().set_length(out.first_angle + a, lever[a]);
   out.angles = angles;
   out.term = &sys.add<MorleyBending>(std::move(term));
   return out;

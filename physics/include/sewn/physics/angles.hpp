@@ -9,6 +9,7 @@
 // block (AngleLayout), so the block solvers need no second matrix type; a block's unused
 // components are fixed.
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,12 @@ class AngleTable {
   [[nodiscard]] bool fixed(Index a) const { return fixed_[a] != 0; }
   /// Fixes or frees angle a (a fixed angle moves at its rate). Throws InputError if out of range.
   void set_fixed(Index a, bool on);
+  /// Sets angle a's length (see add) after the fact, for a term that knows it only once its
+  /// angles exist: a Morley edge's mid-normal takes the height of its triangles over the edge
+  /// (taken as 1 m, a mid-normal that moved a 5 mm cell by 1e-7 m kept Newton iterating long
+  /// after the positions had converged). Throws InputError if a is out of range or metres is
+  /// not finite and > 0.
+  void set_length(Index a, double metres);
   /// Changes whenever angles are added (the Jacobian pattern grows).
   [[nodiscard]] std::uint64_t topology_version() const { return topology_version_; }
 

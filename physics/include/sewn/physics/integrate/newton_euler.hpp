@@ -15,7 +15,8 @@
 // are filtered); a step turning an angle DOF by more than max_angle_step is scaled down to it;
 // Armijo backtracking α = 1, ½, ... until Φ(q + αp) ≤ Φ(q) + c α gᵀp; stop
 // when |p|∞/h < velocity_tolerance, an angle's update counted as the distance it moves its
-// material (AngleTable::lengths() × Δθ: a rod's section radius of gyration), not in radians.
+// material (AngleTable::lengths() × Δθ: a rod's section radius of gyration, a Morley edge's
+// triangle height), not in radians.
 //
 // The linear solve is the single function solve_linear() (block-Jacobi PCG on the block
 // matrix, or a sparse direct solve: CHOLMOD's supernodal Cholesky through solve::LinearSolver
