@@ -14,6 +14,7 @@
 
 #include "sewn/apps/cell_models.hpp"
 #include "sewn/apps/paper_shapes.hpp"
+#include "sewn/physics/solve/linear_solver.hpp"
 #include "sewn/apps/runner.hpp"
 #include "sewn/apps/scene.hpp"
 #include "sewn/cmap/build.hpp"
@@ -229,6 +230,25 @@ TEST_CASE("integrator.solver ldlt: Newton's direct solve, refused with the other
   } catch (const sewn::app::SceneError& e) {
     CHECK(e.path() == "integrator.solver");
     CHECK(e.reason() == "\"ldlt\" solves the Newton systems of integrator.type \"newton\" only (this scene's is \"implicit\")");
+  }
+}
+
+TEST_CASE("integrator.solver with newton: hypre-pcg, petsc and sa-pcg are refused by key, not replaced by block-Jacobi CG") {
+  auto j = sewn::app::test::minimal();
+  for (const char* name : {"hypre-pcg", "petsc", "sa-pcg"}) {
+    CAPTURE(name);
+    j["integrator"] = {{"type", "newton"}, {"solver", name}};
+    try {
+      (void)sewn::app::parse_scene(j, "s.json");
+      FAIL("accepted a solver that Newton does not use");
+    } catch (const sewn::app::SceneError& e) {
+      CHECK(e.path() == "integrator.solver");  // a build without the backend refuses it too, naming the build
+    }
+  }
+  if (!sewn::physics::solve::available(sewn::physics::solve::Backend::cholmod)) return;  // both need CHOLMOD
+  for (const char* name : {"cholmod", "cholmod-pcg"}) {
+    j["integrator"] = {{"type", "newton"}, {"solver", name}};
+    CHECK(sewn::app::parse_scene(j, "s.json").solver == name);
   }
 }
 

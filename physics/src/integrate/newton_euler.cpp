@@ -18,6 +18,8 @@ struct NewtonEuler::LdltCache {
   // times faster than the simplicial LDLT on a shell of thousands of nodes (the umbrella).
   std::unique_ptr<solve::LinearSolver> cholmod;
   bool cholmod_failed = false;  // the matrix was not positive definite once: LDLT from then on
+  // LinearSolver::cholmod_pcg: its factorization is kept across iterations and steps.
+  std::unique_ptr<solve::LinearSolver> kept_pcg;
 };
 
 NewtonEuler::NewtonEuler(NewtonEulerOptions options) : opt_(options) {}
@@ -140,6 +142,7 @@ int NewtonEuler::solve_linear(const BlockMatrix& A, bool need_definite) {
     return r.iterations;
   }
   if (!ldlt_) ldlt_ = std::make_unique<LdltCache>();
+  if (opt_.solver == LinearSolver::cholmod_pcg) return solve_kept_pcg(A);
   if (solve::available(solve::Backend::cholmod) && !ldlt_->cholmod_failed) {
     if (!ldlt_->cholmod) {
       solve::SolverOptions o;
@@ -189,6 +192,30 @@ void NewtonEuler::limit_angle_step(double& slope, double& pmax, NewtonReport& re
   slope *= s;
   pmax *= s;
   ++rep.angle_step_limits;
+}
+
+int NewtonEuler::solve_kept_pcg(const BlockMatrix& A) {
+  const std::size_t n = dof_count();
+  if (!ldlt_->kept_pcg) {
+    if (!solve::available(solve::Backend::cholmod_pcg))
+      throw InputError("newton euler: the solver cholmod-pcg needs CHOLMOD, which this build lacks");
+    solve::SolverOptions o;
+    o.tolerance = opt_.cg_tolerance;
+    o.absolute_tolerance = 0.0;  // relative to the Newton residual, as the block-Jacobi CG
+    o.max_iterations = opt_.cg_max_iterations;
+    ldlt_->kept_pcg = solve::make_solver(solve::Backend::cholmod_pcg, o);
+  }
+  try {
+    const solve::SolveReport r = ldlt_->kept_pcg->solve(A, std::span<const double>(rhs_.data(), n),
+                                                        std::span<double>(p_.data(), n), std::span<const double>(free_.data(), n));
+    return r.iterations;
+  } catch (const SolverError&) {
+    // A fresh factorization of the projected H failed (round-off on a semi-definite matrix):
+    // p = 0 is no descent, and step() falls back on the scaled gradient.
+    std::fill(p_.begin(), p_.begin() + static_cast<std::ptrdiff_t>(n), 0.0);
+    ldlt_->kept_pcg->reset();
+    return 0;
+  }
 }
 
 double NewtonEuler::incremental_potential(const System& sys, std::span<const double> q) {
@@ -266,25 +293,27 @@ NewtonReport NewtonEuler::step(System& sys, double h) {
       // The Newton step is within tolerance: take it whole (it is smaller than what the
       // line search could resolve against round-off in Φ).
       for (std::size_t k = 0; k < n; ++k) q_[k] += p_[k];
-      phi = evaluate(sys, q_, true);
+      phi = evaluate(sys, q_, false);  // for phi_decrease; no gradient is needed after
       converged = true;
       break;
     }
-    // Armijo backtracking; round-off in Φ is allowed for at a few ulps of its terms' size.
+    // Armijo backtracking; round-off in Φ is allowed for at a few ulps of its terms' size. The
+    // first trial evaluates the gradient too (g_ at q_ is not needed again: slope holds what the
+    // test uses): α = 1 is accepted nearly always, and its gradient is then already there.
     double alpha = 1.0;
     const double noise = 8.0 * std::numeric_limits<double>::epsilon() * std::abs(phi);
     for (int ls = 0;; ++ls) {
       if (ls > opt_.max_line_search) fail(NewtonError::no_descent, "the line search found no decrease of the incremental potential");
       for (std::size_t k = 0; k < n; ++k) trial_[k] = q_[k] + alpha * p_[k];
-      const double phi_t = evaluate(sys, trial_, false);
+      const double phi_t = evaluate(sys, trial_, ls == 0);
       if (std::isfinite(phi_t) && phi_t <= phi + opt_.armijo * alpha * slope + noise) {
         std::swap(q_, trial_);
+        phi = ls == 0 ? phi_t : evaluate(sys, q_, true);
         break;
       }
       alpha *= 0.5;
       ++rep.line_search_steps;
     }
-    phi = evaluate(sys, q_, true);
     if (!std::isfinite(phi)) fail(NewtonError::non_finite, "the incremental potential became non-finite");
     if (const auto k = first_non_finite(g_); k >= 0)
       fail(NewtonError::non_finite, "the gradient is not finite at " + describe_dof(static_cast<std::size_t>(k)));

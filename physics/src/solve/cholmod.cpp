@@ -31,6 +31,13 @@ class Factorization {
     // LLᵀ: a simplicial LDLᵀ would succeed on an indefinite matrix (only a zero pivot stops
     // it), and indefiniteness is what must be reported.
     c_.final_ll = 1;
+    // Fill-reducing ordering: the least fill of AMD, METIS and nested dissection (by default
+    // CHOLMOD tries METIS only where AMD's fill is large). The analysis runs once per pattern;
+    // the umbrella's 9702 unknowns factor in 6.0e8 flops with nested dissection, 7.8e8 with AMD.
+    c_.nmethods = 3;
+    c_.method[0].ordering = CHOLMOD_AMD;
+    c_.method[1].ordering = CHOLMOD_METIS;
+    c_.method[2].ordering = CHOLMOD_NESDIS;
   }
   ~Factorization() {
     free_factor();

@@ -19,9 +19,9 @@
 // triangle height), not in radians.
 //
 // The linear solve is the single function solve_linear() (block-Jacobi PCG on the block
-// matrix, or a sparse direct solve: CHOLMOD's supernodal Cholesky through solve::LinearSolver
-// when the build has it, else, or once CHOLMOD finds the matrix not positive definite,
-// Eigen's SimplicialLDLT on its sparse copy).
+// matrix; PCG preconditioned by a kept CHOLMOD factorization; or a sparse direct solve:
+// CHOLMOD's supernodal Cholesky through solve::LinearSolver when the build has it, else, or
+// once CHOLMOD finds the matrix not positive definite, Eigen's SimplicialLDLT on its sparse copy).
 //
 // Failure (no descent direction or line search exhausted, too many iterations, a non-finite
 // energy, gradient or state) throws NewtonError naming what failed, with the node table
@@ -37,8 +37,11 @@
 //
 // Cost per Newton iteration: one Jacobian assembly (element Hessians + projections), one
 // linear solve (CG: iterations × one block-sparse product; LDLT: one numeric factorisation,
-// the symbolic one cached per pattern) and, per line-search trial, one force and one energy
-// evaluation (two force evaluations when some term depends on velocity).
+// the symbolic one cached per pattern; kept-factorization PCG: a few iterations of two
+// triangular solves each, a factorization now and then) and, per line-search trial, one energy
+// and one force evaluation (two force evaluations when some term depends on velocity). The
+// first trial (α = 1) evaluates the forces with the energy: it is accepted nearly always, and
+// the accepted point's gradient is then not evaluated again.
 
 #include <cstdint>
 #include <memory>
@@ -55,6 +58,11 @@ namespace sewn::physics::integrate {
 enum class LinearSolver {
   cg,    ///< block-Jacobi PCG on the block matrix to a relative tolerance (inexact Newton)
   ldlt,  ///< sparse direct: CHOLMOD when built, else Eigen SimplicialLDLT (exact; symbolic step cached)
+  /// CG to cg_tolerance preconditioned by a CHOLMOD factorization kept across Newton iterations
+  /// and steps (solve::Backend::cholmod_pcg, refreshed when CG slows down): a factorization costs
+  /// tens of CG iterations on a large shell (the umbrella), and successive Newton matrices differ
+  /// little. Projected Hessians only (exact_hessian_first is ignored, as with cg). Needs CHOLMOD.
+  cholmod_pcg,
 };
 
 struct NewtonEulerOptions {
@@ -137,6 +145,8 @@ class NewtonEuler {
   int solve_linear(const BlockMatrix& A, bool need_definite = false);
   // Scales p_ (and its slope gᵀp and |p|∞) so no angle turns by more than max_angle_step.
   void limit_angle_step(double& slope, double& pmax, NewtonReport& rep);
+  // solve_linear() for LinearSolver::cholmod_pcg; returns the CG iterations.
+  int solve_kept_pcg(const BlockMatrix& A);
   [[nodiscard]] std::size_t dof_count() const { return inertia_.size(); }
 
   NewtonEulerOptions opt_;
