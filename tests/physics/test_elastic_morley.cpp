@@ -47,7 +47,7 @@ void check_stencil(const shells::MorleyPositions& X, const std::array<shells::Mo
   const std::function<Eigen::VectorXd(const Dofs&)> G = [&](const Dofs& q) {
     return Eigen::VectorXd(shells::morley_gradient(positions_of(q), angles_of(q), rest));
   };
-  Dofs q;
+  Dofs q = Dofs::Zero();  // the edge angles start at 0 (rest), then turned below
   q.head<18>() = Eigen::Map<const Eigen::Matrix<double, 18, 1>>(X.data());
   for (int k = 0; k < 21; ++k) q[k] += 0.3 * u(rng);  // bent, and every mid-normal turned
   const Eigen::VectorXd g = G(q);
