@@ -34,10 +34,14 @@ class SaPreconditioner {
     cols_.assign(A.columns().begin(), A.columns().end());
     pattern_ = A.pattern_version();
     have_pattern_ = true;
+    analysed_ = false;
     return true;
   }
-  [[nodiscard]] bool analysed() const { return have_pattern_; }
-  void analyse() {}
+  // The per-pattern set-up is the pattern's copy above; analyse() only records that this
+  // pattern has had it, so the solve report counts one analysis per pattern (as the other
+  // kept preconditioners do) and a cut shows in it.
+  [[nodiscard]] bool analysed() const { return have_pattern_ && analysed_; }
+  void analyse() { analysed_ = true; }
 
   /// The set-up's input from A: its filtered blocks (S A S + I - S; a zero diagonal entry,
   /// a node nothing weighs or stiffens, becomes 1), the mask and the coordinates last given.
@@ -110,7 +114,7 @@ class SaPreconditioner {
 
   void forget() {
     hierarchy_.clear();
-    have_pattern_ = valid_ = false;
+    have_pattern_ = analysed_ = valid_ = false;
   }
 
   /// The nodes' positions for the rigid-body modes of the next set-up.
@@ -131,7 +135,7 @@ class SaPreconditioner {
  private:
   SaHierarchy hierarchy_;
   std::uint64_t pattern_ = 0;
-  bool have_pattern_ = false, valid_ = false;
+  bool have_pattern_ = false, analysed_ = false, valid_ = false;
   std::vector<Index> rows_, cols_;
   std::vector<double> input_, coordinates_;
   const BlockMatrix* A_ = nullptr;
