@@ -568,6 +568,9 @@ bool Springs::jacobian_symmetric(const JacobianOptions& opt) const {
 
 void Springs::add_stability_rows(const StateView& st, StabilityRows& rows) const {
   if (size() == 0) return;
+  if (max_node_ >= st.size())
+    throw InputError("springs: a spring refers to node " + std::to_string(max_node_) + " but the state has " +
+                     std::to_string(st.size()) + " nodes");
   if (runs_.needs_rebuild()) runs_.rebuild(arrays());
   if (runs_.worthwhile() && runs_.stability_rows(static_cast<detail::RunDamping>(damping_), beta_, st.x, st.size(), rows)) {
     stability_rows_of(runs_.rest(), st, rows);
