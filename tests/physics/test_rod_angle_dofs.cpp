@@ -24,6 +24,17 @@ using namespace sewn::physics::rods;
 
 namespace angle_dofs_test {
 
+// A straight rod of two 0.1 m edges along x, its three vertices fixed (only its angles move),
+// circular section of radius r, E = 10 MPa, nu = 0.3.
+Rods& fixed_two_edge_rod(System& sys, double r) {
+  std::vector<Index> ids;
+  for (int i = 0; i < 3; ++i) ids.push_back(sys.nodes().add(Vec3(0.1 * i, 0, 0), Vec3::Zero(), 1.0));
+  for (Index i : ids) sys.nodes().fix(i);
+  Rods& rods = sys.add<Rods>();
+  (void)rods.add_rod(ids, sys.nodes().x(), false, Section::circular(1e7, 0.3, r));
+  return rods;
+}
+
 // A hanging helical rod (natural curvature and twist), first two vertices and θ^0 clamped.
 Rods& hanging_helix(System& sys, int n) {
   std::vector<Index> ids;
@@ -178,12 +189,8 @@ TEST_CASE("rod angle DOFs without inertia follow the quasi-static rods under New
 TEST_CASE("rod angle DOFs with inertia: a twist oscillator follows backward Euler's recurrence") {
   // Three fixed collinear vertices; θ^0 fixed, θ^1 free with inertia J: E = GJ/(2D)(θ^1)².
   System sys;
-  std::vector<Index> ids;
-  for (int i = 0; i < 3; ++i) ids.push_back(sys.nodes().add(Vec3(0.1 * i, 0, 0), Vec3::Zero(), 1.0));
-  for (Index i : ids) sys.nodes().fix(i);
-  Rods& rods = sys.add<Rods>();
+  Rods& rods = fixed_two_edge_rod(sys, 0.01);
   const Section sec = Section::circular(1e7, 0.3, 0.01);
-  (void)rods.add_rod(ids, sys.nodes().x(), false, sec);
   rods.rod(0).fix_theta(0);
   const double rho_polar = 1000 * std::numbers::pi * std::pow(0.01, 4) / 2;  // ρπr⁴/2
   rods.use_angle_dofs(sys.angles(), rho_polar);
@@ -213,11 +220,7 @@ TEST_CASE("rod angle DOFs: Newton turns no angle by more than max_angle_step per
   // trust region takes it there in steps of at most π/4: three limited ones, the rest, and
   // the converged check; the answer is the same.
   auto twisted = [](System& sys) {
-    std::vector<Index> ids;
-    for (int i = 0; i < 3; ++i) ids.push_back(sys.nodes().add(Vec3(0.1 * i, 0, 0), Vec3::Zero(), 1.0));
-    for (Index i : ids) sys.nodes().fix(i);
-    Rods& rods = sys.add<Rods>();
-    (void)rods.add_rod(ids, sys.nodes().x(), false, Section::circular(1e7, 0.3, 0.01));
+    Rods& rods = fixed_two_edge_rod(sys, 0.01);
     rods.rod(0).fix_theta(0);
     rods.use_angle_dofs(sys.angles(), 0.0);
     sys.angles().values()[rods.angle_of(0, 1)] = 3.0;
@@ -247,12 +250,8 @@ TEST_CASE("rod angle DOFs: Newton's stopping test counts a twist update as the d
   // section by r/√2 · π/4 = 5.55 mm; with h = 1 s and a tolerance of 10 mm/s that is converged,
   // where the π/4 rad of the same update read as metres would not be.
   System sys;
-  std::vector<Index> ids;
-  for (int i = 0; i < 3; ++i) ids.push_back(sys.nodes().add(Vec3(0.1 * i, 0, 0), Vec3::Zero(), 1.0));
-  for (Index i : ids) sys.nodes().fix(i);
-  Rods& rods = sys.add<Rods>();
   const double r = 0.01;
-  (void)rods.add_rod(ids, sys.nodes().x(), false, Section::circular(1e7, 0.3, r));
+  Rods& rods = fixed_two_edge_rod(sys, r);
   rods.rod(0).fix_theta(0);
   rods.use_angle_dofs(sys.angles(), 0.0);
   for (double l : sys.angles().lengths()) CHECK(l == doctest::Approx(r / std::sqrt(2.0)).epsilon(1e-14));
