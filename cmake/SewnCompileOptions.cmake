@@ -29,11 +29,15 @@ if(SEWN_FUZZ AND NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
   message(STATUS "SEWN_FUZZ: libFuzzer needs clang (this is ${CMAKE_CXX_COMPILER_ID}): fuzz targets skipped")
   set(SEWN_FUZZ OFF)
 endif()
-if(SEWN_FUZZ)
+if(SEWN_FUZZ AND SEWN_FUZZ_COVERAGE STREQUAL "all")
   # Every library the targets link gets coverage instrumentation; tests/fuzz adds the driver.
   target_compile_options(sewn_build_flags INTERFACE -fsanitize=fuzzer-no-link,address,undefined
                          -fno-omit-frame-pointer -fno-sanitize-recover=all)
   target_link_options(sewn_build_flags INTERFACE -fsanitize=address,undefined)
+elseif(SEWN_FUZZ AND NOT SEWN_SANITIZE)
+  # Only the listed modules are instrumented (the top-level CMakeLists adds that); the targets
+  # still need the sanitizers everywhere.
+  message(FATAL_ERROR "SEWN_FUZZ_COVERAGE='${SEWN_FUZZ_COVERAGE}' needs SEWN_SANITIZE (e.g. address,undefined)")
 endif()
 
 function(sewn_module name)
