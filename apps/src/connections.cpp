@@ -89,7 +89,7 @@ constexpr double square_torsion = 0.1406;
 struct PointSide {
   connect::SideRef ref;
   SideStiffness k;
-  std::uint32_t cell = 0;  // the mesh cell its frame is built on
+  std::vector<std::uint32_t> cells;  // the mesh cells its frame is built on (a shell vertex: its whole fan)
 };
 
 double mean_edge(const Around& a, std::span<const std::uint32_t> pts) {
@@ -171,14 +171,14 @@ PointSide solid_point_side(const Around& a, std::uint32_t comp, std::uint32_t p,
   side.rest_axis = normal;
   const auto& m = a.material(best);
   const double l = mean_edge(a, c);
-  return {side, {shear_modulus(m) * square_torsion * l * l * l, m.young * l * l * l / 12}, best};
+  return {side, {shear_modulus(m) * square_torsion * l * l * l, m.young * l * l * l / 12}, {best}};
 }
 
 // A shell's side at point p. At a boundary vertex (its fan runs from one boundary edge to
 // another) the axis is the rest bisector of the fan's whole angle, carried by the triangle it
-// lies in (PHYSICS_NOTES §3.5); elsewhere (an interior vertex, or a vertex where fans pinch) the
-// corner bisector of the first triangle: a frame carried rigidly by that triangle, not the
-// vertex normal the notes suggest for interior vertices (not built yet).
+// lies in; at an interior vertex (one closed fan) the one-ring's vertex normal (VertexSide; both
+// PHYSICS_NOTES §3.5); elsewhere (a vertex where fans pinch) the corner bisector of the first
+// triangle: a frame carried rigidly by that triangle.
 PointSide shell_point_side(const Around& a, const std::vector<std::uint32_t>& tris, std::uint32_t p) {
   auto others = [&](std::uint32_t t) {
     std::array<std::uint32_t, 2> o{};
@@ -192,7 +192,7 @@ PointSide shell_point_side(const Around& a, const std::vector<std::uint32_t>& tr
     const auto cp = a.mesh.cell(t);
     for (int v = 0; v < 3; ++v) side.nodes[static_cast<std::size_t>(v)] = a.node(cp[static_cast<std::size_t>(v)]);
     side.rest_axis = axis;
-    return PointSide{side, {}, t};
+    return PointSide{side, {}, {t}};
   };
   std::map<std::uint32_t, int> uses;  // the far end of each edge from p -> triangles using it
   for (std::uint32_t t : tris)
@@ -200,8 +200,8 @@ PointSide shell_point_side(const Around& a, const std::vector<std::uint32_t>& tr
   std::vector<std::uint32_t> ends;
   for (const auto& u : uses)
     if (u.second == 1) ends.push_back(u.first);
-  if (ends.size() != 2) return side_on(tris.front(), std::nullopt);
-  // walk the fan from one boundary edge to the other: (triangle, from, to, angle at p)
+  if (ends.size() != 2 && !ends.empty()) return side_on(tris.front(), std::nullopt);
+  // walk the fan from one boundary edge to the other, or around: (triangle, from, to, angle at p)
   struct Wedge {
     std::uint32_t tri, from, to;
     double angle;
@@ -209,7 +209,7 @@ PointSide shell_point_side(const Around& a, const std::vector<std::uint32_t>& tr
   std::vector<Wedge> fan;
   std::vector<bool> used(tris.size(), false);
   double total = 0;
-  for (std::uint32_t from = ends[0]; fan.size() < tris.size();) {
+  for (std::uint32_t from = ends.empty() ? others(tris.front())[0] : ends[0]; fan.size() < tris.size();) {
     std::size_t k = 0;
     while (k < tris.size() && (used[k] || (others(tris[k])[0] != from && others(tris[k])[1] != from))) ++k;
     if (k == tris.size()) break;
@@ -220,6 +220,13 @@ PointSide shell_point_side(const Around& a, const std::vector<std::uint32_t>& tr
     fan.push_back({tris[k], from, to, std::atan2(e1.cross(e2).norm(), e1.dot(e2))});
     total += fan.back().angle;
     from = to;
+  }
+  if (ends.empty()) {
+    if (fan.size() != tris.size() || fan.back().to != fan.front().from) return side_on(tris.front(), std::nullopt);  // pinched
+    connect::VertexSide side;
+    side.joint = a.node(p);
+    for (const Wedge& w : fan) side.ring.push_back(a.node(w.from));
+    return PointSide{side, {}, tris};
   }
   if (fan.size() != tris.size() || fan.back().to != ends[1]) return side_on(tris.front(), std::nullopt);
   double before = 0;
@@ -247,7 +254,7 @@ PointSide point_side(const Around& a, std::uint32_t comp, std::uint32_t p, const
       const auto [r, edge] = a.parts.rod_edge_of_element[a.element[c]];
       const auto& rod = a.parts.rods->rod(r);
       const double l = rod.rest_length(edge);
-      return {connect::RodEdgeRef{r, edge}, {rod.section().GJ / l, std::min(rod.section().EI1, rod.section().EI2) / l}, c};
+      return {connect::RodEdgeRef{r, edge}, {rod.section().GJ / l, std::min(rod.section().EI1, rod.section().EI2) / l}, {c}};
     }
     case connect::Body::shell: {
       const auto& m = a.material(c);
@@ -501,7 +508,8 @@ ConnectionParts build_connections(const Scene& scene, const IndexedMesh& mesh, c
                                         ch.bending.value_or(factor * std::min(m.k.bend, n.k.bend))};
         if (!out.points) out.points = &sys.add<connect::PointConnections>(parts.rods, update);
         const Index added = out.points->add(name, m.ref, n.ref, k, sys.state());
-        const std::uint32_t cells[2] = {m.cell, n.cell};
+        std::vector<std::uint32_t> cells = m.cells;
+        cells.insert(cells.end(), n.cells.begin(), n.cells.end());
         out.sources->points.push_back(sources_of(a, out.points->connection(added).position_nodes(), cells));
         ++out.point_joints;
       } else {

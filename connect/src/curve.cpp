@@ -198,11 +198,19 @@ EdgeEval EdgeConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update, 
           for (int j = 0; j < n; ++j) (*hessian)(i, j) = result.second.hessian(i, j);
       }
     };
-    // In as few directions as the stencil needs: a rod or face on each side fits in 12.
-    if (hessian && n <= 12)
+    // In as few directions as the stencil needs (a Hessian costs their square): a rod edge
+    // with a face (10: the frisbee's and the toy tunnel's rims), a rod or face on each side (12),
+    // a hinge (18). The forces too, which every line-search trial evaluates.
+    if (hessian && n <= 10)
+      differentiate(detail::Jet<10, true>{});
+    else if (hessian && n <= 12)
       differentiate(detail::Jet<12, true>{});
     else if (hessian)
       differentiate(detail::Jet<edge_max_dofs, true>{});
+    else if (n <= 10)
+      differentiate(detail::Jet<10, false>{});
+    else if (n <= 12)
+      differentiate(detail::Jet<12, false>{});
     else
       differentiate(detail::Jet<edge_max_dofs, false>{});
   } else {

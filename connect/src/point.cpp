@@ -5,9 +5,12 @@
 #include <cmath>
 #include <numbers>
 #include <sstream>
+#include <stdexcept>
+#include <type_traits>
 
 #include "history.hpp"
 #include "jet.hpp"
+#include "vertex_frame.hpp"
 #include "sewn/physics/rods/stencils.hpp"
 
 namespace sewn::connect {
@@ -27,7 +30,7 @@ constexpr double two_pi = 2 * std::numbers::pi;
 constexpr int max_dofs = 24;  // tet + tet
 // The chained Hessian's scalars: a side's frame in 9 (rod, triangle) or 12 (tet) directions,
 // the core in 12.
-constexpr int side_dofs_max = 12;
+constexpr int side_dofs_max = 12;  // the whole-stencil and per-side jets; a vertex side has its own
 using C2 = detail::Jet<12, true>;
 using Coef = std::array<double, 6>;
 
@@ -41,6 +44,8 @@ std::string describe(const Side& s) {
     o << "rod edge (" << r->from << ", " << r->to << ")";
   } else if (const auto* t = std::get_if<TriangleSide>(&s)) {
     o << "triangle (" << t->nodes[0] << ", " << t->nodes[1] << ", " << t->nodes[2] << ")";
+  } else if (const auto* v = std::get_if<VertexSide>(&s)) {
+    o << "shell vertex " << v->joint << " (one-ring of " << v->ring.size() << ")";
   } else {
     const auto& k = std::get<TetSide>(s);
     o << "tetrahedron (" << k.nodes[0] << ", " << k.nodes[1] << ", " << k.nodes[2] << ", " << k.nodes[3] << ")";
@@ -51,12 +56,18 @@ std::string describe(const Side& s) {
 std::vector<Index> side_nodes(const Side& s) {
   if (const auto* r = std::get_if<RodEdgeSide>(&s)) return {r->from, r->to};
   if (const auto* t = std::get_if<TriangleSide>(&s)) return {t->nodes.begin(), t->nodes.end()};
+  if (const auto* v = std::get_if<VertexSide>(&s)) {
+    std::vector<Index> out{v->joint};
+    out.insert(out.end(), v->ring.begin(), v->ring.end());
+    return out;
+  }
   const auto& k = std::get<TetSide>(s);
   return {k.nodes.begin(), k.nodes.end()};
 }
 
 int side_dofs(const Side& s) {
   if (std::holds_alternative<RodEdgeSide>(s)) return 7;
+  if (const auto* v = std::get_if<VertexSide>(&s)) return 3 * (static_cast<int>(v->ring.size()) + 1);
   return std::holds_alternative<TriangleSide>(s) ? 9 : 12;
 }
 
@@ -73,6 +84,10 @@ Index shared_node(const std::string& name, const Side& m, const Side& n) {
     for (Index b : side_nodes(n))
       if (a == b) common.push_back(a);
   if (common.empty()) fail(name, describe(m) + " and " + describe(n) + " share no node");
+  for (const Side* s : {&m, &n})
+    if (const auto* v = std::get_if<VertexSide>(s); v && common.size() == 1 && common[0] != v->joint)
+      fail(name, describe(*s) + " meets " + describe(s == &m ? n : m) + " at ring node " + std::to_string(common[0]) +
+                     ", not at its joint");
   if (common.size() > 1)
     fail(name, describe(m) + " and " + describe(n) +
                    " share more than one node (an edge: that is a curve connection, not a point one)");
@@ -111,7 +126,17 @@ Frame<T> build_frame(const Side& side, const Q& q, int at, double sign, const Co
   using std::sin;
   using std::sqrt;
   Frame<T> f;
-  if (const auto* r = std::get_if<RodEdgeSide>(&side)) {
+  if (const auto* v = std::get_if<VertexSide>(&side)) {
+    // The one-ring is wider than the jets that come here: its derivatives are chained
+    // (vertex_frame_jet), only its values are built here.
+    if constexpr (std::is_same_v<T, double>) {
+      const auto mv = detail::vertex_frame(q, at, static_cast<int>(v->ring.size()), sign);
+      f.m1 = {mv[0].x(), mv[0].y(), mv[0].z()};
+      f.m3 = {mv[1].x(), mv[1].y(), mv[1].z()};
+    } else {
+      throw std::logic_error("point connection: a vertex side's frame has no whole-stencil jet");
+    }
+  } else if (const auto* r = std::get_if<RodEdgeSide>(&side)) {
     const V3<T> t = detail::normalized(vec_at<T>(q, at + 3) - vec_at<T>(q, at));
     const V3<T> tb = detail::constant<T>(r->tangent.x(), r->tangent.y(), r->tangent.z());
     const V3<T> db = detail::constant<T>(r->director.x(), r->director.y(), r->director.z());
@@ -140,11 +165,7 @@ Frame<T> build_frame(const Side& side, const Q& q, int at, double sign, const Co
 
 // A side's frame (m1, m3) as 6 values with their Jacobian and second derivatives over the
 // side's DOFs (the first 7 or 9 columns are used).
-struct SideJet {
-  Eigen::Matrix<double, 6, 1> value;
-  Eigen::Matrix<double, 6, side_dofs_max> jacobian;
-  std::array<Eigen::Matrix<double, side_dofs_max, side_dofs_max>, 6> hessian;
-};
+using SideJet = detail::FrameJet;
 
 template <int N>
 SideJet side_jet_n(const Side& side, const Eigen::VectorXd& q, int at, int dofs, double sign, const Coef& coef) {
@@ -153,21 +174,22 @@ SideJet side_jet_n(const Side& side, const Eigen::VectorXd& q, int at, int dofs,
   for (int i = 0; i < dofs; ++i) qa[static_cast<std::size_t>(i)] = S2::variable(q[at + i], i);
   const Frame<S2> f = build_frame<S2>(side, qa, 0, sign, coef);
   SideJet jet;
-  jet.jacobian.setZero();
+  jet.jacobian = Eigen::MatrixXd::Zero(6, dofs);
   const std::array<const S2*, 6> out{&f.m1.x, &f.m1.y, &f.m1.z, &f.m3.x, &f.m3.y, &f.m3.z};
   for (int k = 0; k < 6; ++k) {
     const S2& v = *out[static_cast<std::size_t>(k)];
     jet.value[k] = v.v;
-    jet.hessian[static_cast<std::size_t>(k)].setZero();
-    for (int i = 0; i < N; ++i) {
+    jet.hessian[static_cast<std::size_t>(k)] = Eigen::MatrixXd::Zero(dofs, dofs);
+    for (int i = 0; i < dofs; ++i) {
       jet.jacobian(k, i) = v.g[static_cast<std::size_t>(i)];
-      for (int j = 0; j < N; ++j) jet.hessian[static_cast<std::size_t>(k)](i, j) = v.hessian(i, j);
+      for (int j = 0; j < dofs; ++j) jet.hessian[static_cast<std::size_t>(k)](i, j) = v.hessian(i, j);
     }
   }
   return jet;
 }
 // In as few directions as the side needs.
 SideJet side_jet(const Side& side, const Eigen::VectorXd& q, int at, int dofs, double sign, const Coef& coef) {
+  if (const auto* v = std::get_if<VertexSide>(&side)) return detail::vertex_frame_jet(q, at, static_cast<int>(v->ring.size()), sign);
   return dofs <= 9 ? side_jet_n<9>(side, q, at, dofs, sign, coef) : side_jet_n<12>(side, q, at, dofs, sign, coef);
 }
 
@@ -230,6 +252,27 @@ PointConnection::PointConnection(std::string name, Side m, Side n, PointStiffnes
     const Vec3 w3 = inv * m3, w1 = inv * m1;
     coef = {w3[0], w3[1], w3[2], w1[0], w1[1], w1[2]};
   };
+  // A vertex side: every ring triangle has an area, their normals a sum, the first edge leaves it.
+  auto check_vertex = [&](const VertexSide& v, const Eigen::VectorXd& q) {
+    const int ring = static_cast<int>(v.ring.size());
+    if (ring < 3) fail(name_, describe(v) + ": a one-ring needs at least 3 nodes");
+    double angles = 0;
+    Vec3 w = Vec3::Zero();
+    for (int i = 0; i < ring; ++i) {
+      const Vec3 a = q.segment<3>(3 * (i + 1)) - q.segment<3>(0), b = q.segment<3>(3 * ((i + 1) % ring + 1)) - q.segment<3>(0);
+      const Vec3 c = a.cross(b);
+      if (!(c.norm() > 1e-12 * a.norm() * b.norm()) || !(c.norm() > 0))
+        fail(name_, describe(v) + ": its triangle (" + std::to_string(v.joint) + ", " + std::to_string(v.ring[static_cast<std::size_t>(i)]) +
+                        ", " + std::to_string(v.ring[static_cast<std::size_t>((i + 1) % ring)]) + ") has zero area at rest");
+      const double alpha = std::atan2(c.norm(), a.dot(b));
+      angles += alpha;
+      w += alpha * c.normalized();
+    }
+    if (!(w.norm() > 1e-9 * angles)) fail(name_, describe(v) + ": its one-ring's normals cancel at rest: no vertex normal");
+    const Vec3 e = q.segment<3>(3) - q.segment<3>(0);
+    if (!(e.cross(w.normalized()).norm() > 1e-9 * e.norm()))
+      fail(name_, describe(v) + ": its first ring edge lies along the vertex normal at rest");
+  };
   // Per side: geometry checks, the frame constants, the into/out-of-joint sign.
   auto prepare = [&](Side& s, const Eigen::VectorXd& q, Coef& coef, double into_joint) -> double {
     if (auto* r = std::get_if<RodEdgeSide>(&s)) {
@@ -247,6 +290,10 @@ PointConnection::PointConnection(std::string name, Side m, Side n, PointStiffnes
       // The rest axis points out of the solid, so the body lies along −axis (a triangle's lies
       // along its axis): a rod standing on the surface continues the solid's axis straight.
       return -into_joint;
+    }
+    if (const auto* v = std::get_if<VertexSide>(&s)) {
+      check_vertex(*v, q);
+      return into_joint;  // the normal's sign is arbitrary: the orientation rule below sets the pair's
     }
     auto& t = std::get<TriangleSide>(s);
     t = rotated(t, joint_);
@@ -349,6 +396,12 @@ PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update
     return Core<double>{value_of(ca.energy), ca.twist, ca.twist_raw, ca.bend, ca.one_plus_c};
   };
   const bool wide = num_dofs() > 18;  // a tet side
+  const bool vertex = std::holds_alternative<VertexSide>(m_) || std::holds_alternative<VertexSide>(n_);
+  Eigen::MatrixXd chained_h;  // a vertex side's gradient comes with its chained Hessian
+  if (vertex && (hessian || want_gradient)) {
+    if (!hessian) hessian = &chained_h;
+    method = HessianMethod::chained;
+  }
   Core<double> c;
   const Eigen::Index n = q.size();
   if (hessian && method == HessianMethod::chained) {
@@ -423,6 +476,9 @@ void PointConnection::remap_nodes(std::span<const Index> old_to_new) {
       map(r->to);
     } else if (auto* t = std::get_if<TriangleSide>(s)) {
       for (Index& i : t->nodes) map(i);
+    } else if (auto* v = std::get_if<VertexSide>(s)) {
+      map(v->joint);
+      for (Index& i : v->ring) map(i);
     } else {
       for (Index& i : std::get<TetSide>(*s).nodes) map(i);
     }

@@ -46,6 +46,7 @@ Index PointConnections::add(const std::string& name, const SideRef& m, const Sid
   auto resolve = [&](const SideRef& ref, int which) -> Side {
     if (const auto* t = std::get_if<TriangleSide>(&ref)) return *t;
     if (const auto* k = std::get_if<TetSide>(&ref)) return *k;
+    if (const auto* v = std::get_if<VertexSide>(&ref)) return *v;
     const RodEdgeBinding bound = bind_rod_edge(rods_, std::get<RodEdgeRef>(ref), s, "point connection '" + name + "'");
     angle[static_cast<std::size_t>(which)] = bound.angle;
     return bound.side;
@@ -57,7 +58,8 @@ Index PointConnections::add(const std::string& name, const SideRef& m, const Sid
   for (int which = 0; which < 2; ++which) {
     const Side& side = which == 0 ? sm : sn;
     const bool rod = std::holds_alternative<RodEdgeSide>(side);
-    const int nodes = rod ? 2 : std::holds_alternative<TriangleSide>(side) ? 3 : 4;
+    const auto* vertex = std::get_if<VertexSide>(&side);
+    const int nodes = rod ? 2 : vertex ? static_cast<int>(vertex->ring.size()) + 1 : std::holds_alternative<TriangleSide>(side) ? 3 : 4;
     for (int v = 0; v < nodes; ++v, ++p) dofs.add_node(layout[p]);
     if (rod) dofs.add_angle(angle[static_cast<std::size_t>(which)]);
   }

@@ -23,6 +23,7 @@
 //   triangle:  x_joint (3), x_next (3), x_prev (3) — 9; the triangle's nodes rotated so that
 //              the joint comes first (orientation, hence the normal's sign, is kept)
 //   tet:       x_joint, then the other three in their order (12); F does not depend on the order
+//   vertex:    x_joint, then the one-ring in its order (3 (ring + 1))
 // The shared node thus has one 3-block per side; an assembler adds both. position_nodes()
 // lists the node of every 3-block in order.
 
@@ -76,7 +77,18 @@ struct TetSide {
   Vec3 rest_axis{0, 0, 1};
 };
 
-using Side = std::variant<RodEdgeSide, TriangleSide, TetSide>;
+/// A shell's interior vertex as a side (PHYSICS_NOTES §3.5): the joint and its one-ring, the
+/// neighbours in order around it so that the triangles (joint, ring[i], ring[i+1]) (the last
+/// closing on ring[0]) are the shell's. m3 = ±hat(Σ αi ni), the angle-weighted vertex normal
+/// (αi the triangle's angle at the joint, ni its unit normal); m1 = hat(e − (e·m3) m3), e the
+/// edge to ring[0]. Unlike a corner's bisector, the normal stands off the surface, so a rod
+/// leaving the shell along it meets the transport's singularity only when folded back onto it.
+struct VertexSide {
+  Index joint = 0;
+  std::vector<Index> ring;
+};
+
+using Side = std::variant<RodEdgeSide, TriangleSide, TetSide, VertexSide>;
 
 /// How δ is followed through a motion (PHYSICS_NOTES §3.5). The incremental updates freeze
 /// their history within a step and are advanced by accept(); both need each step's increment
@@ -114,6 +126,7 @@ struct PointEval {
 /// its ≤ 9 DOFs) and of the frames-to-energy core (12 directions), joined by the chain rule
 /// ∇²E = Jᵀ C_FF J + Σ_k C_F[k] ∇²F_k — exact, like `nested_ad`, which differentiates the
 /// whole stencil at once in 18 directions (kept as the reference the tests compare against).
+/// A vertex side's one-ring is wider than the whole-stencil AD: its connection always chains.
 enum class HessianMethod { chained, nested_ad };
 
 inline constexpr double antiparallel_margin = 1e-3;
@@ -126,7 +139,8 @@ class PointConnection {
   /// stencil_layout() first if needed). Sets δ̄, d̄ and the accepted δ from the rest state.
   /// Throws physics::InputError naming `name`: the sides share no node (or share more than one
   /// for a rod–triangle pair), a rod edge of one node, a triangle with a repeated node or of
-  /// zero area at rest, a rest axis off the triangle's plane or outside its corner, a
+  /// zero area at rest, a rest axis off the triangle's plane or outside its corner, a vertex side
+  /// with fewer than 3 ring nodes, a zero-area ring triangle or normals that cancel at rest, a
   /// q_rest of the wrong size or non-finite, negative or non-finite stiffnesses. O(1).
   PointConnection(std::string name, Side m, Side n, PointStiffness k, const Eigen::VectorXd& q_rest);
 

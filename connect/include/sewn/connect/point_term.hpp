@@ -36,7 +36,7 @@ struct RodEdgeRef {
   Index rod = 0;
   int edge = 0;
 };
-using SideRef = std::variant<RodEdgeRef, TriangleSide, TetSide>;
+using SideRef = std::variant<RodEdgeRef, TriangleSide, TetSide, VertexSide>;
 
 /// A rod edge of the Rods term as a side at state s (its nodes, its current reference frame) and
 /// the System angle holding its θ. Throws physics::InputError naming `owner`: no rods, rods
