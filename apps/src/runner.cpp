@@ -104,6 +104,7 @@ physics::integrate::NewtonEulerOptions newton_options(const Scene& scene) {
   o.max_iterations = static_cast<int>(scene.newton_iterations);
   o.cg_tolerance = scene.tolerance;
   o.cg_max_iterations = static_cast<int>(scene.max_iterations);
+  o.cg_forcing_max = scene.newton_forcing;
   if (scene.solver == "ldlt" || scene.solver == "cholmod") o.solver = physics::integrate::LinearSolver::ldlt;
   if (scene.solver == "cholmod-pcg") o.solver = physics::integrate::LinearSolver::cholmod_pcg;
   return o;

@@ -230,6 +230,8 @@ Field build_schema() {
                     .doc("Floor of the residual as a velocity error on every free axis (implicit): a body at rest stops there instead of chasing round-off. 0: none."),
                 field("max_iterations", Kind::integer).fallback(physics::solve::default_max_iterations).at_least(1).at_most(1000000).doc("Iteration limit of the iterative solvers (implicit); reaching it is an error."),
                 field("newton_tolerance", Kind::number).unit("m/s").fallback(1e-6).above(0).doc("Newton stops when the largest update divided by h is below it; a rod twist angle's update counts as the distance it turns the section, the section's radius of gyration times the angle (newton)."),
+                field("newton_forcing", Kind::number).fallback(0.0).at_least(0).below(1)
+                    .doc("With `newton` and `cholmod-pcg`: inexact Newton. Each Newton system is solved to a relative residual between `tolerance` and this (Eisenstat-Walker forcing terms: this loose at a step's first iteration, tightening as the gradient falls), and a step that passes `newton_tolerance` from a looser solve is solved on to `tolerance` first, so the stopping test means the same. 0: every system to `tolerance`."),
                 field("newton_iterations", Kind::integer).fallback(50).at_least(1).at_most(10000).doc("Newton iteration limit per step (newton); reaching it is an error."),
                 field("allow_unstable", Kind::boolean).fallback(false)
                     .doc("Run a semi-implicit step larger than the estimated stable bound (otherwise refused with the bound)."),
@@ -632,6 +634,9 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     s.max_iterations = static_cast<std::uint32_t>(in.integer("max_iterations"));
     s.newton_tolerance = in.number("newton_tolerance");
     s.newton_iterations = static_cast<std::uint32_t>(in.integer("newton_iterations"));
+    s.newton_forcing = in.number("newton_forcing");
+    if (s.newton_forcing > 0.0 && (s.integrator != "newton" || s.solver != "cholmod-pcg"))
+      throw SceneError(file, "integrator.newton_forcing", "inexact Newton's forcing terms need integrator.type \"newton\" with solver \"cholmod-pcg\" (got \"" + s.integrator + "\" with \"" + s.solver + "\")");
     s.allow_unstable = in.boolean("allow_unstable");
     s.energy_rise_tolerance = in.number("energy_rise_tolerance");
     s.stop_on_inversion = in.boolean("stop_on_inversion");

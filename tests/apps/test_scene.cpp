@@ -195,6 +195,20 @@ TEST_CASE("integrator.solver and the solver defaults: one iteration limit for th
   expect_error(j, "integrator.absolute_tolerance", ">= 0");
 }
 
+TEST_CASE("integrator.newton_forcing: inexact Newton on cholmod-pcg only, below 1") {
+  json j = minimal();
+  CHECK(parse_scene(j, "beam.json").newton_forcing == 0.0);
+  j["integrator"] = json::parse(R"({"type": "newton", "solver": "jacobi", "newton_forcing": 0.5})");
+  expect_error(j, "integrator.newton_forcing", "cholmod-pcg");
+  j["integrator"] = json::parse(R"({"type": "implicit", "newton_forcing": 0.5})");
+  expect_error(j, "integrator.newton_forcing", "newton");
+  j["integrator"] = json::parse(R"({"type": "newton", "solver": "cholmod-pcg", "newton_forcing": 1.5})");
+  expect_error(j, "integrator.newton_forcing", "< 1");
+  if (!sewn::physics::solve::available(sewn::physics::solve::Backend::cholmod_pcg)) return;
+  j["integrator"] = json::parse(R"({"type": "newton", "solver": "cholmod-pcg", "newton_forcing": 0.5})");
+  CHECK(parse_scene(j, "beam.json").newton_forcing == 0.5);
+}
+
 TEST_CASE("threads: the scene key sets the count, 0 (the default) leaves it to SEWN_THREADS") {
   CHECK(parse_scene(minimal(), "beam.json").threads == 0);
   json j = minimal();

@@ -13,6 +13,9 @@
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 
+#include "sewn/physics/solids/tets.hpp"
+#include "sewn/physics/system.hpp"
+
 namespace sewn::physics::test {
 
 struct TetMesh {
@@ -149,6 +152,24 @@ void check_element(const std::function<double(const Eigen::Matrix<double, 3, N>&
   const double scale = g.cwiseAbs().maxCoeff() * (1.0 + x.cwiseAbs().maxCoeff());
   CHECK(f.norm() <= 1e-12 * scale);
   CHECK(t.norm() <= 1e-12 * scale);
+}
+
+/// Adds m's nodes (lumped masses of density rho) and its tetrahedra to sys as one Tets term.
+inline solids::Tets& add_tets(System& sys, const TetMesh& m, solids::TetLaw law, double E, double nu, double rho) {
+  const Index first = sys.nodes().size();
+  std::vector<double> mass(m.x.size(), 0.0);
+  for (const auto& t : m.tets) {
+    const double v = std::abs((m.x[t[1]] - m.x[t[0]]).cross(m.x[t[2]] - m.x[t[0]]).dot(m.x[t[3]] - m.x[t[0]])) / 6.0;
+    for (auto i : t) mass[i] += rho * v / 4.0;
+  }
+  for (std::size_t i = 0; i < m.x.size(); ++i) sys.nodes().add(m.x[i], Eigen::Vector3d::Zero(), mass[i]);
+  auto& tets = sys.add<solids::Tets>(law);
+  for (const auto& t : m.tets) {
+    solids::TetPositions X;
+    for (int a = 0; a < 4; ++a) X.col(a) = m.x[t[a]];
+    tets.add({first + t[0], first + t[1], first + t[2], first + t[3]}, X, E, nu);
+  }
+  return tets;
 }
 
 }  // namespace sewn::physics::test

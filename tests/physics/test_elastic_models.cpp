@@ -42,23 +42,6 @@ const char* solver_name(integrate::LinearSolver s) {
   return s == integrate::LinearSolver::cg ? "cg" : s == integrate::LinearSolver::ldlt ? "ldlt" : "cholmod-pcg";
 }
 
-solids::Tets& add_tets(System& sys, const TetMesh& m, solids::TetLaw law, double E, double nu, double rho) {
-  const Index first = sys.nodes().size();
-  std::vector<double> mass(m.x.size(), 0.0);
-  for (const auto& t : m.tets) {
-    const double v = std::abs((m.x[t[1]] - m.x[t[0]]).cross(m.x[t[2]] - m.x[t[0]]).dot(m.x[t[3]] - m.x[t[0]])) / 6.0;
-    for (auto i : t) mass[i] += rho * v / 4.0;
-  }
-  for (std::size_t i = 0; i < m.x.size(); ++i) sys.nodes().add(m.x[i], Vector3d::Zero(), mass[i]);
-  auto& tets = sys.add<solids::Tets>(law);
-  for (const auto& t : m.tets) {
-    solids::TetPositions X;
-    for (int a = 0; a < 4; ++a) X.col(a) = m.x[t[a]];
-    tets.add({first + t[0], first + t[1], first + t[2], first + t[3]}, X, E, nu);
-  }
-  return tets;
-}
-
 double total_energy(System& sys) { return sys.kinetic_energy() + sys.potential_energy(); }
 
 // E = μ(3λ+2μ)/(λ+μ), ν = λ/(2(λ+μ)) for the notes' μ = 0.7, λ = 1.3.

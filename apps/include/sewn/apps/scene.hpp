@@ -149,6 +149,7 @@ struct Scene {
   std::uint32_t max_iterations = physics::solve::default_max_iterations;
   double newton_tolerance = 1e-6;  // m/s, integrator "newton"
   std::uint32_t newton_iterations = 50;
+  double newton_forcing = 0.0;  // largest relative CG tolerance, cholmod-pcg (0: off)
   bool allow_unstable = false;
   double energy_rise_tolerance = 1e-4;  // relative, see physics::EnergyLedger
   bool stop_on_inversion = false;       // check every step, stop at the first inverted element

@@ -56,6 +56,7 @@ class CurveConnections final : public physics::ForceTerm {
   [[nodiscard]] EdgeEval evaluate(Index c, const physics::StateView& s) const;
 
   [[nodiscard]] std::string_view name() const override { return "curve connections"; }
+  [[nodiscard]] bool velocity_dependent() const override { return false; }
   void add_forces(const physics::StateView& s, std::span<double> f) const override;
   [[nodiscard]] double potential_energy(const physics::StateView& s) const override;
   void collect_pairs(std::vector<physics::NodePair>& out) const override;

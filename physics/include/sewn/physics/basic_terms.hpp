@@ -15,6 +15,7 @@ class Gravity final : public ForceTerm {
   /// Throws InputError if g is not finite.
   explicit Gravity(const Eigen::Vector3d& g);
   [[nodiscard]] std::string_view name() const override { return "gravity"; }
+  [[nodiscard]] bool velocity_dependent() const override { return false; }
   [[nodiscard]] const Eigen::Vector3d& g() const { return g_; }
   void set_g(const Eigen::Vector3d& g);
   void add_forces(const StateView& s, std::span<double> f) const override;

@@ -171,6 +171,12 @@ class ForceTerm {
     std::fill(f.begin(), f.end(), 0.0);
     add_forces(s, f);
   }
+  /// False if this term's forces depend on the positions and angles only, never on s.v or
+  /// s.angle_rates. NewtonEuler's damping potential needs F(q, v) - F(q, 0): it evaluates only
+  /// the velocity-dependent terms twice (with Rayleigh damping, the shells and rods were
+  /// evaluated twice for a mass-proportional force). Default true: a term that does not say is
+  /// evaluated at both velocities, which is always right, only slower.
+  [[nodiscard]] virtual bool velocity_dependent() const { return true; }
   /// Potential energy at state s. Cost: one pass over the elements.
   [[nodiscard]] virtual double potential_energy(const StateView& s) const = 0;
   [[nodiscard]] virtual EnergyKind energy_kind() const { return EnergyKind::internal; }

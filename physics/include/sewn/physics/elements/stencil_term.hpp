@@ -49,6 +49,8 @@ class StencilTerm : public ForceTerm {
   [[nodiscard]] bool is_alive(Index e) const { return alive_[e] != 0; }
 
   void add_forces(const StateView& s, std::span<double> f) const override;
+  /// Element forces are gradients of an energy of the gathered positions.
+  [[nodiscard]] bool velocity_dependent() const override { return false; }
   [[nodiscard]] double potential_energy(const StateView& s) const override;
   void collect_pairs(std::vector<NodePair>& out) const override;
   void bind_pattern(const BlockMatrix& pattern) override;

@@ -72,6 +72,12 @@ struct NewtonEulerOptions {
   double armijo = 1e-4;              ///< c of the sufficient-decrease test
   LinearSolver solver = LinearSolver::cg;
   double cg_tolerance = 1e-4;        ///< η: relative residual of each Newton system
+  /// With cholmod_pcg, > cg_tolerance: inexact Newton, each system solved to a forcing term
+  /// η_k in [cg_tolerance, cg_forcing_max] (Eisenstat-Walker: this loose at the first
+  /// iteration, tightening with the gradient's decrease), and a step that passes the stopping
+  /// test with η_k > cg_tolerance is solved on to cg_tolerance before it is taken. 0: every
+  /// system to cg_tolerance.
+  double cg_forcing_max = 0.0;
   int cg_max_iterations = 5000;
   /// With the direct solve (ldlt): each iteration first factors the exact Hessian (no element
   /// projection) and keeps its step when the factorization finds the matrix positive definite
@@ -97,6 +103,7 @@ struct NewtonReport {
   int steepest_fallbacks = 0; ///< iterations whose solve gave no descent and used -D⁻¹g instead
   int projected_retries = 0;  ///< iterations whose exact Hessian was indefinite (exact_hessian_first)
   int angle_step_limits = 0;  ///< iterations whose step was shortened by max_angle_step
+  int forcing_refinements = 0; ///< loose solves (cg_forcing_max) solved on to cg_tolerance before the stopping test
   double step_velocity = 0.0; ///< |p|∞/h of the last iteration, m/s (angles as length × Δθ)
   double phi_decrease = 0.0;  ///< Φ(q̂) - Φ(q_{n+1}) ≥ 0
 };
@@ -146,14 +153,23 @@ class NewtonEuler {
   // Scales p_ (and its slope gᵀp and |p|∞) so no angle turns by more than max_angle_step.
   void limit_angle_step(double& slope, double& pmax, NewtonReport& rep);
   // solve_linear() for LinearSolver::cholmod_pcg; returns the CG iterations.
-  int solve_kept_pcg(const BlockMatrix& A);
+  // Its relative tolerance given; starts from p_ as it is.
+  int solve_kept_pcg(const BlockMatrix& A, double tolerance);
+  // p_ = -D⁻¹g (D: A's diagonal), always a descent direction; its slope gᵀp and |p|∞.
+  void steepest_descent(const BlockMatrix& A, double& slope, double& pmax);
+  // max over the DOFs of length × |p|: how far the step moves any material point.
+  [[nodiscard]] double largest_move() const;
+  [[nodiscard]] double gradient_norm() const;
+  // The relative CG tolerance of this iteration's solve (cg_forcing_max).
+  [[nodiscard]] double forcing_term(double g_now, double g_prev, bool first) const;
   [[nodiscard]] std::size_t dof_count() const { return inertia_.size(); }
 
   NewtonEulerOptions opt_;
   double h_ = 0.0;
   std::size_t n3_ = 0;  // position entries; angles follow
   bool damped_ = false;
-  AlignedVector<double> xn_, vn_, qhat_, q_, trial_, inertia_, free_, length_, g_, f_, f0_, vel_, p_, rhs_, precond_, zeros_;
+  double eta_ = 0.0;  // this iteration's relative CG tolerance (forcing_term)
+  AlignedVector<double> xn_, vn_, qhat_, q_, trial_, inertia_, free_, length_, g_, f_, fv_, f0_, vel_, p_, rhs_, precond_, zeros_;
   CgWorkspace ws_;
   std::unique_ptr<LdltCache> ldlt_;
 };

@@ -85,6 +85,7 @@ class Rods final : public ForceTerm {
   void restore(std::span<const RodHistory> h);
 
   [[nodiscard]] std::string_view name() const override { return "rods"; }
+  [[nodiscard]] bool velocity_dependent() const override { return false; }
   /// Solves θ at s (if s changed since the last solve), then adds −∂E/∂x. Throws
   /// rods::SolveError if a twist solve fails. O(vertices · twist Newton iterations).
   void add_forces(const StateView& s, std::span<double> f) const override;

@@ -33,6 +33,7 @@ class MorleyBending final : public ForceTerm {
   [[nodiscard]] const Element& element(Index e) const { return elements_[e]; }
 
   [[nodiscard]] std::string_view name() const override { return "Morley bending"; }
+  [[nodiscard]] bool velocity_dependent() const override { return false; }
   /// Throws InputError if the state carries fewer angles than the elements use.
   void add_forces(const StateView& s, std::span<double> f) const override;
   [[nodiscard]] double potential_energy(const StateView& s) const override;
