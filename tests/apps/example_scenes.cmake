@@ -25,6 +25,7 @@ set(expect_solid_cantilever      "189;480")  # the same beam as finite-element t
 set(expect_shell_plate           "85;128")   # membranes and Morley bending on 16x4x2 triangles
 set(expect_obstacles_spike       "81;32")    # rigid obstacles: no cut
 set(expect_mixed_fin             "177;449")  # 411 tetrahedra, 34 shell triangles, 4 rod segments; the top face a label
+set(expect_rod_spring            "101;100")  # a rod alone: 100 segments, the first edge clamped
 # The 2019 paper's Table 1 scenes (meshes from `sewn make-mesh`), two steps each (the umbrella
 # one: a step of its 3168 nodes costs about a second): every node simulated, every cell an element.
 set(expect_s04_frisbee           "289;576;0.07")

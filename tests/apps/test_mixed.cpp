@@ -3,11 +3,14 @@
 // simulated complex of a tetgen-style mesh with a face list.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <set>
+#include <sstream>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -17,6 +20,7 @@
 #include "sewn/apps/runner.hpp"
 #include "sewn/apps/scene.hpp"
 #include "sewn/io/cleanup.hpp"
+#include "sewn/io/read.hpp"
 #include "sewn/physics/rods/rods_term.hpp"
 #include "sewn/physics/shells/shell_terms.hpp"
 #include "sewn/physics/solids/tets.hpp"
@@ -284,6 +288,91 @@ TEST_CASE("sewn check reports the simulated complex of a mesh with a face list, 
   CHECK(j["connections"]["curve"]["shell-solid"] == 4);
   CHECK(j["connections"]["point"]["rod-shell"] == 1);
   CHECK(j["connections"]["surface"].empty());
+}
+
+TEST_CASE("a tetgen -f style list of every face and edge, interior ones included, is all labels: one solid") {
+  // tetgen -f -e writes every face and edge of the tetrahedralisation, not only the boundary's:
+  // each must be a label, so the simulated complex is the tetrahedra alone, one component,
+  // for the mass-spring, solid and mixed models alike (as `sewn check` reports and `sewn run`
+  // builds). Checked by hand on a 49 736-tet Gmsh box with its 95 832 interior faces added.
+  IndexedMesh m = io::read_mesh(std::string(SEWN_SOURCE_DIR) + "/tests/apps/data/box_faces.mesh");
+  const std::uint32_t cells = m.num_cells();
+  std::set<std::array<std::uint32_t, 3>> faces;
+  std::set<std::array<std::uint32_t, 2>> edges;
+  std::uint32_t tets = 0;
+  for (std::uint32_t c = 0; c < cells; ++c) {
+    if (m.types[c] != CellType::tetrahedron) continue;
+    ++tets;
+    const auto v = m.cell(c);
+    for (int skip = 0; skip < 4; ++skip) {
+      std::array<std::uint32_t, 3> f{};
+      for (int k = 0, j = 0; k < 4; ++k)
+        if (k != skip) f[static_cast<std::size_t>(j++)] = v[static_cast<std::size_t>(k)];
+      std::sort(f.begin(), f.end());
+      faces.insert(f);
+    }
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b)
+        edges.insert({std::min(v[static_cast<std::size_t>(a)], v[static_cast<std::size_t>(b)]),
+                      std::max(v[static_cast<std::size_t>(a)], v[static_cast<std::size_t>(b)])});
+  }
+  for (const auto& f : faces) (void)m.add_cell(CellType::triangle, {f[0], f[1], f[2]}, 99);
+  for (const auto& e : edges) (void)m.add_cell(CellType::segment, {e[0], e[1]}, 98);
+  REQUIRE(faces.size() == (4 * tets + 116) / 2);  // interior faces twice, the 116 boundary ones once
+  const auto embedded = io::embedded_cells(m);
+  Scene solid = mixed_scene();
+  solid.model = "solid";
+  for (const Scene& s : {mixed_scene(), solid, Scene{}}) {
+    CAPTURE(s.model);
+    const auto models = cell_models(m, embedded, s, "meshes[0]");
+    const SimulatedComplex sc = simulated_complex(m, models);
+    CHECK(sc.cells == std::array<std::uint32_t, 4>{0, 0, 0, tets});
+    CHECK(sc.components == 1);
+    std::uint32_t labelled = 0;
+    for (const auto& l : sc.labels) labelled += l.cells;
+    CHECK(labelled == m.num_cells() - tets);
+  }
+}
+
+TEST_CASE("sewn run simulates what sewn check reports on a mesh with a face list: its tetrahedra only") {
+  // box_faces.mesh: 144 tetrahedra on 62 points with 116 boundary triangles and 32 edges as
+  // cells of their own; `sewn check` reports 144 volumes (above). The run's frames.csv counts
+  // the particles and elements it simulated, for the solid and the default mass-spring model.
+  const auto dir = std::filesystem::temp_directory_path() / ("sewn_mixed_run_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string mesh = std::string(SEWN_SOURCE_DIR) + "/tests/apps/data/box_faces.mesh";
+  for (const std::string model : {R"({"type": "solid"})", R"({"type": "mass-spring"})"}) {
+    CAPTURE(model);
+    const auto scene = dir / "scene.json";
+    std::ofstream(scene) << R"({"materials": {"rubber": {"young": 1e6, "poisson": 0.3, "density": 1000}},
+      "meshes": [{"type": "file", "path": ")" << mesh << R"(", "material": "rubber"}],
+      "gravity": [0, 0, -9.81], "damping": {"model": "rayleigh", "alpha": 1.0}, "model": )" << model << R"(,
+      "integrator": {"type": "newton", "step": 1e-3}, "duration": 0.002,
+      "output": {"frames": 2, "vtu": false, "picture": {"enabled": false}}})";
+    std::string out;
+    REQUIRE(sewn_stdout("run " + scene.string() + " --out " + (dir / "out").string() + " --quiet", out) == 0);
+    std::ifstream csv(dir / "out" / "frames.csv");
+    std::string header, row, last;
+    std::getline(csv, header);
+    while (std::getline(csv, row))
+      if (!row.empty()) last = row;
+    auto field = [](const std::string& line, std::size_t k) {
+      std::stringstream ss(line);
+      std::string f;
+      for (std::size_t i = 0; i <= k; ++i) std::getline(ss, f, ',');
+      return f;
+    };
+    auto column = [&](const std::string& name) {
+      for (std::size_t k = 0;; ++k) {
+        const std::string h = field(header, k);
+        REQUIRE(!h.empty());
+        if (h == name) return std::stod(field(last, k));
+      }
+    };
+    CHECK(column("particles") == 62);
+    CHECK(column("elements") == 144);
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("connections of a mixed mesh: the flap's edge line is curves, the rod's node a point, a face a surface") {

@@ -48,7 +48,8 @@ shells::MorleyPositions flat_stencil(std::mt19937& rng, double noise) {
   return X;
 }
 
-void check_stencil(const shells::MorleyPositions& X, const std::array<shells::MorleyEdge, 3>& kind, std::mt19937& rng) {
+void check_stencil(const shells::MorleyPositions& X, const std::array<shells::MorleyEdge, 3>& kind, std::mt19937& rng,
+                   double amplitude = 0.3) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const shells::MorleyRest rest = shells::morley_rest(X, kind, shells::plate_material(1e3, 0.3, 0.1));
   const std::function<double(const Dofs&)> E = [&](const Dofs& q) {
@@ -59,7 +60,7 @@ void check_stencil(const shells::MorleyPositions& X, const std::array<shells::Mo
   };
   Dofs q = Dofs::Zero();  // the edge angles start at 0 (rest), then turned below
   q.head<18>() = Eigen::Map<const Eigen::Matrix<double, 18, 1>>(X.data());
-  for (int k = 0; k < 21; ++k) q[k] += 0.3 * u(rng);  // bent, and every mid-normal turned
+  for (int k = 0; k < 21; ++k) q[k] += amplitude * u(rng);  // bent, and every mid-normal turned
   const Eigen::VectorXd g = G(q);
   const Eigen::MatrixXd H = shells::morley_hessian(positions_of(q), angles_of(q), rest);
   const double g_err = sewn::physics::test::rel_err(g, sewn::physics::test::fd_gradient<Dofs>(E, q, 1e-6));
@@ -68,6 +69,12 @@ void check_stencil(const shells::MorleyPositions& X, const std::array<shells::Mo
   CAPTURE(h_err);
   CHECK(g_err < 1e-6);
   CHECK(h_err < 1e-5);
+  // per stencil, zero net force and torque: the angles are measured from the triangles, so a
+  // rotation of the positions alone is rigid (the position part of the gradient only)
+  const auto [f, t] = sewn::physics::test::net_force_torque<6>(positions_of(q), g.head<18>());
+  const double scale = g.cwiseAbs().maxCoeff() * (1.0 + positions_of(q).cwiseAbs().maxCoeff());
+  CHECK(f.norm() <= 1e-12 * scale);
+  CHECK(t.norm() <= 1e-12 * scale);
   // rigid motions with the angles at rest: no energy, no force, no torque on the angles
   const Eigen::Matrix3d R = sewn::physics::test::random_rotation(rng);
   shells::MorleyPositions moved = R * X;
@@ -88,6 +95,9 @@ TEST_CASE("Morley bending: gradients and Hessians in positions and edge angles m
     check_stencil(X, {K::other, K::own, K::clamp}, rng);
     check_stencil(X, {K::other, K::other, K::other}, rng);
     check_stencil(X, {K::clamp, K::clamp, K::own}, rng);
+    // nearly flat: every hinge within 1e-4 rad of flat, mid-normals barely turned
+    check_stencil(X, {K::own, K::own, K::own}, rng, 1e-4);
+    check_stencil(X, {K::other, K::own, K::clamp}, rng, 1e-4);
   }
   // a curved rest shape: zero energy at rest all the same
   shells::MorleyPositions X = flat_stencil(rng, 0.0);

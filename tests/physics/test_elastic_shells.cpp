@@ -43,15 +43,15 @@ shells::PatchPositions<N> take(const shells::PatchPositions<6>& X, const std::ar
 
 template <int N>
 void check_patch(const shells::PatchPositions<N>& X, const std::array<std::uint8_t, N - 3>& edges,
-                 const std::array<std::uint8_t, N - 3>& clamped, std::mt19937& rng) {
+                 const std::array<std::uint8_t, N - 3>& clamped, std::mt19937& rng, double amplitude = 0.3) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const shells::PatchRest rest = shells::patch_rest<N>(X, edges, clamped, shells::plate_material(1e3, 0.3, 0.1));
   using P = shells::PatchPositions<N>;
   const auto E = [&](const P& x) { return shells::patch_energy<N>(x, rest); };
   const auto G = [&](const P& x) { return shells::patch_gradient<N>(x, rest); };
   const auto H = [&](const P& x) { return shells::patch_hessian<N>(x, rest); };
-  // bent by up to 0.3 per coordinate, then rotated and moved rigidly
-  const P x = X + 0.3 * P::NullaryExpr([&] { return u(rng); });
+  // bent by up to `amplitude` per coordinate, then rotated and moved rigidly
+  const P x = X + amplitude * P::NullaryExpr([&] { return u(rng); });
   sewn::physics::test::check_element<N>(E, G, H, x, 1e-6, 1e-5);
   const Eigen::Matrix3d R = sewn::physics::test::random_rotation(rng);
   P moved = R * X;
@@ -71,6 +71,9 @@ TEST_CASE("patch bending: gradients and Hessians match finite differences, rigid
     check_patch<5>(take<5>(X, {0, 1, 2, 3, 5}), {0, 2}, {1, 0}, rng);
     check_patch<4>(take<4>(X, {0, 1, 2, 5}), {2}, {0}, rng);
     check_patch<4>(take<4>(X, {0, 1, 2, 3}), {0}, {1}, rng);
+    // nearly flat: every dihedral angle within ~1e-4 rad of its rest value
+    check_patch<6>(X, {0, 1, 2}, {0, 0, 0}, rng, 1e-4);
+    check_patch<5>(take<5>(X, {0, 1, 2, 3, 5}), {0, 2}, {1, 0}, rng, 1e-4);
   }
   // a curved rest patch (every rest angle nonzero): still zero energy at rest
   shells::PatchPositions<6> X = flat_patch(rng, 0.0);
