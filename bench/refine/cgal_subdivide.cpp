@@ -161,9 +161,13 @@ void bench_subdivide(benchmark::State& st, const SubdivisionCase& c) {
 }
 
 void register_peer() {
+  // the same peer twice: against refine_all (all/<beam>, ours with the physics) and against our
+  // map's insertions alone (map/<beam>, map_subdivide.cpp: the like-for-like row)
   for (const SubdivisionCase& c : subdivision_cases())
-    peer("refine", "subdivision/" + c.name, "CGAL " CGAL_VERSION_STR " Linear_cell_complex_for_combinatorial_map<3>",
-         [c](benchmark::State& st) { bench_subdivide(st, c); });
+    for (const std::string against : {"all/", "map/"})
+      peer("refine", "subdivision/" + against + c.name.substr(c.name.find('/') + 1),
+           "CGAL " CGAL_VERSION_STR " Linear_cell_complex_for_combinatorial_map<3>",
+           [c](benchmark::State& st) { bench_subdivide(st, c); });
 }
 
 const Registration reg(&register_peer);

@@ -11,6 +11,8 @@
 //       T-junction constraints rebuilt (coarsened back, untimed, between repetitions).
 //   refine/subdivision/all/<beam>     every hexahedron of the beam refined 1:8 (refine_all, with the
 //       physics), against the same subdivision with CGAL LCC's insertions (cgal_subdivide.cpp).
+//   refine/subdivision/map/<beam>     the map part alone: CGAL's three passes with our map's own
+//       insertions, points only (map_subdivide.cpp), against the same CGAL peer.
 //   refine/t_junctions/forces         the T-junction force distribution of one step on the
 //       adaptive 2-4 state (SlaveNodes::pass_forces: forces of slaves passed to their masters).
 //   The implicit cases also carry "top-edge error (mm)": after 10 000 implicit steps from rest

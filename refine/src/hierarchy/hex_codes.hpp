@@ -36,16 +36,24 @@ inline double on_segment(const Eigen::Vector3d& r, const Eigen::Vector3d& a, con
 /// volume is marked for the model's resync.
 inline void code_hex_volume(physics::MssModel<3>& m, const DartList& vol, const std::array<physics::Index, 8>& corner) {
   using A = ModelAccess<3>;
+  // the 12 edges' ends at rest, read once for all the volume's darts (as on_segment reads them)
+  std::array<Eigen::Vector3d, 12> ra, rb;
+  for (std::size_t k = 0; k < 12; ++k) {
+    ra[k] = m.rest_position(corner[hex_edge_ends[k][0]]);
+    rb[k] = m.rest_position(corner[hex_edge_ends[k][1]]);
+  }
   for (Dart x : vol) {
     const physics::Index s = m.node_of(x), t = end_node(m, x);
     std::uint8_t vertex = physics::not_a_corner, code = 0;
     for (std::size_t w = 0; w < 8; ++w)
       if (corner[w] == s) vertex = static_cast<std::uint8_t>(w);
+    const Eigen::Vector3d rs = m.rest_position(s), rt = m.rest_position(t);
     for (std::size_t k = 0; k < 12; ++k) {
       const auto [a, b] = hex_edge_ends[k];
-      const Eigen::Vector3d ra = m.rest_position(corner[a]), rb = m.rest_position(corner[b]);
-      const double ts = on_segment(m.rest_position(s), ra, rb), tt = on_segment(m.rest_position(t), ra, rb);
-      if (ts < 0 || tt < 0) continue;
+      const double ts = on_segment(rs, ra[k], rb[k]);
+      if (ts < 0) continue;
+      const double tt = on_segment(rt, ra[k], rb[k]);
+      if (tt < 0) continue;
       code = static_cast<std::uint8_t>(k | ((tt > ts) == (a < b) ? 0x80 : 0));
       break;
     }

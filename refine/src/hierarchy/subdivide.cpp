@@ -39,15 +39,25 @@ void check_refinable(const MssModel<D>& m, Index e, const RefineOptions& o) {
                      ": its children would pass the maximum level " + std::to_string(o.max_level));
 }
 
+// Inside refine_elements' one edit(): the map and the new particles and springs only; their
+// masses, stiffnesses and rest lengths wait for the pass's single resync.
 template <int D>
 void refine_one(MssModel<D>& m, Index e, RefineReport& report) {
+  if constexpr (D == 3)
+    if (m.elements()[e].kind == ElementKind::hexahedron) return detail::refine_hex(m, e, report);
+  detail::refine_quad(m, e, report);
+}
+
+// f inside one MssModel::edit() with the model's refining flag set: the model's resync (masses,
+// springs, diagonals of every touched cell) runs once for the whole pass, not once per element,
+// so a particle shared by the k elements refined around it is weighed once instead of k times.
+// Nothing a refinement reads in between (rest positions, states, corner codes, edge levels)
+// waits for the resync. An exception still resyncs what was done before it (edit()).
+template <int D, class F>
+void in_one_edit(MssModel<D>& m, F&& f) {
   detail::ModelAccess<D>::set_refining(m, true);
   try {
-    m.edit([&](auto&) {
-      if constexpr (D == 3)
-        if (m.elements()[e].kind == ElementKind::hexahedron) return detail::refine_hex(m, e, report);
-      detail::refine_quad(m, e, report);
-    });
+    m.edit([&](auto&) { f(); });
   } catch (...) {
     detail::ModelAccess<D>::set_refining(m, false);
     throw;
@@ -113,18 +123,21 @@ RefineReport refine_element(MssModel<D>& m, Index e, const RefineOptions& option
 template <int D>
 RefineReport refine_elements(MssModel<D>& m, std::span<const Index> elements, const RefineOptions& options) {
   RefineReport report;
-  for (Index e : elements) {
-    // with balance, an element of the list may have been refined already, for an earlier one
-    if (options.balance && e < m.elements().size() && m.elements()[e].first_child != physics::invalid_index &&
-        std::any_of(report.children.begin(), report.children.end(), [&](Index c) { return m.elements()[c].parent == e; }))
-      continue;
-    check_refinable(m, e, options);
-    if (options.balance)
-      refine_balanced(m, e, options, report);
-    else
-      refine_one(m, e, report);
-  }
-  if (!elements.empty()) update_t_junctions(m, std::span<const Index>(report.children));
+  if (elements.empty()) return report;
+  in_one_edit(m, [&] {
+    for (Index e : elements) {
+      // with balance, an element of the list may have been refined already, for an earlier one
+      if (options.balance && e < m.elements().size() && m.elements()[e].first_child != physics::invalid_index &&
+          std::any_of(report.children.begin(), report.children.end(), [&](Index c) { return m.elements()[c].parent == e; }))
+        continue;
+      check_refinable(m, e, options);
+      if (options.balance)
+        refine_balanced(m, e, options, report);
+      else
+        refine_one(m, e, report);
+    }
+  });
+  update_t_junctions(m, std::span<const Index>(report.children));
   return report;
 }
 

@@ -137,10 +137,16 @@ void update_t_junctions(MssModel<D>& m, std::span<const Index> changed) {
   const physics::NodeTable& nodes = m.nodes();
   std::vector<char> again(nodes.size(), 0);
   std::vector<Index> els;
-  for (Index e : changed) {
-    if (e >= m.elements().size() || !m.elements()[e].alive) continue;
+  for (Index e : changed)
+    if (e < m.elements().size() && m.elements()[e].alive) els.push_back(e);
+  std::sort(els.begin(), els.end());
+  els.erase(std::unique(els.begin(), els.end()), els.end());
+  // every live element changed (a uniform pass): the elements around them are these, so the
+  // vertex walks that would find them are skipped
+  const bool all_changed = els.size() == m.num_live_elements();
+  for (Index e : std::vector<Index>(els)) {
     for (Dart x : detail::element_darts(m, e)) {
-      if (std::exchange(again[m.node_of(x)], 1)) continue;
+      if (std::exchange(again[m.node_of(x)], 1) || all_changed) continue;
       for (Dart y : m.map().template cell<0>(x))
         if (const Index n = m.element_of(y); n != physics::invalid_index && m.elements()[n].alive) els.push_back(n);
     }

@@ -658,6 +658,9 @@ class CMap {
   // The face of a dart and its copies across βj (j ≥ 3), see cmap_insert.hpp.
   struct FaceCopies;
   [[nodiscard]] bool face_copies(std::uint32_t d, FaceCopies& out) const;
+  // True if each dart of the path is met turning inside its volume around the vertex where the
+  // previous one ends (is_insertable_face_in_volume's usual case, without walking the volume).
+  [[nodiscard]] bool chained_in_one_volume(std::span<const Dart> path) const;
   // insert_vertex_in_face; `centre` receives the new darts that start at the new vertex.
   Dart star_face(Dart d, detail::DartBuffer<32>& centre);
   // A bit per dimension whose attributes are enabled: work that only serves attributes is

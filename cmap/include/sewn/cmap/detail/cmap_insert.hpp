@@ -143,6 +143,13 @@ bool CMap<D, A...>::is_insertable_face_in_volume(std::span<const Dart> path) con
     for (int j = 4; j <= D; ++j)
       if (b(d.index(), j) != detail::null_index) return false;
   }
+  if (chained_in_one_volume(path)) {
+    // one volume and a closed chain, proved without walking the volume; distinct edges left
+    for (std::size_t k = 0; k < path.size(); ++k)
+      for (std::size_t l = 0; l < k; ++l)
+        if (same_cell<1>(path[l], path[k])) return false;
+    return true;
+  }
   // one volume
   const DartList vol = cell<3>(path[0]);
   auto in_volume = [&](Dart d) { return std::find(vol.begin(), vol.end(), d) != vol.end(); };
@@ -156,6 +163,29 @@ bool CMap<D, A...>::is_insertable_face_in_volume(std::span<const Dart> path) con
     if (!same_cell<0>(Dart(end), next)) return false;
     for (std::size_t l = 0; l < k; ++l)
       if (same_cell<1>(path[l], path[k])) return false;
+  }
+  return true;
+}
+
+// The usual case, decided from the path's ends alone: each next dart is met turning around the
+// vertex where the previous one ends, inside its volume (β1 then β2∘β1 steps stay at that
+// vertex and in that volume), so all share one volume and the chain closes. False when a turn
+// meets a free β1 or β2 or closes without meeting the next dart (a vertex the volume touches in
+// several cones, say): the caller then walks the volume.
+template <int D, class... A>
+bool CMap<D, A...>::chained_in_one_volume(std::span<const Dart> path) const {
+  constexpr std::uint32_t null = detail::null_index;
+  const std::uint32_t cap = dart_capacity();
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    const std::uint32_t first = b(path[k].index(), 1), next = path[(k + 1) % path.size()].index();
+    if (first == null) return false;
+    std::uint32_t y = first;
+    for (std::uint32_t steps = 0; y != next; ++steps) {
+      const std::uint32_t y2 = b(y, 2);
+      if (y2 == null || steps > cap) return false;
+      y = b(y2, 1);
+      if (y == null || y == first) return false;
+    }
   }
   return true;
 }
