@@ -121,7 +121,6 @@ CgResult pcg_threads(const BlockMatrix& A, std::span<const double> b, std::span<
   return out;
 }
 
-#ifdef SEWN_CG_AVX512
 // Copies A's upper block triangle into ws (pattern rebuilt only when A's changes). Returns
 // false, leaving the caller to use A itself, if a block is not exactly symmetric. (The filter
 // cannot be folded into the blocks: S_i B S_j is not symmetric when i and j fix different axes.)
@@ -162,6 +161,7 @@ bool pack_symmetric(const BlockMatrix& A, CgWorkspace& ws) {
   return symmetric;
 }
 
+#ifdef SEWN_CG_AVX512
 // The three columns of a packed symmetric block, as padded rows [c0 c1 c2 0].
 inline void columns(const double* v, __m256d& c0, __m256d& c1, __m256d& c2) {
   const __m256d lo = _mm256_loadu_pd(v);      // a00 a01 a02 a11
@@ -430,6 +430,34 @@ CgResult filtered_pcg(const BlockMatrix& A, std::span<const double> b, std::span
   out.relative_residual = r_norm / b_norm;
   out.converged = !out.breakdown && std::isfinite(r_norm) && r_norm <= stop;
   return out;
+}
+
+bool pack_symmetric_blocks(const BlockMatrix& A, CgWorkspace& ws) { return pack_symmetric(A, ws); }
+
+double packed_symmetric_product(const CgWorkspace& ws, const double* p, double* y, const double* free4, Index nodes) {
+#ifdef SEWN_CG_AVX512
+  return sym_multiply(ws, p, y, free4, nodes);
+#else
+  // The same product on scalars: block (i,j), j > i, also serves (j,i).
+  std::fill(y, y + 4 * std::size_t{nodes}, 0.0);
+  for (Index i = 0; i < nodes; ++i)
+    for (Index k = ws.sym_row[i]; k < ws.sym_row[i + 1]; ++k) {
+      const double* v = ws.sym_val.data() + 6 * std::size_t{k};
+      const double m[9] = {v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5]};
+      const std::size_t j = std::size_t{ws.sym_col[k]}, oi = 4 * std::size_t{i}, oj = 4 * j;
+      for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 3; ++c) {
+          y[oi + a] += m[3 * a + c] * p[oj + c];
+          if (j != std::size_t{i}) y[oj + a] += m[3 * a + c] * p[oi + c];
+        }
+    }
+  double py = 0;
+  for (std::size_t o = 0; o < 4 * std::size_t{nodes}; ++o) {
+    y[o] *= free4[o];
+    py += p[o] * y[o];
+  }
+  return py;
+#endif
 }
 
 bool reduced_pcg_packed(const BlockMatrix& A, std::span<const double> rb, std::span<double> x,
