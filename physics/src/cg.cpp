@@ -121,7 +121,6 @@ CgResult pcg_threads(const BlockMatrix& A, std::span<const double> b, std::span<
   return out;
 }
 
-#ifdef SEWN_CG_AVX512
 // Copies A's upper block triangle into ws (pattern rebuilt only when A's changes). Returns
 // false, leaving the caller to use A itself, if a block is not exactly symmetric. (The filter
 // cannot be folded into the blocks: S_i B S_j is not symmetric when i and j fix different axes.)
@@ -162,6 +161,7 @@ bool pack_symmetric(const BlockMatrix& A, CgWorkspace& ws) {
   return symmetric;
 }
 
+#ifdef SEWN_CG_AVX512
 // The three columns of a packed symmetric block, as padded rows [c0 c1 c2 0].
 inline void columns(const double* v, __m256d& c0, __m256d& c1, __m256d& c2) {
   const __m256d lo = _mm256_loadu_pd(v);      // a00 a01 a02 a11
@@ -231,6 +231,65 @@ double packed_product(CgWorkspace& ws, const double* __restrict p, double* __res
   return hsum(pq);
 }
 
+// sym_multiply on `parts` threads, thread t owning rows [node(t), node(t + 1)): its blocks
+// add to its own rows in y and to later threads' rows in its spill array; then each thread adds
+// the spills of the threads before it to its rows, in thread order, filters them and sums its
+// part of p·y. Deterministic for a given count; equal to one thread's to round-off (a row's
+// terms are grouped by thread). The one-thread product fuses both passes (sym_multiply).
+double sym_multiply_parts(CgWorkspace& ws, const double* __restrict p, double* __restrict y, const double* __restrict free4,
+                          Index n, int parts) {
+  const std::size_t nodes = static_cast<std::size_t>(n);
+  if (ws.spill.size() < static_cast<std::size_t>(parts)) ws.spill.resize(static_cast<std::size_t>(parts));
+  for (int t = 0; t + 1 < parts; ++t) ws.spill[static_cast<std::size_t>(t)].resize(4 * nodes);
+  const auto node = [&](int t) { return range_begin(nodes, parts, t); };
+  const Index* __restrict row = ws.sym_row.data();
+  const Index* __restrict col = ws.sym_col.data();
+  const double* __restrict val = ws.sym_val.data();
+  run_parts(parts, [&](int t) {
+    const std::size_t i0 = node(t), i1 = node(t + 1);
+    double* __restrict spill = t + 1 < parts ? ws.spill[static_cast<std::size_t>(t)].data() : nullptr;
+    std::fill(y + 4 * i0, y + 4 * i1, 0.0);
+    if (spill != nullptr) std::fill(spill + 4 * i1, spill + 4 * nodes, 0.0);
+    for (std::size_t i = i0; i < i1; ++i) {
+      const double* pi = p + 4 * i;
+      const __m256d b0 = _mm256_broadcast_sd(pi), b1 = _mm256_broadcast_sd(pi + 1), b2 = _mm256_broadcast_sd(pi + 2);
+      __m256d c0, c1, c2;
+      Index k = row[i];
+      columns(val + 6 * std::size_t{k}, c0, c1, c2);
+      __m256d a0 = _mm256_fmadd_pd(c0, b0, _mm256_load_pd(y + 4 * i));
+      __m256d a1 = _mm256_mul_pd(c1, b1);
+      __m256d a2 = _mm256_mul_pd(c2, b2);
+      for (++k; k < row[i + 1]; ++k) {
+        columns(val + 6 * std::size_t{k}, c0, c1, c2);
+        const std::size_t j = std::size_t{col[k]};
+        const double* pj = p + 4 * j;
+        a0 = _mm256_fmadd_pd(c0, _mm256_broadcast_sd(pj), a0);
+        a1 = _mm256_fmadd_pd(c1, _mm256_broadcast_sd(pj + 1), a1);
+        a2 = _mm256_fmadd_pd(c2, _mm256_broadcast_sd(pj + 2), a2);
+        double* yj = (j < i1 ? y : spill) + 4 * j;
+        _mm256_store_pd(yj, _mm256_fmadd_pd(c2, b2, _mm256_fmadd_pd(c1, b1, _mm256_fmadd_pd(c0, b0, _mm256_load_pd(yj)))));
+      }
+      _mm256_store_pd(y + 4 * i, _mm256_add_pd(_mm256_add_pd(a0, a1), a2));
+    }
+  });
+  double part[max_threads];
+  run_parts(parts, [&](int t) {
+    const std::size_t i0 = node(t), i1 = node(t + 1);
+    __m256d pq = _mm256_setzero_pd();
+    for (std::size_t i = i0; i < i1; ++i) {
+      __m256d yi = _mm256_load_pd(y + 4 * i);
+      for (int u = 0; u < t; ++u) yi = _mm256_add_pd(yi, _mm256_load_pd(ws.spill[static_cast<std::size_t>(u)].data() + 4 * i));
+      yi = _mm256_mul_pd(yi, _mm256_load_pd(free4 + 4 * i));
+      _mm256_store_pd(y + 4 * i, yi);
+      pq = _mm256_fmadd_pd(yi, _mm256_load_pd(p + 4 * i), pq);
+    }
+    part[t] = hsum(pq);
+  });
+  double s = 0;
+  for (int t = 0; t < parts; ++t) s += part[t];
+  return s;
+}
+
 // z_i = S_i P_i S_i r_i for one node (pre: that block packed as a symmetric one).
 inline __m256d precond_row(const double* pre, __m256d r) {
   __m256d c0, c1, c2;
@@ -247,29 +306,14 @@ inline __m256d precond_row(const double* pre, __m256d r) {
 // With W, the same on the reduced system (packed_product).
 CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
                     std::span<const double> P, double b_norm, double stop, int max_iterations, CgWorkspace& ws,
-                    const PaddedReduction* W = nullptr) {
-  const std::size_t n = b.size() / 3, n4 = 4 * n;
-  for (auto* v : {&ws.r, &ws.z, &ws.p, &ws.q, &ws.x4, &ws.free4}) v->assign(n4, 0.0);
+                    const PaddedReduction* W = nullptr, int parts = 1) {
+  const std::size_t n = b.size() / 3;
+  for (auto* v : {&ws.r, &ws.z, &ws.p, &ws.q, &ws.x4, &ws.free4}) v->resize(4 * n);
   if (W != nullptr) {
-    ws.expanded.assign(n4, 0.0);
-    ws.ones4.assign(n4, 1.0);
+    ws.expanded.assign(4 * n, 0.0);
+    ws.ones4.assign(4 * n, 1.0);
   }
   ws.pre.resize(6 * n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double* f = free_dof.data() + 3 * i;
-    const double* Pi = P.data() + 9 * i;  // column-major
-    double* o = ws.pre.data() + 6 * i;
-    o[0] = f[0] * Pi[0];
-    o[1] = f[0] * f[1] * Pi[3];
-    o[2] = f[0] * f[2] * Pi[6];
-    o[3] = f[1] * Pi[4];
-    o[4] = f[1] * f[2] * Pi[7];
-    o[5] = f[2] * Pi[8];
-    for (std::size_t a = 0; a < 3; ++a) {
-      ws.x4[4 * i + a] = x[3 * i + a];
-      ws.free4[4 * i + a] = f[a];
-    }
-  }
   double* __restrict xv = ws.x4.data();
   double* __restrict r = ws.r.data();
   double* __restrict z = ws.z.data();
@@ -278,48 +322,86 @@ CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<co
   const double* __restrict pre = ws.pre.data();
   const double* __restrict s = ws.free4.data();
   const auto nodes = static_cast<Index>(n);
-  (void)packed_product(ws, xv, q, s, nodes, W);
-  __m256d rr_acc = _mm256_setzero_pd(), rz_acc = _mm256_setzero_pd();
-  for (std::size_t i = 0; i < n; ++i) {
-    const __m256d ri = _mm256_sub_pd(_mm256_mul_pd(_mm256_maskz_loadu_pd(0x7, b.data() + 3 * i), _mm256_load_pd(s + 4 * i)),
-                                     _mm256_load_pd(q + 4 * i));
-    const __m256d zi = precond_row(pre + 6 * i, ri);
-    _mm256_store_pd(r + 4 * i, ri);
-    _mm256_store_pd(z + 4 * i, zi);
-    _mm256_store_pd(p + 4 * i, zi);
-    rr_acc = _mm256_fmadd_pd(ri, ri, rr_acc);
-    rz_acc = _mm256_fmadd_pd(ri, zi, rz_acc);
-  }
-  double r_norm = std::sqrt(hsum(rr_acc));
-  double rz = hsum(rz_acc);
+  const auto node = [&](int t) { return range_begin(n, parts, t); };
+  double part_a[max_threads], part_b[max_threads];
+  const auto sum = [&](const double* part) {
+    double total = 0;
+    for (int t = 0; t < parts; ++t) total += part[t];
+    return total;
+  };
+  const auto product = [&](const double* v, double* out) {
+    return parts > 1 ? sym_multiply_parts(ws, v, out, s, nodes, parts) : packed_product(ws, v, out, s, nodes, W);
+  };
+  run_parts(parts, [&](int t) {
+    for (std::size_t i = node(t); i < node(t + 1); ++i) {
+      const double* f = free_dof.data() + 3 * i;
+      const double* Pi = P.data() + 9 * i;  // column-major
+      double* o = ws.pre.data() + 6 * i;
+      o[0] = f[0] * Pi[0];
+      o[1] = f[0] * f[1] * Pi[3];
+      o[2] = f[0] * f[2] * Pi[6];
+      o[3] = f[1] * Pi[4];
+      o[4] = f[1] * f[2] * Pi[7];
+      o[5] = f[2] * Pi[8];
+      for (std::size_t a = 0; a < 3; ++a) {
+        xv[4 * i + a] = x[3 * i + a];
+        ws.free4[4 * i + a] = f[a];
+      }
+      xv[4 * i + 3] = ws.free4[4 * i + 3] = 0.0;
+      for (double* v : {r, z, p, q}) v[4 * i + 3] = 0.0;
+    }
+  });
+  (void)product(xv, q);
+  run_parts(parts, [&](int t) {
+    __m256d rr_acc = _mm256_setzero_pd(), rz_acc = _mm256_setzero_pd();
+    for (std::size_t i = node(t); i < node(t + 1); ++i) {
+      const __m256d ri = _mm256_sub_pd(_mm256_mul_pd(_mm256_maskz_loadu_pd(0x7, b.data() + 3 * i), _mm256_load_pd(s + 4 * i)),
+                                       _mm256_load_pd(q + 4 * i));
+      const __m256d zi = precond_row(pre + 6 * i, ri);
+      _mm256_store_pd(r + 4 * i, ri);
+      _mm256_store_pd(z + 4 * i, zi);
+      _mm256_store_pd(p + 4 * i, zi);
+      rr_acc = _mm256_fmadd_pd(ri, ri, rr_acc);
+      rz_acc = _mm256_fmadd_pd(ri, zi, rz_acc);
+    }
+    part_a[t] = hsum(rr_acc);
+    part_b[t] = hsum(rz_acc);
+  });
+  double r_norm = std::sqrt(sum(part_a));
+  double rz = sum(part_b);
   CgResult out;
   int it = 0;
   while (r_norm > stop && it < max_iterations) {
-    const double pq = packed_product(ws, p, q, s, nodes, W);
+    const double pq = product(p, q);
     if (!(pq > 0.0)) {
       out.breakdown = true;
       break;
     }
     const __m256d alpha = _mm256_set1_pd(rz / pq);
-    rr_acc = _mm256_setzero_pd();
-    rz_acc = _mm256_setzero_pd();
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t o = 4 * i;
-      _mm256_store_pd(xv + o, _mm256_fmadd_pd(alpha, _mm256_load_pd(p + o), _mm256_load_pd(xv + o)));
-      const __m256d ri = _mm256_fnmadd_pd(alpha, _mm256_load_pd(q + o), _mm256_load_pd(r + o));
-      const __m256d zi = precond_row(pre + 6 * i, ri);
-      _mm256_store_pd(r + o, ri);
-      _mm256_store_pd(z + o, zi);
-      rr_acc = _mm256_fmadd_pd(ri, ri, rr_acc);
-      rz_acc = _mm256_fmadd_pd(ri, zi, rz_acc);
-    }
+    run_parts(parts, [&](int t) {
+      __m256d rr_acc = _mm256_setzero_pd(), rz_acc = _mm256_setzero_pd();
+      for (std::size_t i = node(t); i < node(t + 1); ++i) {
+        const std::size_t o = 4 * i;
+        _mm256_store_pd(xv + o, _mm256_fmadd_pd(alpha, _mm256_load_pd(p + o), _mm256_load_pd(xv + o)));
+        const __m256d ri = _mm256_fnmadd_pd(alpha, _mm256_load_pd(q + o), _mm256_load_pd(r + o));
+        const __m256d zi = precond_row(pre + 6 * i, ri);
+        _mm256_store_pd(r + o, ri);
+        _mm256_store_pd(z + o, zi);
+        rr_acc = _mm256_fmadd_pd(ri, ri, rr_acc);
+        rz_acc = _mm256_fmadd_pd(ri, zi, rz_acc);
+      }
+      part_a[t] = hsum(rr_acc);
+      part_b[t] = hsum(rz_acc);
+    });
     ++it;
-    r_norm = std::sqrt(hsum(rr_acc));
-    const double rz_new = hsum(rz_acc);
+    r_norm = std::sqrt(sum(part_a));
+    const double rz_new = sum(part_b);
     const __m256d beta = _mm256_set1_pd(rz_new / rz);
     rz = rz_new;
-    for (std::size_t o = 0; o < n4; o += 4)
-      _mm256_store_pd(p + o, _mm256_fmadd_pd(beta, _mm256_load_pd(p + o), _mm256_load_pd(z + o)));
+    run_parts(parts, [&](int t) {
+      for (std::size_t o = 4 * node(t); o < 4 * node(t + 1); o += 4)
+        _mm256_store_pd(p + o, _mm256_fmadd_pd(beta, _mm256_load_pd(p + o), _mm256_load_pd(z + o)));
+    });
   }
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t a = 0; a < 3; ++a) x[3 * i + a] = xv[4 * i + a];
@@ -393,11 +475,13 @@ CgResult filtered_pcg(const BlockMatrix& A, std::span<const double> b, std::span
   const double b_norm = std::sqrt(b_norm2);
   // The floor: near rest b is round-off, and a tolerance relative to it alone chases noise.
   const double stop = std::max(tolerance * b_norm, absolute_floor);
-  if (const int parts = detail::parts_for(n3 / 3, cg_grain); parts > 1)
-    return pcg_threads(A, b, x, free_dof, P, b_norm, stop, max_iterations, ws, parts);
+  const int parts = detail::parts_for(n3 / 3, cg_grain);
 #ifdef SEWN_CG_AVX512
-  if (pack_symmetric(A, ws)) return pcg_packed(b, x, free_dof, P, b_norm, stop, max_iterations, ws);
+  // The packed product on every count: the general one streams twice its bytes, which took
+  // most of what a second thread gained (docs/solvers.md, Threads).
+  if (pack_symmetric(A, ws)) return pcg_packed(b, x, free_dof, P, b_norm, stop, max_iterations, ws, nullptr, parts);
 #endif
+  if (parts > 1) return pcg_threads(A, b, x, free_dof, P, b_norm, stop, max_iterations, ws, parts);
   A.multiply(x, q);
   for (std::size_t k = 0; k < n3; ++k) r[k] = free_dof[k] * (b[k] - q[k]);
   double r_norm = std::sqrt(dot(r, r));
@@ -430,6 +514,34 @@ CgResult filtered_pcg(const BlockMatrix& A, std::span<const double> b, std::span
   out.relative_residual = r_norm / b_norm;
   out.converged = !out.breakdown && std::isfinite(r_norm) && r_norm <= stop;
   return out;
+}
+
+bool pack_symmetric_blocks(const BlockMatrix& A, CgWorkspace& ws) { return pack_symmetric(A, ws); }
+
+double packed_symmetric_product(const CgWorkspace& ws, const double* p, double* y, const double* free4, Index nodes) {
+#ifdef SEWN_CG_AVX512
+  return sym_multiply(ws, p, y, free4, nodes);
+#else
+  // The same product on scalars: block (i,j), j > i, also serves (j,i).
+  std::fill(y, y + 4 * std::size_t{nodes}, 0.0);
+  for (Index i = 0; i < nodes; ++i)
+    for (Index k = ws.sym_row[i]; k < ws.sym_row[i + 1]; ++k) {
+      const double* v = ws.sym_val.data() + 6 * std::size_t{k};
+      const double m[9] = {v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5]};
+      const std::size_t j = std::size_t{ws.sym_col[k]}, oi = 4 * std::size_t{i}, oj = 4 * j;
+      for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 3; ++c) {
+          y[oi + a] += m[3 * a + c] * p[oj + c];
+          if (j != std::size_t{i}) y[oj + a] += m[3 * a + c] * p[oi + c];
+        }
+    }
+  double py = 0;
+  for (std::size_t o = 0; o < 4 * std::size_t{nodes}; ++o) {
+    y[o] *= free4[o];
+    py += p[o] * y[o];
+  }
+  return py;
+#endif
 }
 
 bool reduced_pcg_packed(const BlockMatrix& A, std::span<const double> rb, std::span<double> x,

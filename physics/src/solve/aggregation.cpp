@@ -29,11 +29,15 @@ constexpr int power_iterations = 20;
 // once (classical smoothed aggregation) the first coarse matrix has 1.0e6 entries, more than the
 // fine one (7.5e5), and P 6.4e5; unsmoothed, 3.2e5 and 7.1e4, at the same iteration count once
 // the fine level is smoothed well (3 block-Jacobi sweeps: 87 against 90 a step; 1 sweep: 145).
-// The fine smoother is Chebyshev's polynomial in D⁻¹A of degree 4 (3 products), better than
-// as many damped Jacobi sweeps at the same cost: 51 iterations a step (degree 3: 61, 6: 43 at
-// a dearer step). The coarse levels take one damped block-Jacobi sweep.
+// The fine smoother is Chebyshev's polynomial in D⁻¹A, better than as many damped Jacobi sweeps
+// at the same cost: degree 4 (3 products) gave 51 iterations a step (3: 61, 6: 43 at a dearer
+// step) when a product was the general 9-value one. On the packed symmetric product a V-cycle
+// of degree d costs 2d fine products and CG's own one more; measured on the N = 8 cantilever,
+// 20 steps (CPU ms a step, iterations): degree 2 145-163 (73.8), 3 112-117 (57.8), 4 118-133
+// (48.0); on the 8x8x10 beam 3 and 4 are within the noise. The coarse levels take one damped
+// block-Jacobi sweep.
 constexpr bool smooth_prolongator = false;
-constexpr int fine_degree = 4;
+constexpr int fine_degree = 3;
 
 // One level being built: its matrix, its nodes' unknowns and its near-null space (rows: the
 // unknowns, columns: the modes).
@@ -47,13 +51,18 @@ struct Work {
 // y = M x on the calling thread (Eigen's own product forks OpenMP threads per call, which on
 // these small levels costs far more than the product: 75 % of a V-cycle's time in libgomp).
 void product(const RowSparse& M, const double* x, double* y) {
-  const std::int64_t* outer = M.outerIndexPtr();
-  const std::int64_t* inner = M.innerIndexPtr();
-  const double* v = M.valuePtr();
-  for (std::int64_t r = 0; r < M.rows(); ++r) {
-    double acc = 0;
-    for (std::int64_t k = outer[r]; k < outer[r + 1]; ++k) acc += v[k] * x[inner[k]];
-    y[r] = acc;
+  const RowSparse::StorageIndex* __restrict outer = M.outerIndexPtr();
+  const RowSparse::StorageIndex* __restrict inner = M.innerIndexPtr();
+  const double* __restrict v = M.valuePtr();
+  // Four partial sums in a fixed order: one running sum would wait on the add's latency at
+  // every entry (rows of a coarse level hold ~100).
+  for (Eigen::Index r = 0; r < M.rows(); ++r) {
+    double acc[4] = {};
+    RowSparse::StorageIndex k = outer[r];
+    for (; k + 4 <= outer[r + 1]; k += 4)
+      for (int q = 0; q < 4; ++q) acc[q] += v[k + q] * x[inner[k + q]];
+    for (; k < outer[r + 1]; ++k) acc[0] += v[k] * x[inner[k]];
+    y[r] = (acc[0] + acc[1]) + (acc[2] + acc[3]);
   }
 }
 
@@ -137,7 +146,7 @@ void tentative(const Work& w, const std::vector<std::int64_t>& agg, std::int64_t
   std::vector<std::vector<std::int64_t>> members(static_cast<std::size_t>(count));
   for (std::int64_t i = 0; i < n; ++i)
     if (agg[i] >= 0) members[agg[i]].push_back(i);
-  std::vector<Eigen::Triplet<double, std::int64_t>> trip;
+  std::vector<Eigen::Triplet<double, int>> trip;
   coarse_first.assign(1, 0);
   std::vector<Eigen::MatrixXd> R(static_cast<std::size_t>(count));
   for (std::int64_t a = 0; a < count; ++a) {
@@ -159,7 +168,7 @@ void tentative(const Work& w, const std::vector<std::int64_t>& agg, std::int64_t
     }
     const std::int64_t base = coarse_first.back();
     for (std::size_t r = 0; r < rows.size(); ++r)
-      for (Eigen::Index q = 0; q < Q.cols(); ++q) trip.emplace_back(rows[r], base + q, Q(Eigen::Index(r), q));
+      for (Eigen::Index q = 0; q < Q.cols(); ++q) trip.emplace_back(int(rows[r]), int(base + q), Q(Eigen::Index(r), q));
     R[a] = Q.transpose() * M;
     coarse_first.push_back(base + Q.cols());
   }
@@ -175,7 +184,7 @@ void block_inverses(const Work& w, const char* who, int level, std::vector<doubl
   const std::int64_t n = nodes_of(w);
   inv.clear();
   at.assign(1, 0);
-  std::vector<Eigen::Triplet<double, std::int64_t>> trip;
+  std::vector<Eigen::Triplet<double, int>> trip;
   for (std::int64_t i = 0; i < n; ++i) {
     const std::int64_t f = w.first[i], s = w.first[i + 1] - f;
     Eigen::MatrixXd D = Eigen::MatrixXd::Zero(s, s);
@@ -192,7 +201,7 @@ void block_inverses(const Work& w, const char* who, int level, std::vector<doubl
     for (std::int64_t r = 0; r < s; ++r)
       for (std::int64_t c = 0; c < s; ++c) {
         inv.push_back(Di(r, c));
-        trip.emplace_back(f + r, f + c, Di(r, c));
+        trip.emplace_back(int(f + r), int(f + c), Di(r, c));
       }
     at.push_back(static_cast<std::int64_t>(inv.size()));
   }
@@ -252,6 +261,20 @@ Eigen::MatrixXd rigid_modes(const FineInput& in, std::int64_t nodes) {
       B.block<3, 1>(3 * i, 3 + e) = Eigen::Vector3d::Unit(e).cross(p);
   }
   return B;
+}
+
+// Level 1's prolongator with its rows renumbered for padded fine vectors (3i + a -> 4i + a), as
+// the V-cycle applies it (FineLevel's layout); no rows for the padding.
+void pad_fine_prolongator(CoarseLevel& c) {
+  const Eigen::Index n = c.P.rows() / 3;
+  std::vector<Eigen::Triplet<double, int>> trip;
+  trip.reserve(static_cast<std::size_t>(c.P.nonZeros()));
+  for (Eigen::Index row = 0; row < c.P.rows(); ++row)
+    for (RowSparse::InnerIterator it(c.P, row); it; ++it)
+      trip.emplace_back(int(4 * (row / 3) + row % 3), int(it.col()), it.value());
+  c.P.resize(4 * n, c.P.cols());
+  c.P.setFromTriplets(trip.begin(), trip.end());
+  c.Pt = c.P.transpose();
 }
 
 }  // namespace
@@ -324,6 +347,7 @@ void SaHierarchy::build(const FineInput& in, const char* who) {
     w.free_dof = {};
     theta *= 0.5;
   }
+  if (!levels_.empty()) pad_fine_prolongator(levels_[0]);
   const std::size_t L = levels_.size() + 1;
   rc_.resize(L);
   zc_.resize(L);
@@ -392,62 +416,51 @@ void SaHierarchy::descend(std::size_t l) {
   add_smoothing(c, u, z);
 }
 
-void SaHierarchy::vcycle(const BlockMatrix& A, std::span<const double> free_dof, std::span<const double> inv,
-                         std::span<const double> r, std::span<double> z) {
-  const std::size_t n3 = r.size();
-  t0_.resize(n3);
-  u0_.resize(n3);
-  // u = r - K z, K = S A S + (I - S); z is zero on the fixed axes here, so S z = z
+void SaHierarchy::vcycle(FineLevel& fine, const double* r, double* z) {
+  const std::size_t n4 = 4 * fine.nodes();
+  t0_.resize(n4);
+  u0_.resize(n4);
+  d0_.resize(n4);
+  double* __restrict t = t0_.data();
+  double* __restrict u = u0_.data();
+  double* __restrict d = d0_.data();
+  // u = r - K z, K = S A S + (I - S); z is zero on the fixed axes here, so K z = S A z
   auto residual = [&] {
-    A.multiply(z, t0_);
-    for (std::size_t k = 0; k < n3; ++k) u0_[k] = r[k] - (free_dof[k] * t0_[k] + (1.0 - free_dof[k]) * z[k]);
+    fine.product(z, t);
+    for (std::size_t k = 0; k < n4; ++k) u[k] = r[k] - t[k];
   };
-  auto masked = [&] {
-    for (std::size_t k = 0; k < n3; ++k) z[k] *= free_dof[k];
-  };
-  // z += p(D⁻¹K) D⁻¹ v: Chebyshev's polynomial of degree fine_degree for D⁻¹K on
-  // [b / 30, b], b = 1.1 ρ (ρ from the set-up's power iteration), v then holding v - K Δz. A
-  // polynomial in D⁻¹K times D⁻¹ is symmetric, so the same smoother before and after keeps the
-  // V-cycle symmetric, as CG needs. Costs fine_degree - 1 products.
-  d0_.resize(n3);
-  auto chebyshev = [&](std::span<double> v) {
+  // z += p(D⁻¹K) D⁻¹ u: Chebyshev's polynomial of degree fine_degree for D⁻¹K on
+  // [b / 30, b], b = 1.1 ρ (ρ from the set-up's power iteration), u then holding u - K Δz but
+  // for the last term. A polynomial in D⁻¹K times D⁻¹ is symmetric, so the same smoother before
+  // and after keeps the V-cycle symmetric, as CG needs. Costs fine_degree - 1 products.
+  auto chebyshev = [&] {
     const double upper = 1.1 * 4.0 / (3.0 * fine_omega_), lower = upper / 30.0;
     const double theta = 0.5 * (upper + lower), delta = 0.5 * (upper - lower), sigma = theta / delta;
     double rho = 1.0 / sigma;
-    auto apply_inverse = [&](double scale, double keep) {  // d = keep d + scale D⁻¹ v, masked
-      for (std::size_t i = 0; i < n3 / 3; ++i) {
-        const double* D = inv.data() + 9 * i;
-        const double* x = v.data() + 3 * i;
-        for (int a = 0; a < 3; ++a) {
-          const std::size_t k = 3 * i + std::size_t(a);
-          d0_[k] = free_dof[k] * (keep * d0_[k] + scale * (D[a] * x[0] + D[3 + a] * x[1] + D[6 + a] * x[2]));
-        }
-      }
-    };
-    apply_inverse(1.0 / theta, 0.0);
-    for (std::size_t k = 0; k < n3; ++k) z[k] += d0_[k];
+    fine.smooth_step(u, d, 1.0 / theta, 0.0);
+    for (std::size_t k = 0; k < n4; ++k) z[k] += d[k];
     for (int j = 1; j < fine_degree; ++j) {
-      A.multiply(d0_, t0_);
-      for (std::size_t k = 0; k < n3; ++k) v[k] -= free_dof[k] * t0_[k] + (1.0 - free_dof[k]) * d0_[k];
+      fine.product(d, t);
+      for (std::size_t k = 0; k < n4; ++k) u[k] -= t[k];
       const double rho_next = 1.0 / (2.0 * sigma - rho);
-      apply_inverse(2.0 * rho_next / delta, rho_next * rho);
+      fine.smooth_step(u, d, 2.0 * rho_next / delta, rho_next * rho);
       rho = rho_next;
-      for (std::size_t k = 0; k < n3; ++k) z[k] += d0_[k];
+      for (std::size_t k = 0; k < n4; ++k) z[k] += d[k];
     }
   };
-  std::fill(z.begin(), z.end(), 0.0);
-  std::copy(r.begin(), r.end(), u0_.begin());
-  chebyshev(u0_);
+  std::fill(z, z + n4, 0.0);
+  std::copy(r, r + n4, u);
+  chebyshev();
   residual();
   if (!levels_.empty()) {
-    product(levels_[0].Pt, u0_.data(), rc_[1].data());
+    product(levels_[0].Pt, u, rc_[1].data());
     descend(1);
-    product(levels_[0].P, zc_[1].data(), t0_.data());
-    for (std::size_t k = 0; k < n3; ++k) z[k] += t0_[k];
-    masked();
+    product(levels_[0].P, zc_[1].data(), t);
+    const double* f = fine.free4();
+    for (std::size_t k = 0; k < n4; ++k) z[k] = f[k] * (z[k] + t[k]);
     residual();
   }
-  chebyshev(u0_);
+  chebyshev();
 }
 
 }  // namespace sewn::physics::solve::detail

@@ -12,8 +12,10 @@
 // one damped block-Jacobi sweep, the same before and after: the V-cycle is symmetric.
 //
 // Level 0 is the filtered fine matrix K = S A S + (I - S). The V-cycle applies it through A
-// itself (BlockMatrix::multiply, threaded) so that the fine smoothing follows the matrix of the
-// current solve while the coarse levels, set up on an earlier one, are kept (kept_pcg.hpp).
+// itself (FineLevel: the packed symmetric product, on vectors padded to 4 doubles a node) so
+// that the fine smoothing follows the matrix of the current solve while the coarse levels, set
+// up on an earlier one, are kept (kept_pcg.hpp). The coarse matrices use 32-bit indices: their
+// products stream fewer bytes.
 
 #include <cstdint>
 #include <span>
@@ -25,10 +27,11 @@
 
 #include "sewn/physics/aligned.hpp"
 #include "sewn/physics/block_matrix.hpp"
+#include "fine_level.hpp"
 
 namespace sewn::physics::solve::detail {
 
-using RowSparse = Eigen::SparseMatrix<double, Eigen::RowMajor, std::int64_t>;
+using RowSparse = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 
 /// One level below the fine one: its matrix, the block-diagonal inverse of its smoother (one
 /// dense block per coarse node, i.e. per aggregate of the level above, of 1 to 6 unknowns) and
@@ -39,6 +42,7 @@ struct CoarseLevel {
   std::vector<double> inverse;      // the nodes' inverse diagonal blocks, row-major, concatenated
   std::vector<std::int64_t> inverse_at;
   RowSparse P, Pt;                  // prolongator from this level to the one above, and its transpose
+                                    // (from level 1 to 0: rows indexed as padded fine vectors, 4i + a)
   double omega = 0;                 // smoother damping of this level (4 / (3 ρ(D⁻¹K)))
 };
 
@@ -56,10 +60,10 @@ class SaHierarchy {
   void build(const FineInput& in, const char* who);
   void clear();
   [[nodiscard]] bool empty() const { return levels_.empty() && fine_omega_ == 0; }
-  /// z = one symmetric V-cycle on r (K⁻¹ approximated), the fine level applied through A (the
-  /// current solve's matrix) with the block-Jacobi inverse `fine_inverse` (block_jacobi_inverse).
-  void vcycle(const BlockMatrix& A, std::span<const double> free_dof, std::span<const double> fine_inverse,
-              std::span<const double> r, std::span<double> z);
+  /// z = one symmetric V-cycle on r (K⁻¹ approximated), padded vectors (4 a node, r zero on
+  /// the fixed axes and the padding), the fine level applied through `fine` (the current
+  /// solve's matrix). No allocation once the work vectors are sized.
+  void vcycle(FineLevel& fine, const double* r, double* z);
   [[nodiscard]] std::size_t levels() const { return levels_.size() + 1; }
   /// Unknowns per level, fine first (for reports and tests).
   [[nodiscard]] std::vector<std::int64_t> sizes() const;

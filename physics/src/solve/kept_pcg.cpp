@@ -2,6 +2,7 @@
 
 #include "kept_pcg.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace sewn::physics::solve::detail {
@@ -71,6 +72,74 @@ PcgOutcome pcg_with(const BlockMatrix& A, std::span<const double> b, std::span<d
     rz = rz_new;
     for (std::size_t k = 0; k < n3; ++k) p[k] = z[k] + beta * p[k];
   }
+  out.iterations = it;
+  out.residual = r_norm;
+  out.relative_residual = r_norm / b_norm;
+  out.converged = std::isfinite(r_norm) && r_norm <= stop;
+  return out;
+}
+
+}  // namespace sewn::physics::solve::detail
+
+namespace sewn::physics::solve::detail {
+
+PcgOutcome pcg_padded(FineLevel& fine, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
+                      double tolerance, double floor, int max_iterations,
+                      const std::function<void(const double*, double*)>& precondition, PcgWorkspace& ws) {
+  const std::size_t n3 = b.size(), n4 = 4 * fine.nodes();
+  PcgOutcome out;
+  double bb = 0;
+  for (std::size_t k = 0; k < n3; ++k) bb += free_dof[k] * b[k] * b[k];
+  const double b_norm = std::sqrt(bb);
+  if (bb == 0.0) {
+    for (std::size_t k = 0; k < n3; ++k)
+      if (free_dof[k] != 0.0) x[k] = 0.0;
+    out.converged = true;
+    return out;
+  }
+  for (auto* v : {&ws.r, &ws.z, &ws.p, &ws.q, &ws.x}) v->resize(n4);
+  double* __restrict r = ws.r.data();
+  double* __restrict z = ws.z.data();
+  double* __restrict p = ws.p.data();
+  double* __restrict q = ws.q.data();
+  double* __restrict xv = ws.x.data();
+  const double* __restrict f = fine.free4();
+  const double stop = std::max(tolerance * b_norm, floor);
+  FineLevel::pad(x, xv);
+  FineLevel::pad(b, r);
+  fine.product(xv, q);  // S A x, x holding the prescribed values on the fixed axes
+  for (std::size_t k = 0; k < n4; ++k) r[k] = f[k] * r[k] - q[k];
+  double r_norm = std::sqrt(dot(r, r, n4));
+  auto apply = [&] {
+    precondition(r, z);
+    for (std::size_t k = 0; k < n4; ++k) z[k] *= f[k];
+  };
+  if (r_norm > stop) apply();
+  else std::fill(z, z + n4, 0.0);
+  std::copy(z, z + n4, p);
+  double rz = dot(r, z, n4);
+  int it = 0;
+  while (r_norm > stop && it < max_iterations) {
+    const double pq = fine.product(p, q);
+    if (!(pq > 0.0) || !(rz > 0.0)) {
+      out.breakdown = true;
+      break;
+    }
+    const double alpha = rz / pq;
+    for (std::size_t k = 0; k < n4; ++k) {
+      xv[k] += alpha * p[k];
+      r[k] -= alpha * q[k];
+    }
+    ++it;
+    r_norm = std::sqrt(dot(r, r, n4));
+    if (r_norm <= stop) break;
+    apply();
+    const double rz_new = dot(r, z, n4);
+    const double beta = rz_new / rz;
+    rz = rz_new;
+    for (std::size_t k = 0; k < n4; ++k) p[k] = z[k] + beta * p[k];
+  }
+  FineLevel::unpad(xv, x);
   out.iterations = it;
   out.residual = r_norm;
   out.relative_residual = r_norm / b_norm;

@@ -11,13 +11,14 @@
 #include <vector>
 
 #include "backends.hpp"
+#include "fine_level.hpp"
 #include "sewn/physics/aligned.hpp"
 #include "sewn/physics/errors.hpp"
 
 namespace sewn::physics::solve::detail {
 
 struct PcgWorkspace {
-  AlignedVector<double> r, z, p, q;
+  AlignedVector<double> r, z, p, q, x;
 };
 
 /// What pcg_with() ended with.
@@ -35,6 +36,13 @@ PcgOutcome pcg_with(const BlockMatrix& A, std::span<const double> b, std::span<d
                     double tolerance, double floor, int max_iterations,
                     const std::function<void(std::span<const double>, std::span<double>)>& precondition, PcgWorkspace& ws);
 
+/// pcg_with on vectors padded to 4 doubles a node, A applied by `fine` (bound to the solve's
+/// matrix) and P⁻¹ by `precondition(r4, z4)`: the layout of the packed symmetric product, so that
+/// a preconditioner working on it (sa-pcg's V-cycle) needs no copies. Same stopping rule.
+PcgOutcome pcg_padded(FineLevel& fine, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
+                      double tolerance, double floor, int max_iterations,
+                      const std::function<void(const double*, double*)>& precondition, PcgWorkspace& ws);
+
 /// The preconditioner P must offer (see Factorization in cholmod.cpp, AmgHierarchy in hypre.cpp):
 ///   bool sync_pattern(A)           rebuild for A's pattern if it changed; true then
 ///   bool analysed(), void analyse() the per-pattern set-up
@@ -46,6 +54,8 @@ PcgOutcome pcg_with(const BlockMatrix& A, std::span<const double> b, std::span<d
 /// and may offer (SaPreconditioner in sa_pcg.cpp):
 ///   void set_coordinates(xyz)       the nodes' positions, for the next set-up
 ///   void bind(A, free_dof)          the matrix of the solve about to run
+///   FineLevel& fine(); void solve4(r4, z4)  that matrix and P⁻¹ on padded vectors: CG runs
+///                                   on them (pcg_padded)
 template <class P>
 class KeptPcg final : public LinearSolver {
  public:
@@ -112,7 +122,11 @@ class KeptPcg final : public LinearSolver {
  private:
   PcgOutcome run(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
                  double floor) {
-    return pcg_with(A, b, x, free_dof, opt_.tolerance, floor, opt_.max_iterations,
+    if constexpr (requires { p_.fine(); })
+      return pcg_padded(p_.fine(), b, x, free_dof, opt_.tolerance, floor, opt_.max_iterations,
+                        [this](const double* r, double* z) { p_.solve4(r, z); }, ws_);
+    else
+      return pcg_with(A, b, x, free_dof, opt_.tolerance, floor, opt_.max_iterations,
                     [this](std::span<const double> r, std::span<double> z) { p_.solve(r, z); }, ws_);
   }
   // The refresh rule. A cycle is a set-up and the solves that use it; its mean cost per solve,

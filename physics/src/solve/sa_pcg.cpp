@@ -11,7 +11,6 @@
 #include "aggregation.hpp"
 #include "backends.hpp"
 #include "kept_pcg.hpp"
-#include "sewn/physics/cg.hpp"
 #include "sewn/physics/errors.hpp"
 
 namespace sewn::physics::solve::detail {
@@ -19,9 +18,11 @@ namespace sewn::physics::solve::detail {
 namespace {
 
 // A set-up's cost in CG iterations of sa-pcg (KeptPcg's refresh rule): measured in CPU time
-// against its iterations, 48 on the 8x8x10 beam and ~40 on the N = 8 cantilever
-// (docs/solvers.md). A constant, so that the rule does not depend on timings.
-constexpr double sa_setup_iterations = 40;
+// against its iterations once they ran on the packed product (docs/solvers.md), ~230 on the
+// 8x8x10 beam (30 ms against 0.13 ms) and ~170 on the N = 8 cantilever (250 ms against 1.45 ms);
+// it was 40 when an iteration cost 26 of block-Jacobi's. A constant, so that the rule does not
+// depend on timings.
+constexpr double sa_setup_iterations = 200;
 
 class SaPreconditioner {
  public:
@@ -120,15 +121,13 @@ class SaPreconditioner {
   /// The nodes' positions for the rigid-body modes of the next set-up.
   void set_coordinates(std::span<const double> xyz) { coordinates_.assign(xyz.begin(), xyz.end()); }
 
-  /// The current solve's matrix: the fine level of the V-cycle smooths with it.
-  void bind(const BlockMatrix& A, std::span<const double> free_dof) {
-    A_ = &A;
-    free_ = free_dof;
-    inverse_.resize(9 * std::size_t(A.size()));
-    block_jacobi_inverse(A, free_dof, inverse_);
-  }
+  /// The current solve's matrix: the fine level of the V-cycle smooths with it, and the CG
+  /// (KeptPcg's padded path) multiplies by it, both through the packed symmetric product.
+  void bind(const BlockMatrix& A, std::span<const double> free_dof) { fine_.bind(A, free_dof); }
+  [[nodiscard]] FineLevel& fine() { return fine_; }
 
-  void solve(std::span<const double> r, std::span<double> z) { hierarchy_.vcycle(*A_, free_, inverse_, r, z); }
+  /// z = one V-cycle on r, padded vectors (FineLevel).
+  void solve4(const double* r, double* z) { hierarchy_.vcycle(fine_, r, z); }
 
   [[nodiscard]] const SaHierarchy& hierarchy() const { return hierarchy_; }
 
@@ -138,9 +137,7 @@ class SaPreconditioner {
   bool have_pattern_ = false, analysed_ = false, valid_ = false;
   std::vector<Index> rows_, cols_;
   std::vector<double> input_, coordinates_;
-  const BlockMatrix* A_ = nullptr;
-  std::span<const double> free_;
-  AlignedVector<double> inverse_;
+  FineLevel fine_;
 };
 
 }  // namespace

@@ -39,7 +39,18 @@ struct CgWorkspace {
   AlignedVector<double> x4, free4;                // 4 per node
   AlignedVector<double> pre;                      // the filtered preconditioner, 6 per node
   AlignedVector<double> expanded, ones4;          // a reduced solve's W p, and a filter of ones
+  // Several threads: thread t's products into rows past its own range, one array per thread
+  // (4 per node, rows [end of t's range, n) used), added in thread order (deterministic).
+  std::vector<AlignedVector<double>> spill;
 };
+
+/// The fast path's packed matrix for other solvers (sa-pcg's multigrid and its CG): copies A's
+/// upper block triangle into ws (its pattern rebuilt only when A's changes). Returns false, ws
+/// unusable, if a block of A is not exactly symmetric. O(blocks).
+bool pack_symmetric_blocks(const BlockMatrix& A, CgWorkspace& ws);
+/// y = S A p on vectors padded to 4 doubles a node (padding zero), S the padded mask free4;
+/// returns p·y. Pre: pack_symmetric_blocks(A, ws) returned true. One thread. O(blocks).
+double packed_symmetric_product(const CgWorkspace& ws, const double* p, double* y, const double* free4, Index nodes);
 
 /// W and Wᵀ of a reduced system on node vectors padded to 4 doubles (SlaveNodes: the
 /// T-junctions' interpolation): expand4 sets each slave's row from its masters, reduce4 adds it
