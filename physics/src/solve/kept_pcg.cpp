@@ -20,6 +20,42 @@ double dot(const double* __restrict x, const double* __restrict y, std::size_t n
   return s;
 }
 
+// The preconditioned CG iterations both layouts share, from the first residual on: `product`
+// sets q = S A p and returns p . q, `apply` sets z from r (masked), each on n entries.
+template <class Product, class Apply>
+void cg_iterate(std::size_t n, double* x, double* r, double* z, double* p, const double* q, double stop,
+                int max_iterations, Product&& product, Apply&& apply, PcgOutcome& out) {
+  double r_norm = std::sqrt(dot(r, r, n));
+  if (r_norm > stop) apply();
+  else std::fill(z, z + n, 0.0);
+  std::copy(z, z + n, p);
+  double rz = dot(r, z, n);
+  int it = 0;
+  while (r_norm > stop && it < max_iterations) {
+    const double pq = product();
+    if (!(pq > 0.0) || !(rz > 0.0)) {
+      out.breakdown = true;
+      break;
+    }
+    const double alpha = rz / pq;
+    for (std::size_t k = 0; k < n; ++k) {
+      x[k] += alpha * p[k];
+      r[k] -= alpha * q[k];
+    }
+    ++it;
+    r_norm = std::sqrt(dot(r, r, n));
+    if (r_norm <= stop) break;
+    apply();
+    const double rz_new = dot(r, z, n);
+    const double beta = rz_new / rz;
+    rz = rz_new;
+    for (std::size_t k = 0; k < n; ++k) p[k] = z[k] + beta * p[k];
+  }
+  out.iterations = it;
+  out.residual = r_norm;
+  out.converged = std::isfinite(r_norm) && r_norm <= stop;
+}
+
 }  // namespace
 
 PcgOutcome pcg_with(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
@@ -41,47 +77,19 @@ PcgOutcome pcg_with(const BlockMatrix& A, std::span<const double> b, std::span<d
   const double stop = std::max(tolerance * b_norm, floor);
   A.multiply(x, q);
   for (std::size_t k = 0; k < n3; ++k) r[k] = free_dof[k] * (b[k] - q[k]);
-  double r_norm = std::sqrt(dot(r.data(), r.data(), n3));
+  auto product = [&] {
+    A.multiply(p, q);
+    for (std::size_t k = 0; k < n3; ++k) q[k] *= free_dof[k];
+    return dot(p.data(), q.data(), n3);
+  };
   auto apply = [&] {
     precondition(r, z);
     for (std::size_t k = 0; k < n3; ++k) z[k] *= free_dof[k];
   };
-  if (r_norm > stop) apply();
-  std::copy(z.begin(), z.end(), p.begin());
-  double rz = dot(r.data(), z.data(), n3);
-  int it = 0;
-  while (r_norm > stop && it < max_iterations) {
-    A.multiply(p, q);
-    for (std::size_t k = 0; k < n3; ++k) q[k] *= free_dof[k];
-    const double pq = dot(p.data(), q.data(), n3);
-    if (!(pq > 0.0) || !(rz > 0.0)) {
-      out.breakdown = true;
-      break;
-    }
-    const double alpha = rz / pq;
-    for (std::size_t k = 0; k < n3; ++k) {
-      x[k] += alpha * p[k];
-      r[k] -= alpha * q[k];
-    }
-    ++it;
-    r_norm = std::sqrt(dot(r.data(), r.data(), n3));
-    if (r_norm <= stop) break;
-    apply();
-    const double rz_new = dot(r.data(), z.data(), n3);
-    const double beta = rz_new / rz;
-    rz = rz_new;
-    for (std::size_t k = 0; k < n3; ++k) p[k] = z[k] + beta * p[k];
-  }
-  out.iterations = it;
-  out.residual = r_norm;
-  out.relative_residual = r_norm / b_norm;
-  out.converged = std::isfinite(r_norm) && r_norm <= stop;
+  cg_iterate(n3, x.data(), r.data(), z.data(), p.data(), q.data(), stop, max_iterations, product, apply, out);
+  out.relative_residual = out.residual / b_norm;
   return out;
 }
-
-}  // namespace sewn::physics::solve::detail
-
-namespace sewn::physics::solve::detail {
 
 PcgOutcome pcg_padded(FineLevel& fine, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
                       double tolerance, double floor, int max_iterations,
@@ -109,41 +117,14 @@ PcgOutcome pcg_padded(FineLevel& fine, std::span<const double> b, std::span<doub
   FineLevel::pad(b, r);
   fine.product(xv, q);  // S A x, x holding the prescribed values on the fixed axes
   for (std::size_t k = 0; k < n4; ++k) r[k] = f[k] * r[k] - q[k];
-  double r_norm = std::sqrt(dot(r, r, n4));
+  auto product = [&] { return fine.product(p, q); };
   auto apply = [&] {
     precondition(r, z);
     for (std::size_t k = 0; k < n4; ++k) z[k] *= f[k];
   };
-  if (r_norm > stop) apply();
-  else std::fill(z, z + n4, 0.0);
-  std::copy(z, z + n4, p);
-  double rz = dot(r, z, n4);
-  int it = 0;
-  while (r_norm > stop && it < max_iterations) {
-    const double pq = fine.product(p, q);
-    if (!(pq > 0.0) || !(rz > 0.0)) {
-      out.breakdown = true;
-      break;
-    }
-    const double alpha = rz / pq;
-    for (std::size_t k = 0; k < n4; ++k) {
-      xv[k] += alpha * p[k];
-      r[k] -= alpha * q[k];
-    }
-    ++it;
-    r_norm = std::sqrt(dot(r, r, n4));
-    if (r_norm <= stop) break;
-    apply();
-    const double rz_new = dot(r, z, n4);
-    const double beta = rz_new / rz;
-    rz = rz_new;
-    for (std::size_t k = 0; k < n4; ++k) p[k] = z[k] + beta * p[k];
-  }
+  cg_iterate(n4, xv, r, z, p, q, stop, max_iterations, product, apply, out);
   FineLevel::unpad(xv, x);
-  out.iterations = it;
-  out.residual = r_norm;
-  out.relative_residual = r_norm / b_norm;
-  out.converged = std::isfinite(r_norm) && r_norm <= stop;
+  out.relative_residual = out.residual / b_norm;
   return out;
 }
 
