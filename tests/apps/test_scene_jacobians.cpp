@@ -59,44 +59,4 @@ TEST_CASE("paper scenes: every term's exact Jacobian is the derivative of its fo
   check_terms("frisbee", 5, true);
 }
 
-TEST_CASE("paper scenes: every term's exact Jacobian is the derivative of its forces (toy ball, joints on)") {
-  check_terms("toy_ball", 5, false);
-  check_terms("toy_ball", 5, true);
-}
-
-TEST_CASE("toy ball with its joints on: a second of steps converged, the spring's foot framed by the platform's vertex normal") {
-  // NewtonEuler::step throws when a step does not converge within the scene's limit, so every
-  // step below reached the scene's tolerance. Before the vertex frame (the platform centre's
-  // side was an in-plane corner bisector) step 20 met the joint's antiparallel guard.
-  const sewn::app::Scene scene = sewn::app::load_scene(std::string(SEWN_SOURCE_DIR) + "/scenes/s04_toy_ball.json");
-  REQUIRE(scene.connections.enabled);
-  sewn::app::RunSummary sum;
-  auto b = sewn::app::detail::build_bodies(scene, true, sum);
-  REQUIRE(b.joints.points != nullptr);
-  const auto& points = *b.joints.points;
-  REQUIRE(points.size() == 2);
-  // the rod–shell joint is at an interior vertex: its stencil holds the one-ring (more than a
-  // triangle's three nodes plus the rod edge's two)
-  int vertex_joint = -1;
-  for (sewn::physics::Index c = 0; c < points.size(); ++c)
-    if (points.connection(c).position_nodes().size() > 5) vertex_joint = static_cast<int>(c);
-  REQUIRE(vertex_joint >= 0);
-  sewn::physics::integrate::NewtonEuler newton(sewn::app::test::scene_newton_options(scene));
-  sewn::physics::System& sys = b.model->system();
-  int iterations = 0;
-  double closest = 2;  // smallest 1 + m3·n3 of that joint over the run (2: parallel, 0: antiparallel)
-  const int steps = 30;
-  for (int s = 0; s < steps; ++s) {
-    iterations += newton.step(sys, scene.step).iterations;
-    const auto f = points.frames(static_cast<sewn::physics::Index>(vertex_joint), sys.state());
-    closest = std::min(closest, 1 + f[1].dot(f[3]));
-    REQUIRE(std::isfinite(sys.potential_energy()));
-  }
-  MESSAGE("toy ball with joints: " << iterations << " Newton iterations in " << steps << " steps; the foot joint's axes at most "
-                                   << std::acos(closest - 1) << " rad apart (1 + m3.n3 >= " << closest << ")");
-  // The spring leaves the platform along its normal and bends, but its foot never folds back
-  // past a right angle onto the platform.
-  CHECK(closest > 1.0);
-}
-
 }  // namespace test_scene_jacobians

@@ -9,6 +9,7 @@
 
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/physics.hpp"
+#include "sewn/physics/rods/rods_term.hpp"
 
 namespace sewn::physics::test {
 
@@ -54,5 +55,21 @@ inline Eigen::MatrixXd finite_difference(System& sys, bool wrt_velocity, double 
 }
 
 inline double max_abs(const Eigen::MatrixXd& m) { return m.cwiseAbs().maxCoeff(); }
+
+/// A straight rod of n nodes (0.004 kg each) hanging from the origin along -z over length L, its
+/// top two nodes fixed and the twist angles of its first and last edges clamped: the rod the
+/// "twisted past pi and back" cases drive by its last edge's angle.
+inline rods::Rods& hanging_clamped_rod(System& sys, int n, double L, const rods::Section& section) {
+  std::vector<Index> ids;
+  for (int i = 0; i < n; ++i)
+    ids.push_back(sys.nodes().add(rods::Vec3(0, 0, -L * i / (n - 1)), rods::Vec3::Zero(), 0.004));
+  sys.nodes().fix(ids[0]);
+  sys.nodes().fix(ids[1]);
+  auto& rods = sys.add<rods::Rods>();
+  (void)rods.add_rod(ids, sys.nodes().x(), false, section);
+  rods.rod(0).fix_theta(0);
+  rods.rod(0).fix_theta(n - 2);
+  return rods;
+}
 
 }  // namespace sewn::physics::test

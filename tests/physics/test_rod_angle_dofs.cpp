@@ -302,15 +302,8 @@ TEST_CASE("rod angle DOFs: a hanging rod twisted past pi and back under Newton, 
   const double L = 0.5, r = 0.005, h = 1e-3;
   const Section sec = Section::circular(1e7, 0.3, r);
   System sys;
-  std::vector<Index> ids;
-  for (int i = 0; i < n; ++i) ids.push_back(sys.nodes().add(Vec3(0, 0, -L * i / (n - 1)), Vec3::Zero(), 0.004));
-  sys.nodes().fix(ids[0]);
-  sys.nodes().fix(ids[1]);
-  Rods& rods = sys.add<Rods>();
-  (void)rods.add_rod(ids, sys.nodes().x(), false, sec);
+  Rods& rods = test::hanging_clamped_rod(sys, n, L, sec);
   const int last = n - 2;
-  rods.rod(0).fix_theta(0);
-  rods.rod(0).fix_theta(last);
   rods.use_angle_dofs(sys.angles(), 1000 * std::numbers::pi * std::pow(r, 4) / 2);  // ρπr⁴/2 per metre
   const Index driven = rods.angle_of(0, last);
   sys.add<Gravity>(Vec3(0, 0, -9.81));

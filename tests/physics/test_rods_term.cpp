@@ -231,15 +231,8 @@ TEST_CASE("rods term: a hanging rod twisted past pi and back, under the implicit
   const double L = 0.5, r = 0.005;
   const Section sec = Section::circular(1e7, 0.3, r);
   System sys;
-  std::vector<Index> ids;
-  for (int i = 0; i < n; ++i) ids.push_back(sys.nodes().add(Vec3(0, 0, -L * i / (n - 1)), Vec3::Zero(), 0.004));
-  sys.nodes().fix(ids[0]);
-  sys.nodes().fix(ids[1]);
-  Rods& rods = sys.add<Rods>();
-  (void)rods.add_rod(ids, sys.nodes().x(), false, sec);
+  Rods& rods = test::hanging_clamped_rod(sys, n, L, sec);
   const int last = n - 2;
-  rods.rod(0).fix_theta(0);
-  rods.rod(0).fix_theta(last);
   sys.add<Gravity>(Vec3(0, 0, -9.81));
   sys.add<MassDamping>(10.0);
   LinearlyImplicitEuler euler;
