@@ -11,6 +11,7 @@
 #include <doctest/doctest.h>
 #include <Eigen/Geometry>
 
+#include "point_fd.hpp"
 #include "sewn/connect/point.hpp"
 #include "sewn/physics/rods/stencils.hpp"
 
@@ -58,21 +59,10 @@ struct TwoRods {
   }
 };
 
-VectorXd finite_gradient(const PointConnection& c, const VectorXd& q, TwistUpdate u, double h) {
-  VectorXd g(q.size());
-  for (Eigen::Index i = 0; i < q.size(); ++i) {
-    VectorXd qp = q, qm = q;
-    qp[i] += h;
-    qm[i] -= h;
-    g[i] = (c.evaluate(qp, u, false).energy - c.evaluate(qm, u, false).energy) / (2 * h);
-  }
-  return g;
-}
-
 void check_gradient(const PointConnection& c, const VectorXd& q, TwistUpdate u) {
   const PointEval e = c.evaluate(q, u, true);
   REQUIRE(e.gradient.size() == q.size());
-  const VectorXd fd = finite_gradient(c, q, u, 1e-6);
+  const VectorXd fd = sewn::connect::test::finite_gradient(c, q, u, 1e-6);
   INFO("analytic " << e.gradient.transpose() << "\nfinite   " << fd.transpose());
   CHECK(e.energy > 0);
   CHECK((e.gradient - fd).norm() <= 1e-6 * std::max(1.0, fd.norm()));

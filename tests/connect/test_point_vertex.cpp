@@ -13,6 +13,7 @@
 #include <doctest/doctest.h>
 #include <Eigen/Geometry>
 
+#include "point_fd.hpp"
 #include "sewn/connect/point.hpp"
 #include "sewn/physics/rods/stencils.hpp"
 
@@ -66,25 +67,13 @@ struct RodOnVertex {
   }
 };
 
-VectorXd finite_gradient(const PointConnection& c, const VectorXd& q, TwistUpdate u) {
-  VectorXd g(q.size());
-  const double h = 1e-6;
-  for (Eigen::Index i = 0; i < q.size(); ++i) {
-    VectorXd qp = q, qm = q;
-    qp[i] += h;
-    qm[i] -= h;
-    g[i] = (c.evaluate(qp, u, false).energy - c.evaluate(qm, u, false).energy) / (2 * h);
-  }
-  return g;
-}
-
 // Gradient against differences of the energy, Hessian against differences of the gradient.
 void check_derivatives(const PointConnection& c, const VectorXd& q, TwistUpdate u) {
   Eigen::MatrixXd H;
   const PointEval e = c.evaluate(q, u, true, &H);
   REQUIRE(e.gradient.size() == q.size());
   REQUIRE(H.rows() == q.size());
-  const VectorXd fd = finite_gradient(c, q, u);
+  const VectorXd fd = sewn::connect::test::finite_gradient(c, q, u, 1e-6);
   INFO("analytic " << e.gradient.transpose() << "\nfinite   " << fd.transpose());
   CHECK((e.gradient - fd).norm() <= 1e-6 * std::max(1.0, fd.norm()));
   CHECK((c.evaluate(q, u, true).gradient - e.gradient).norm() <= 1e-12 * std::max(1.0, e.gradient.norm()));
