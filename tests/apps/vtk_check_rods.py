@@ -9,23 +9,15 @@ import os
 import sys
 import xml.etree.ElementTree as ET
 
-try:
-    import vtk
-except ImportError:
-    if os.environ.get("SEWN_CI"):
-        print("vtk_check_rods: VTK's Python bindings (python3-vtk9) are missing but SEWN_CI is set")
-        sys.exit(1)
-    print("SEWN-SKIP: VTK's Python bindings (python3-vtk9) are not installed for " + sys.executable)
-    sys.exit(0)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from vtk_checks import Checks, import_vtk  # noqa: E402
+
+vtk = import_vtk("vtk_check_rods")
 
 out = sys.argv[1]
-failures = []
-
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
-
+checks = Checks()
+check = checks.check
+failures = checks.failures
 
 frames = [ds.get("file") for ds in ET.parse(os.path.join(out, "tiny_rod.pvd")).getroot().iter("DataSet")]
 check(len(frames) == 5, "the .pvd lists %d frames, expected 5" % len(frames))

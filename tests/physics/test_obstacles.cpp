@@ -161,6 +161,22 @@ MssModel<3> cube(double edge, Vec3 origin, DampingModel damping = DampingModel::
   return MssModel<3>(hex_grid(2, 2, 2, {{edge / 2, edge / 2, edge / 2}, {origin.x(), origin.y(), origin.z()}}), {mat}, {}, opt);
 }
 
+// The model's weight under g = 9.81 m/s² (N).
+double weight_of(MssModel<3>& m) {
+  double weight = 0;
+  for (Index i = 0; i < m.nodes().size(); ++i) weight += m.nodes().mass(i) * 9.81;
+  return weight;
+}
+
+// The vertical force the obstacles exert on the model in its current state (N).
+double contact_lift(MssModel<3>& m, Obstacles& obs) {
+  std::vector<double> f(3 * std::size_t{m.nodes().size()}, 0.0);
+  obs.add_forces(m.nodes().state(), f);
+  double lift = 0;
+  for (Index i = 0; i < m.nodes().size(); ++i) lift += f[3 * i + 2];
+  return lift;
+}
+
 double max_depth(const System& sys, const Shape& s) {
   double d = 0;
   for (Index i = 0; i < sys.nodes().size(); ++i) d = std::max(d, depth(s, sys.nodes().position(i)).depth);
@@ -180,12 +196,7 @@ TEST_CASE("obstacles: a cube dropped on the ground settles, carried by the conta
     (void)euler.step(m.system(), 1e-3);
     deepest = std::max(deepest, max_depth(m.system(), ground));
   }
-  double weight = 0;
-  for (Index i = 0; i < m.nodes().size(); ++i) weight += m.nodes().mass(i) * 9.81;
-  std::vector<double> f(3 * std::size_t{m.nodes().size()}, 0.0);
-  obs.add_forces(m.nodes().state(), f);
-  double lift = 0;
-  for (Index i = 0; i < m.nodes().size(); ++i) lift += f[3 * i + 2];
+  const double weight = weight_of(m), lift = contact_lift(m, obs);
   MESSAGE("cube on the ground: weight " << weight << " N, contact " << lift << " N, deepest " << deepest << " m");
   CHECK(m.system().kinetic_energy() < 1e-6 * weight * 0.02);  // of the energy the 2 cm drop released
   CHECK(lift == doctest::Approx(weight).epsilon(1e-3));
@@ -245,11 +256,7 @@ TEST_CASE("obstacles: the semi-implicit integrator lands a cube on the ground wi
     (void)euler.step(m.system(), 1e-4);
     deepest = std::max(deepest, max_depth(m.system(), ground));
   }
-  double weight = 0, lift = 0;
-  for (Index i = 0; i < m.nodes().size(); ++i) weight += m.nodes().mass(i) * 9.81;
-  std::vector<double> f(3 * std::size_t{m.nodes().size()}, 0.0);
-  obs.add_forces(m.nodes().state(), f);
-  for (Index i = 0; i < m.nodes().size(); ++i) lift += f[3 * i + 2];
+  const double weight = weight_of(m), lift = contact_lift(m, obs);
   CHECK(lift == doctest::Approx(weight).epsilon(1e-3));
   CHECK(deepest < 0.01);
   CHECK(m.system().kinetic_energy() < 1e-6 * weight * 0.02);
@@ -276,11 +283,7 @@ TEST_CASE("obstacles under Newton: a cube dropped on the ground settles, carried
     worst = std::max(worst, it);
     deepest = std::max(deepest, max_depth(m.system(), ground));
   }
-  double weight = 0, lift = 0;
-  for (Index i = 0; i < m.nodes().size(); ++i) weight += m.nodes().mass(i) * 9.81;
-  std::vector<double> f(3 * std::size_t{m.nodes().size()}, 0.0);
-  obs.add_forces(m.nodes().state(), f);
-  for (Index i = 0; i < m.nodes().size(); ++i) lift += f[3 * i + 2];
+  const double weight = weight_of(m), lift = contact_lift(m, obs);
   MESSAGE("Newton, cube on the ground: contact " << lift << " N of " << weight << " N, deepest " << deepest << " m, "
                                                  << iterations << " Newton iterations in 300 steps (worst " << worst << ")");
   CHECK(m.system().kinetic_energy() < 1e-6 * weight * 0.02);

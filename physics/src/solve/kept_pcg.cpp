@@ -20,6 +20,22 @@ double dot(const double* __restrict x, const double* __restrict y, std::size_t n
   return s;
 }
 
+// |S b| over the free axes (S the free-axis mask).
+double free_norm(std::span<const double> b, std::span<const double> free_dof) {
+  double bb = 0;
+  for (std::size_t k = 0; k < b.size(); ++k) bb += free_dof[k] * b[k] * b[k];
+  return std::sqrt(bb);
+}
+
+// A zero right-hand side: the free axes' solution is zero, the fixed axes keep their values.
+PcgOutcome zero_solution(std::span<double> x, std::span<const double> free_dof) {
+  for (std::size_t k = 0; k < x.size(); ++k)
+    if (free_dof[k] != 0.0) x[k] = 0.0;
+  PcgOutcome out;
+  out.converged = true;
+  return out;
+}
+
 // The preconditioned CG iterations both layouts share, from the first residual on: `product`
 // sets q = S A p and returns p . q, `apply` sets z from r (masked), each on n entries.
 template <class Product, class Apply>
@@ -65,15 +81,8 @@ PcgOutcome pcg_with(const BlockMatrix& A, std::span<const double> b, std::span<d
   for (auto* v : {&ws.r, &ws.z, &ws.p, &ws.q}) v->resize(n3);
   auto &r = ws.r, &z = ws.z, &p = ws.p, &q = ws.q;
   PcgOutcome out;
-  double bb = 0;
-  for (std::size_t k = 0; k < n3; ++k) bb += free_dof[k] * b[k] * b[k];
-  const double b_norm = std::sqrt(bb);
-  if (bb == 0.0) {
-    for (std::size_t k = 0; k < n3; ++k)
-      if (free_dof[k] != 0.0) x[k] = 0.0;
-    out.converged = true;
-    return out;
-  }
+  const double b_norm = free_norm(b, free_dof);
+  if (b_norm == 0.0) return zero_solution(x, free_dof);
   const double stop = std::max(tolerance * b_norm, floor);
   A.multiply(x, q);
   for (std::size_t k = 0; k < n3; ++k) r[k] = free_dof[k] * (b[k] - q[k]);
@@ -94,17 +103,10 @@ PcgOutcome pcg_with(const BlockMatrix& A, std::span<const double> b, std::span<d
 PcgOutcome pcg_padded(FineLevel& fine, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
                       double tolerance, double floor, int max_iterations,
                       const std::function<void(const double*, double*)>& precondition, PcgWorkspace& ws) {
-  const std::size_t n3 = b.size(), n4 = 4 * fine.nodes();
+  const std::size_t n4 = 4 * fine.nodes();
   PcgOutcome out;
-  double bb = 0;
-  for (std::size_t k = 0; k < n3; ++k) bb += free_dof[k] * b[k] * b[k];
-  const double b_norm = std::sqrt(bb);
-  if (bb == 0.0) {
-    for (std::size_t k = 0; k < n3; ++k)
-      if (free_dof[k] != 0.0) x[k] = 0.0;
-    out.converged = true;
-    return out;
-  }
+  const double b_norm = free_norm(b, free_dof);
+  if (b_norm == 0.0) return zero_solution(x, free_dof);
   for (auto* v : {&ws.r, &ws.z, &ws.p, &ws.q, &ws.x}) v->resize(n4);
   double* __restrict r = ws.r.data();
   double* __restrict z = ws.z.data();

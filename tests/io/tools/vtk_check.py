@@ -6,22 +6,14 @@ import math
 import os
 import sys
 
-try:
-    import vtk
-except ImportError:
-    if os.environ.get("SEWN_CI"):
-        print("vtk_check: VTK's Python bindings (python3-vtk9) are missing but SEWN_CI is set")
-        sys.exit(1)
-    print("SEWN-SKIP: VTK's Python bindings (python3-vtk9) are not installed for " + sys.executable)
-    sys.exit(0)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../.."))
+from vtk_checks import Checks, import_vtk  # noqa: E402
 
-failures = []
+vtk = import_vtk("vtk_check")
 
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
-
+checks = Checks()
+check = checks.check
+failures = checks.failures
 
 def read_vtu(path):
     r = vtk.vtkXMLUnstructuredGridReader()
