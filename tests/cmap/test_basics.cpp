@@ -9,6 +9,8 @@
 #include "sewn/cmap/build.hpp"
 #include "sewn/cmap/cmap.hpp"
 
+namespace test_basics {
+
 using namespace sewn;
 using sewn::test::check_map;
 
@@ -319,3 +321,5 @@ TEST_CASE("cells<I>() of every dimension iterates through const&, more than once
   }
   CHECK(size_of(v) == want[0]);
 }
+
+}  // namespace test_basics

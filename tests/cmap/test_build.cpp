@@ -7,6 +7,8 @@
 #include "sewn/cmap/build.hpp"
 #include "sewn/cmap/cmap.hpp"
 
+namespace test_build {
+
 using namespace sewn;
 using sewn::test::check_map;
 using sewn::test::counts;
@@ -389,3 +391,5 @@ TEST_CASE("unions of lattice boxes: overlaps counted once, touching boxes glued"
   CHECK_THROWS_WITH_AS(box_union(huge), doctest::Contains("2^28"), MeshError);
   CHECK_THROWS_AS(box_union(single, GridSpec{{1, 0, 1}, {}}), MeshError);
 }
+
+}  // namespace test_build

@@ -8,6 +8,8 @@
 #include "sewn/cmap/build.hpp"
 #include "sewn/cmap/cmap.hpp"
 
+namespace test_dart_info {
+
 using namespace sewn;
 
 namespace dart_info_test {
@@ -176,3 +178,5 @@ TEST_CASE("dart info: a map without it stores nothing more per dart") {
   CHECK(extra < std::size_t{tagged.dart_capacity()} * sizeof(std::uint32_t) * 2);
   CHECK(sizeof(CMap<3>) < sizeof(CMap<3, DartInfo<std::uint32_t>>));
 }
+
+}  // namespace test_dart_info

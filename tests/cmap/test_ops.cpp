@@ -6,6 +6,8 @@
 #include "check.hpp"
 #include "sewn/cmap/cmap.hpp"
 
+namespace test_ops {
+
 using namespace sewn;
 using sewn::test::check_map;
 using sewn::test::counts;
@@ -358,3 +360,5 @@ TEST_CASE("contract an edge shared by two hexahedra") {
   CHECK(after[2] == before[2]);
   CHECK(after[3] == 2);
 }
+
+}  // namespace test_ops

@@ -11,6 +11,8 @@
 #include "sewn/cmap/cmap.hpp"
 #include "sewn/cmap/topology.hpp"
 
+namespace test_ops_faces {
+
 using namespace sewn;
 
 namespace {
@@ -194,7 +196,6 @@ TEST_CASE("insert_dangling_edge_in_face adds an edge to a new vertex inside the 
   }
 }
 
-namespace test_ops_faces {
 namespace {
 
 // insert_vertex_in_face as the sequence of smaller insertions it was first written as (an edge
@@ -361,4 +362,5 @@ TEST_CASE("insert_vertex_in_face refuses a face sewn to itself") {
 }
 
 }  // namespace
+
 }  // namespace test_ops_faces

@@ -14,6 +14,8 @@
 #include "sewn/cmap/build.hpp"
 #include "sewn/cmap/cmap.hpp"
 
+namespace test_random {
+
 using namespace sewn;
 
 namespace {
@@ -330,3 +332,5 @@ TEST_CASE("randomized operation sequences on a 3-map") {
   CHECK(f.splits > 1000);
   CHECK(f.merges > 1000);
 }
+
+}  // namespace test_random

@@ -13,6 +13,8 @@
 #include "sewn/cmap/build.hpp"
 #include "sewn/cmap/cmap.hpp"
 
+namespace test_sew {
+
 using namespace sewn;
 using sewn::test::check_map;
 using sewn::test::counts;
@@ -303,3 +305,5 @@ TEST_CASE("unsew_all leaves the cells, links and attribute values of the unsews 
   same_partition(std::integral_constant<int, 2>{});
   same_partition(std::integral_constant<int, 3>{});
 }
+
+}  // namespace test_sew

@@ -13,6 +13,8 @@
 #include "sewn/cmap/cmap.hpp"
 #include "sewn/cmap/topology.hpp"
 
+namespace test_topology {
+
 using namespace sewn;
 
 namespace {
@@ -308,7 +310,6 @@ TEST_CASE("open faces and volumes are refused with the dart named") {
   CHECK_THROWS_WITH_AS(topology(q, {pts}), doctest::Contains("no point"), TopologyError);
 }
 
-namespace test_topology {
 namespace {
 
 // One dart per d-sewn facet of a built grid (D = 2: edges, D = 3: faces) all of whose darts start
@@ -364,4 +365,5 @@ TEST_CASE("a cut through a body adds one to b0; a crack inside it adds a b_{D-1}
 }
 
 }  // namespace
+
 }  // namespace test_topology

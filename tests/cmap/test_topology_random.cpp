@@ -30,6 +30,8 @@
 #include "sewn/cmap/cmap.hpp"
 #include "sewn/cmap/topology.hpp"
 
+namespace test_topology_random {
+
 using namespace sewn;
 
 namespace {
@@ -538,7 +540,6 @@ TEST_CASE("random operation sequences keep the invariants they must (3-maps)") {
   CHECK(facet_moves > 0);
 }
 
-namespace test_topology_random {
 namespace {
 
 // Every D-sewn facet of m in turn: unsewn, then sewn back. When the unsew changes no count but
@@ -603,4 +604,5 @@ TEST_CASE("unsewing one facet whose boundary stays shared moves b_{D-1} up or b_
 }
 
 }  // namespace
+
 }  // namespace test_topology_random

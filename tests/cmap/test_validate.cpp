@@ -9,6 +9,8 @@
 #include "sewn/cmap/build.hpp"
 #include "sewn/cmap/cmap.hpp"
 
+namespace test_validate {
+
 using namespace sewn;
 using Kind = ValidationIssue::Kind;
 
@@ -296,3 +298,5 @@ TEST_CASE("faces of a 3-map whose links low-level calls left inconsistent are st
   CHECK(m.count<2>() == roots.size());
   CHECK(m.num_reserved_marks() == 0);
 }
+
+}  // namespace test_validate

@@ -4,7 +4,11 @@
 #include <limits>
 
 #include "io_test_util.hpp"
+#include "sewn/io/cleanup.hpp"
 #include "sewn/io/geometry.hpp"
+#include "sewn/io/read.hpp"
+
+namespace test_geometry {
 
 using namespace sewn;
 using namespace sewn::io;
@@ -167,9 +171,6 @@ TEST_CASE("indices out of range are a MeshError before any geometry is looked at
   CHECK_THROWS_AS(check_mesh_geometry(m, "bad"), MeshError);
 }
 
-#include "sewn/io/cleanup.hpp"
-#include "sewn/io/read.hpp"
-
 TEST_CASE("drop_embedded_cells removes boundary copies, keeps cells that are not faces or edges") {
   IndexedMesh m = hex_grid(2, 1, 1);
   m.add_cell(CellType::quad, {0, 1, 4, 3}, 7);     // a face of hexahedron 0 (bottom)
@@ -201,3 +202,5 @@ TEST_CASE("drop_unused_points renumbers the cells") {
     for (std::size_t k = 0; k < before.cell(c).size(); ++k)
       CHECK(f.mesh.points[f.mesh.cell(c)[k]] == before.points[before.cell(c)[k]]);
 }
+
+}  // namespace test_geometry

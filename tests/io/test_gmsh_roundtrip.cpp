@@ -14,6 +14,8 @@
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/read.hpp"
 
+namespace test_gmsh_roundtrip {
+
 using namespace sewn;
 using namespace sewn::io;
 
@@ -161,3 +163,5 @@ TEST_CASE("unstructured tetrahedra: formats agree with each other and with gmsh'
   CHECK(medit.mesh.num_points() == nodes);
   CHECK_NOTHROW(check_mesh_geometry(medit.mesh, "box_tet.mesh"));
 }
+
+}  // namespace test_gmsh_roundtrip

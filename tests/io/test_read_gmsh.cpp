@@ -4,6 +4,8 @@
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/read.hpp"
 
+namespace test_read_gmsh {
+
 using namespace sewn;
 using namespace sewn::io;
 using sewn::io::test::message_of;
@@ -186,3 +188,5 @@ TEST_CASE("read_mesh: missing, empty, directory, unknown content; dispatch by co
   CHECK(read_mesh(test::data("cube.mesh")).num_cells() == 5);
   CHECK(read_mesh_file(test::data("sample51_binary.vtk")).format == MeshFormat::vtk_legacy);
 }
+
+}  // namespace test_read_gmsh

@@ -8,6 +8,8 @@
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/read.hpp"
 
+namespace test_read_medit_vtk {
+
 using namespace sewn;
 using namespace sewn::io;
 using sewn::io::test::message_of;
@@ -248,3 +250,5 @@ TEST_CASE("random corruption of every sample throws only IoError, and what parse
   MESSAGE("corrupted samples: " << parsed << " parsed, " << rejected << " rejected");
   CHECK(rejected > parsed);
 }
+
+}  // namespace test_read_medit_vtk

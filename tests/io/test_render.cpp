@@ -10,6 +10,8 @@
 #include "io_test_util.hpp"
 #include "sewn/io/render.hpp"
 
+namespace test_render {
+
 using namespace sewn;
 using namespace sewn::io;
 using sewn::io::test::message_of;
@@ -132,3 +134,5 @@ TEST_CASE("render_png: bad arguments and unwritable paths; non-finite points are
   IndexedMesh none;
   CHECK_NOTHROW(render_png(dir.path() / "empty.png", none.points, CellsView::of(none)));
 }
+
+}  // namespace test_render

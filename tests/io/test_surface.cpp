@@ -11,6 +11,8 @@
 #include "io_test_util.hpp"
 #include "sewn/io/surface.hpp"
 
+namespace test_surface {
+
 using namespace sewn;
 using namespace sewn::io;
 using sewn::io::test::message_of;
@@ -149,3 +151,5 @@ TEST_CASE("surface files and voxelization: bad input named") {
   CHECK(message_of<SemanticError>([&] { (void)voxelize(octahedron(), 0, "zero"); }).find("at least 1 cell") != std::string::npos);
   CHECK(message_of<SemanticError>([&] { (void)voxelize(octahedron(), 100000, "huge"); }).find("more than 2^28") != std::string::npos);
 }
+
+}  // namespace test_surface

@@ -9,6 +9,8 @@
 #include "io_test_util.hpp"
 #include "sewn/io/write.hpp"
 
+namespace test_write {
+
 using namespace sewn;
 using namespace sewn::io;
 using sewn::io::test::message_of;
@@ -95,3 +97,5 @@ TEST_CASE("vtu: caller mistakes are std::invalid_argument naming the array; I/O 
   CHECK_THROWS_AS(write_vtu(dir.path() / "x.vtu", few, CellsView::of(m)), std::invalid_argument);
   message_of<FileError>([&] { write_vtu(dir.path() / "missing" / "x.vtu", m); });
 }
+
+}  // namespace test_write

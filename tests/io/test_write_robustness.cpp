@@ -14,6 +14,8 @@
 #include "sewn/io/render.hpp"
 #include "sewn/io/write.hpp"
 
+namespace test_write_robustness {
+
 using namespace sewn;
 using namespace sewn::io;
 using sewn::io::test::message_of;
@@ -157,3 +159,5 @@ TEST_CASE("duplicate cells, in any vertex order, are a geometry problem") {
   REQUIRE(three.size() == 3);
   CHECK(three[2].message.find("m.msh: cell 5 (quad) repeats cell 0 ") == 0);
 }
+
+}  // namespace test_write_robustness

@@ -11,6 +11,8 @@
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
 
+namespace test_blowup {
+
 using namespace sewn;
 using namespace sewn::physics;
 using Eigen::Vector3d;
@@ -129,3 +131,5 @@ TEST_CASE("a stable semi-implicit run just below its bound is not stopped") {
   const double h = 0.99 * m.system().stable_step().h_max;
   for (int n = 0; n < 5000; ++n) REQUIRE_NOTHROW((void)se.step(m.system(), h));
 }
+
+}  // namespace test_blowup

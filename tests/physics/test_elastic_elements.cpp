@@ -15,6 +15,8 @@
 #include "sewn/physics/shells/shell_terms.hpp"
 #include "sewn/physics/solids/tets.hpp"
 
+namespace test_elastic_elements {
+
 using namespace sewn::physics;
 using namespace sewn::physics::test;
 using Eigen::Matrix3d;
@@ -270,3 +272,5 @@ TEST_CASE("elastic force terms reject bad elements naming them, before changing 
   CHECK_THROWS_WITH_AS(hinges.add_interior_edges(flipped, rest, 1.0), doctest::Contains("oriented inconsistently"),
                        InputError);
 }
+
+}  // namespace test_elastic_elements

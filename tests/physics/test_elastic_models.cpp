@@ -21,6 +21,8 @@
 #include "sewn/physics/solve/linear_solver.hpp"
 #include "sewn/physics/solids/tets.hpp"
 
+namespace test_elastic_models {
+
 using namespace sewn::physics;
 using namespace sewn::physics::test;
 using doctest::Approx;
@@ -458,3 +460,5 @@ TEST_CASE("StVK tet cantilever: linear FE's tips at small sizes, the error again
   CHECK(order1 > 0.0);
   CHECK(order2 > order1);
 }
+
+}  // namespace test_elastic_models

@@ -11,6 +11,8 @@
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
 
+namespace test_hard_cases {
+
 using namespace sewn;
 using namespace sewn::physics;
 using Eigen::Vector3d;
@@ -212,3 +214,5 @@ TEST_CASE("at nu = 0.3 the mass-spring cantilever converges, but not to the cont
   CHECK(limit == doctest::Approx(beam / 1.048).epsilon(0.02));
   CHECK((beam - limit) / beam > 0.03);
 }
+
+}  // namespace test_hard_cases

@@ -12,6 +12,8 @@
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/solids/inversion.hpp"
 
+namespace test_inversion {
+
 using namespace sewn;
 using namespace sewn::physics;
 using Eigen::Vector3d;
@@ -53,3 +55,5 @@ TEST_CASE("a mirror-image rest mesh is refused, naming the cell") {
     CHECK_THROWS_WITH_AS(MssModel<3>(mesh, {{1e6, 0.3, 1000}}, {}), doctest::Contains("inside out"), InputError);
   }
 }
+
+}  // namespace test_inversion

@@ -13,6 +13,8 @@
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/stiffness.hpp"
 
+namespace test_mss_model {
+
 using namespace sewn;
 using namespace sewn::physics;
 
@@ -208,3 +210,5 @@ TEST_CASE("a cut through edit(): the paper's Fig. 5 and Fig. 6") {
   CHECK(std::abs(m.node_mass() - mass0) <= sum_rounding(64, mass0));
   CHECK((momentum() - p0).norm() <= 1e-12 * (p0.norm() + 1));
 }
+
+}  // namespace test_mss_model

@@ -6,6 +6,8 @@
 
 #include "sewn/physics/physics.hpp"
 
+namespace test_nodes {
+
 using namespace sewn::physics;
 using Eigen::Vector3d;
 
@@ -131,3 +133,5 @@ TEST_CASE("gravity and mass damping: per-node forces, energy and Jacobian") {
   sys.add_jacobians(r);
   CHECK(sys.matrix().block(sys.matrix().diagonal(3)).isApprox(-2.0 * 0.7 * sys.nodes().mass(3) * Eigen::Matrix3d::Identity()));
 }
+
+}  // namespace test_nodes

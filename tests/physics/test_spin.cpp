@@ -16,6 +16,8 @@
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
 
+namespace test_spin {
+
 using namespace sewn;
 using namespace sewn::physics;
 using Eigen::Vector3d;
@@ -176,8 +178,6 @@ TEST_CASE("the midpoint rule at 100 rad/s: conservative at 2 ms, and at one radi
   CHECK(what.find("Newton") != std::string::npos);
   CHECK(what.find("max_step_halvings") != std::string::npos);
 }
-
-namespace test_spin {
 
 namespace {
 

@@ -15,6 +15,8 @@
 #include "sewn/physics/split_boxes.hpp"
 #include "sewn/physics/stiffness.hpp"
 
+namespace test_split_boxes {
+
 using namespace sewn;
 using namespace sewn::physics;
 
@@ -130,3 +132,5 @@ TEST_CASE("split boxes: the cantilever's static tip at 10:1, 5:1 and 2.5:1 boxes
     CHECK(std::abs(tip / cubes - 1) < 0.10);
   }
 }
+
+}  // namespace test_split_boxes

@@ -10,6 +10,8 @@
 
 #include "helpers.hpp"
 
+namespace test_springs {
+
 using namespace sewn::physics;
 using namespace sewn::physics::test;
 using Eigen::Vector3d;
@@ -542,3 +544,5 @@ TEST_CASE("the symmetric spring Jacobian (a·I + b·UUᵀ per spring) equals the
 }
 
 }  // namespace test_springs_fast_jacobian
+
+}  // namespace test_springs

@@ -7,6 +7,8 @@
 
 #include "sewn/physics/physics.hpp"
 
+namespace test_stiffness {
+
 using namespace sewn::physics;
 using doctest::Approx;
 using Eigen::Vector3d;
@@ -136,3 +138,5 @@ TEST_CASE("stiffness formulas refuse bad material and geometry, naming the value
   CHECK_THROWS_AS((void)van_gelder_tet_edge(1, 0, 1), InputError);
   CHECK_THROWS_AS((void)baudet_box_max_aspect(0.7), InputError);
 }
+
+}  // namespace test_stiffness

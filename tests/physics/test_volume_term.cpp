@@ -20,6 +20,8 @@
 #include "sewn/physics/solids/inversion.hpp"
 #include "sewn/physics/solids/volume_term.hpp"
 
+namespace test_volume_term {
+
 using namespace sewn;
 using namespace sewn::physics;
 using Eigen::Vector3d;
@@ -225,3 +227,5 @@ TEST_CASE("the volume term follows a cut: each stencil on its element's particle
   const Eigen::MatrixXd K_fd = test::finite_difference(m.system(), false, 1e-7);
   CHECK(test::max_abs(K - K_fd) < 1e-5 * test::max_abs(K_fd));
 }
+
+}  // namespace test_volume_term
