@@ -292,6 +292,9 @@ void implicit_ours(benchmark::State& st, const CostCase& c) {
   if (!usable(st, m)) return;
   physics::LinearlyImplicitEuler ie;  // CG to 1e-6, block Jacobi, warm start (the solve suite compares the other backends)
   ie.options().solver = physics::solve::Backend::jacobi;
+  // The peer's stopping rule, relative residual 1e-6 only: the library's absolute floor (a
+  // velocity error of 1e-9 m/s) would stop ours after fewer iterations than the peer.
+  ie.options().cg_absolute_tolerance = 0.0;
   Ours& o = *m.ours;
   implicit_loop(
       st, [&] { return ie.step(o.system(), c.h).cg_iterations; },
