@@ -311,23 +311,46 @@ void follow_cut(const ContinuumParts& parts, const physics::MssModel<3>& model) 
   }
 }
 
-std::vector<Point3> rod_directors(const ContinuumParts& parts, const physics::MssModel<3>& model,
-                                  std::span<const physics::Index> elements) {
-  std::vector<Point3> out(elements.size(), Point3{0, 0, 0});
+RodOutput rod_output(const ContinuumParts& parts, const physics::MssModel<3>& model) {
+  RodOutput out;
+  out.m1.assign(model.nodes().size(), Point3{0, 0, 0});
+  out.m2 = out.m1;
   if (!parts.rods) return out;
   // read through the const term: its non-const rod() forgets the last θ solve, and writing a
   // frame has no reason to cost the next force evaluation a twist solve (a no-op from a solved
   // θ: it stops at once, its Newton step below 1e-13)
   const physics::rods::Rods& rods = *parts.rods;
   const auto x = model.nodes().x();
-  std::map<Index, physics::rods::Points> positions;  // per rod, gathered once
-  for (std::size_t k = 0; k < elements.size(); ++k) {
-    const auto [r, edge] = parts.rod_edge_of_element[elements[k]];
-    if (r == physics::invalid_index) continue;
-    auto it = positions.find(r);
-    if (it == positions.end()) it = positions.emplace(r, rods.gather(r, x)).first;
-    const Vec3d m1 = rods.rod(r).material_directors(it->second, edge).first;
-    out[k] = {m1.x(), m1.y(), m1.z()};
+  std::vector<std::uint8_t> done(model.nodes().size(), 0);
+  for (Index r = 0; r < rods.num_rods(); ++r) {
+    const physics::rods::Rod& rod = rods.rod(r);
+    const std::span<const Index> nodes = rods.rod_nodes(r);
+    out.chains.emplace_back(nodes.begin(), nodes.end());
+    if (rod.closed()) out.chains.back().push_back(nodes.front());
+    const physics::rods::Points p = rods.gather(r, x);
+    const int edges = rod.num_edges(), n = static_cast<int>(nodes.size());
+    for (int v = 0; v < n; ++v) {
+      if (done[nodes[static_cast<std::size_t>(v)]] != 0) continue;
+      // the edges meeting at vertex v: edge v - 1 (v + n - 1 on a closed rod) and edge v
+      const int before = rod.closed() ? (v + n - 1) % n : v - 1, after = v < edges ? v : -1;
+      Vec3d m1 = Vec3d::Zero(), t = Vec3d::Zero(), first = Vec3d::Zero();
+      for (const int e : {before, after}) {
+        if (e < 0) continue;
+        const int next = (e + 1) % n;
+        t += (p.col(next) - p.col(e)).normalized();
+        m1 += rod.material_directors(p, e).first;
+        if (first.isZero()) first = m1;
+      }
+      t.normalize();
+      m1 -= m1.dot(t) * t;
+      // two edges' directors half a turn apart cancel: the first edge's then
+      if (!(m1.norm() > 1e-6)) m1 = first - first.dot(t) * t;
+      m1.normalize();
+      const Vec3d m2 = t.cross(m1);
+      out.m1[nodes[static_cast<std::size_t>(v)]] = {m1.x(), m1.y(), m1.z()};
+      out.m2[nodes[static_cast<std::size_t>(v)]] = {m2.x(), m2.y(), m2.z()};
+      done[nodes[static_cast<std::size_t>(v)]] = 1;
+    }
   }
   return out;
 }

@@ -74,6 +74,50 @@ void Snapshot::take(const physics::MssModel<3>& m) {
   }
 }
 
+void Snapshot::rods_as_poly_lines(const ContinuumParts& parts, const RodOutput& rods) {
+  if (rods.chains.empty()) return;
+  // each rod's first live segment: its cell's material and level go to the rod's poly-line
+  std::vector<std::size_t> first_cell(rods.chains.size(), types.size());
+  std::vector<int> first_edge(rods.chains.size(), std::numeric_limits<int>::max());
+  Snapshot kept;
+  kept.offsets = {0};
+  for (std::size_t c = 0; c < types.size(); ++c) {
+    const auto [r, edge] = element[c] < parts.rod_edge_of_element.size() ? parts.rod_edge_of_element[element[c]]
+                                                                          : std::pair<Index, int>{physics::invalid_index, 0};
+    if (r != physics::invalid_index) {
+      if (edge < first_edge[r]) first_edge[r] = edge, first_cell[r] = c;
+      continue;
+    }
+    kept.types.push_back(types[c]);
+    kept.conn.insert(kept.conn.end(), conn.begin() + offsets[c], conn.begin() + offsets[c + 1]);
+    kept.offsets.push_back(static_cast<std::uint32_t>(kept.conn.size()));
+    kept.material.push_back(material[c]);
+    kept.level.push_back(level[c]);
+    kept.mesh_cell.push_back(mesh_cell[c]);
+    kept.element.push_back(element[c]);
+  }
+  kept.poly_line.assign(kept.types.size(), 0);
+  for (std::size_t r = 0; r < rods.chains.size(); ++r) {
+    if (first_cell[r] == types.size()) continue;  // no live segment
+    kept.types.push_back(CellType::segment);
+    kept.conn.insert(kept.conn.end(), rods.chains[r].begin(), rods.chains[r].end());
+    kept.offsets.push_back(static_cast<std::uint32_t>(kept.conn.size()));
+    kept.material.push_back(material[first_cell[r]]);
+    kept.level.push_back(level[first_cell[r]]);
+    kept.mesh_cell.push_back(-1);
+    kept.element.push_back(element[first_cell[r]]);
+    kept.poly_line.push_back(1);
+  }
+  types = std::move(kept.types);
+  offsets = std::move(kept.offsets);
+  conn = std::move(kept.conn);
+  material = std::move(kept.material);
+  level = std::move(kept.level);
+  mesh_cell = std::move(kept.mesh_cell);
+  element = std::move(kept.element);
+  poly_line = std::move(kept.poly_line);
+}
+
 void prepare_output(const std::filesystem::path& dir) {
   for (const auto& part : dir)
     if (part.native().size() > 255)

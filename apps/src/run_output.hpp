@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "sewn/apps/continuum.hpp"
 #include "sewn/apps/runner.hpp"
 #include "sewn/apps/scene.hpp"
 #include "sewn/cmap/mesh.hpp"
@@ -23,11 +24,16 @@ struct Snapshot {
   std::vector<CellType> types;
   std::vector<std::uint32_t> offsets{0}, conn;
   std::vector<std::int32_t> material, level, mesh_cell;
-  std::vector<physics::Index> element;  // per output cell, its element
+  std::vector<physics::Index> element;  // per output cell, its element (a rod's: its first segment's)
+  std::vector<std::uint8_t> poly_line;  // empty, or per output cell: 1 for a whole rod
 
   /// Fills every field from the model's live nodes and elements. O(nodes + elements).
   void take(const physics::MssModel<3>& m);
-  [[nodiscard]] io::CellsView cells() const { return {types, offsets, conn}; }
+  /// Replaces the rods' segment cells by one poly-line per rod (rods.chains), appended after
+  /// the other cells, with the material and level of its first segment and mesh_cell -1 (it
+  /// stands for many mesh cells). O(cells).
+  void rods_as_poly_lines(const ContinuumParts& parts, const RodOutput& rods);
+  [[nodiscard]] io::CellsView cells() const { return {types, offsets, conn, poly_line}; }
 };
 
 // Makes `dir` the output folder, refusing what cannot be one (OutputPathError, bad input) and

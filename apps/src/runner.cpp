@@ -317,16 +317,17 @@ void RunLoop::write_frame(double t) {
   check_inversion(steps_done_);
   if (pvd_) {
     snap_.take(model_);
+    // rods: one poly-line each, their material frame (m1, m2) per node, zero off rods
+    const RodOutput rods = rod_output(b_.continuum, model_);
+    snap_.rods_as_poly_lines(b_.continuum, rods);
     const std::string name = frame_file(frame_);
     const io::DataArray point_data[] = {
         io::DataArray::vectors("velocity", snap_.velocity), io::DataArray::vectors("force", snap_.force),
-        io::DataArray::vectors("displacement", snap_.displacement), io::DataArray::flags("fixed", snap_.fixed)};
-    // rods' material frames: m1 per segment (m2 = t × m1), zero on other cells
-    const std::vector<Point3> director = rod_directors(b_.continuum, model_, snap_.element);
+        io::DataArray::vectors("displacement", snap_.displacement), io::DataArray::flags("fixed", snap_.fixed),
+        io::DataArray::vectors("rod_m1", rods.m1), io::DataArray::vectors("rod_m2", rods.m2)};
     const io::DataArray cell_data[] = {io::DataArray::ints("material", snap_.material),
                                        io::DataArray::ints("refinement_level", snap_.level),
-                                       io::DataArray::ints("mesh_cell", snap_.mesh_cell),
-                                       io::DataArray::vectors("rod_director", director)};
+                                       io::DataArray::ints("mesh_cell", snap_.mesh_cell)};
     // the frame is complete on disk before the series lists it
     writing([&] {
       io::write_vtu(sum_.out / name, snap_.points, snap_.cells(), point_data, cell_data);

@@ -148,6 +148,12 @@ void write_vtu(const std::filesystem::path& path, std::span<const Point3> points
   const std::size_t nc = cells.size();
   if (cells.offsets.size() != nc + 1 || cells.offsets[0] != 0 || cells.offsets[nc] != cells.conn.size())
     throw std::invalid_argument("write_vtu: cell offsets do not match the cell types and connectivity");
+  if (!cells.poly_line.empty() && cells.poly_line.size() != nc)
+    throw std::invalid_argument("write_vtu: " + std::to_string(cells.poly_line.size()) + " poly-line flags for " + std::to_string(nc) +
+                                " cells");
+  for (std::size_t c = 0; c < cells.poly_line.size(); ++c)
+    if (cells.poly_line[c] != 0 && (cells.types[c] != CellType::segment || cells.offsets[c + 1] < cells.offsets[c] + 2))
+      throw std::invalid_argument("write_vtu: cell " + std::to_string(c) + " is flagged a poly-line but is not a segment chain of two or more points");
   for (const std::uint32_t v : cells.conn)
     if (v >= points.size())
       throw std::invalid_argument("write_vtu: a cell refers to point " + std::to_string(v) + " but there are " +
@@ -169,7 +175,9 @@ void write_vtu(const std::filesystem::path& path, std::span<const Point3> points
   const std::vector<std::int64_t> conn(cells.conn.begin(), cells.conn.end());
   const std::vector<std::int64_t> offsets(cells.offsets.begin() + 1, cells.offsets.end());  // VTU: cell ends
   std::vector<std::uint8_t> types(nc);
-  for (std::size_t c = 0; c < nc; ++c) types[c] = vtk_cell_type(cells.types[c]);
+  constexpr std::uint8_t vtk_poly_line = 4;
+  for (std::size_t c = 0; c < nc; ++c)
+    types[c] = !cells.poly_line.empty() && cells.poly_line[c] != 0 ? vtk_poly_line : vtk_cell_type(cells.types[c]);
   data_array<std::int64_t>(out, "connectivity", 1, conn, opt.encoding);
   data_array<std::int64_t>(out, "offsets", 1, offsets, opt.encoding);
   data_array<std::uint8_t>(out, "types", 1, types, opt.encoding);

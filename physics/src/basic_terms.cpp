@@ -67,6 +67,13 @@ void MassDamping::add_forces(const StateView& s, std::span<double> f) const {
     for (int a = 0; a < 3; ++a) out[3 * i + a] -= c_ * m[i] * v[3 * i + a];
 }
 
+double MassDamping::dissipation(const StateView& s) const {
+  double psi = 0.0;
+  for (std::size_t i = 0; i < s.mass.size(); ++i)
+    psi += s.mass[i] * (s.v[3 * i] * s.v[3 * i] + s.v[3 * i + 1] * s.v[3 * i + 1] + s.v[3 * i + 2] * s.v[3 * i + 2]);
+  return 0.5 * c_ * psi;
+}
+
 void MassDamping::add_jacobians(const StateView& s, const JacobianRequest& req) const {
   if (req.matrix == nullptr || req.cv == 0.0) return;
   for (Index i = 0; i < s.size(); ++i)

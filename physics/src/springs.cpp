@@ -533,6 +533,26 @@ double Springs::potential_energy(const StateView& st) const {
   return e;
 }
 
+double Springs::dissipation(const StateView& st) const {
+  if (damping_ == SpringDamping::none) return 0.0;
+  double psi = 0.0;
+  for (Index s = 0; s < size(); ++s) {
+    if (alive_[s] == 0) continue;
+    const detail::SpringFrame fr = detail::spring_frame(st, ni_[s], nj_[s], l_[s]);
+    if (!fr.ok) continue;  // no direction: no force, so no potential either
+    const Eigen::Vector3d dv = detail::vel_diff(st, ni_[s], nj_[s]);
+    const double along = dv.dot(fr.dx) / fr.d;
+    if (damping_ == SpringDamping::viscous) {
+      psi += 0.5 * gamma_[s] * along * along;
+    } else {
+      // ½ β ΔVᵀK_sΔV with K_s = k[UUᵀ + c(I - UUᵀ)], c = max(0, 1 - l/d), as the force loop.
+      const double c = std::max(0.0, 1.0 - l_[s] / fr.d);
+      psi += 0.5 * beta_ * k_[s] * ((1.0 - c) * along * along + c * dv.squaredNorm());
+    }
+  }
+  return psi;
+}
+
 double Springs::energy_scale() const {
   double e = 0.0;
   for (Index s = 0; s < size(); ++s) e += 0.5 * k_[s] * l_[s] * l_[s];

@@ -231,18 +231,34 @@ TEST_CASE("rods: segments chain through nodes of two, split at junctions, close 
   }
   CHECK(closed == 1);
   CHECK(edges == 8);
-  // the material frame written to .vtu: unit, perpendicular to its segment
-  std::vector<physics::Index> elements(model.elements().size());
-  for (physics::Index e = 0; e < elements.size(); ++e) elements[e] = e;
+  // the rods written to .vtu: one chain per rod (a closed one back to its start), every node
+  // of a rod with a unit frame (m1, m2) normal to the node's tangent
   model.system().compute_forces();
-  const auto d = rod_directors(parts, model, elements);
-  for (physics::Index e = 0; e < elements.size(); ++e) {
-    const auto nodes = model.element_nodes(e);
-    const Eigen::Vector3d t = (model.nodes().position(nodes[1]) - model.nodes().position(nodes[0])).normalized();
-    const Eigen::Vector3d m1(d[e][0], d[e][1], d[e][2]);
-    CHECK(std::abs(m1.norm() - 1) < 1e-12);
-    CHECK(std::abs(m1.dot(t)) < 1e-12);
+  const RodOutput out = rod_output(parts, model);
+  REQUIRE(out.chains.size() == 4);
+  std::size_t chain_edges = 0;
+  for (physics::Index r = 0; r < 4; ++r) {
+    const auto& chain = out.chains[r];
+    chain_edges += chain.size() - 1;
+    CHECK((chain.front() == chain.back()) == parts.rods->rod(r).closed());
+    for (std::size_t k = 0; k < chain.size(); ++k) {
+      const physics::Index v = chain[k];
+      // the node's tangent: its neighbours along the chain (one of them at an open end)
+      const std::size_t prev = k > 0 ? k - 1 : (chain.front() == chain.back() ? chain.size() - 2 : k);
+      const std::size_t next = k + 1 < chain.size() ? k + 1 : (chain.front() == chain.back() ? 1 : k);
+      Eigen::Vector3d t = Eigen::Vector3d::Zero();
+      if (prev != k) t += (model.nodes().position(v) - model.nodes().position(chain[prev])).normalized();
+      if (next != k) t += (model.nodes().position(chain[next]) - model.nodes().position(v)).normalized();
+      t.normalize();
+      const Eigen::Vector3d m1(out.m1[v][0], out.m1[v][1], out.m1[v][2]), m2(out.m2[v][0], out.m2[v][1], out.m2[v][2]);
+      if (v == 0) continue;  // the junction: the frame of the first rod through it
+      CAPTURE(v);
+      CHECK(std::abs(m1.norm() - 1) < 1e-12);
+      CHECK(std::abs(m1.dot(t)) < 1e-12);
+      CHECK((m2 - t.cross(m1)).norm() < 1e-12);
+    }
   }
+  CHECK(chain_edges == 8);
 }
 
 TEST_CASE("scene keys of model groups: sections for rods only, labels only with mass-spring") {

@@ -79,6 +79,26 @@ TEST_CASE("vtu: base64 blocks are a 64-bit byte count followed by the data") {
         std::string::npos);
 }
 
+TEST_CASE("vtu: a segment chain flagged a poly-line is one VTK cell of type 4; misuse is refused") {
+  test::TempDir dir("vtu_poly");
+  const std::vector<Point3> pts = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}};
+  const std::vector<CellType> types = {CellType::segment, CellType::segment};
+  const std::vector<std::uint32_t> offsets = {0, 4, 6}, conn = {0, 1, 2, 3, 3, 4};
+  const std::vector<std::uint8_t> poly = {1, 0};
+  write_vtu(dir.path() / "p.vtu", pts, CellsView{types, offsets, conn, poly}, {}, {}, {VtuEncoding::ascii});
+  const std::string a = test::read_text(dir.path() / "p.vtu");
+  CHECK(a.find("Name=\"types\" format=\"ascii\">\n          4 3\n") != std::string::npos);
+  CHECK(a.find("Name=\"offsets\" format=\"ascii\">\n          4 6\n") != std::string::npos);
+  const std::vector<std::uint8_t> short_flags = {1};
+  CHECK_THROWS_WITH_AS(write_vtu(dir.path() / "x.vtu", pts, CellsView{types, offsets, conn, short_flags}),
+                       doctest::Contains("1 poly-line flags for 2 cells"), std::invalid_argument);
+  const std::vector<CellType> tri = {CellType::triangle};
+  const std::vector<std::uint32_t> tri_offsets = {0, 3}, tri_conn = {0, 1, 4};
+  const std::vector<std::uint8_t> one = {1};
+  CHECK_THROWS_WITH_AS(write_vtu(dir.path() / "x.vtu", pts, CellsView{tri, tri_offsets, tri_conn, one}),
+                       doctest::Contains("cell 0 is flagged a poly-line"), std::invalid_argument);
+}
+
 TEST_CASE("vtu: caller mistakes are std::invalid_argument naming the array; I/O failures FileError") {
   test::TempDir dir("vtu_bad");
   const IndexedMesh m = hex_grid(1, 1, 1);

@@ -1,7 +1,7 @@
 // Rigid obstacles: depth gradients and Hessians against finite differences for every shape,
 // the penalty's forces and Jacobian, friction's velocity Jacobian, continuity at the
 // surface; a cube resting on the ground, a cube dropped on a sphere, a block sliding to a stop
-// at Coulomb's distance; the cube on the ground also under Newton's backward Euler.
+// at Coulomb's distance; the cube on the ground and the sliding block also under Newton's backward Euler.
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -263,30 +263,62 @@ TEST_CASE("obstacles: the semi-implicit integrator lands a cube on the ground wi
 }
 
 // Newton's backward Euler minimises an incremental potential: the penalty enters through its
-// energy and its Hessian. The settling case above under NewtonEuler at h = 10 ms, ten times the
-// linearly implicit step, with Newton's iteration counts. Without the paper's per-spring
-// viscosity: its force −c(v·n)n turns with the spring direction n(q), so Newton's Rayleigh
-// term −½Δq·F_d is not its potential and the line search stalls near rest (50 iterations at
-// 1.3e-6 m/s in step 154). Friction under Newton is not tested for the same reason: Coulomb's
-// F_d has constant magnitude, −½Δq·F_d has half its gradient, and Newton does not converge.
+// energy and its Hessian, the paper's per-spring viscosity and friction through their
+// dissipation potentials (ForceTerm::dissipation). The settling case above under NewtonEuler
+// at h = 10 ms, ten times the linearly implicit step, with Newton's iteration counts; with the
+// paper's per-spring viscosity (before the dissipation potentials, Newton's −½Δq·F_d stalled
+// near rest: 50 iterations at 1.3e-6 m/s in step 154) and without it.
 TEST_CASE("obstacles under Newton: a cube dropped on the ground settles, carried by the contact forces") {
-  MssModel<3> m = cube(0.1, Vec3(-0.05, -0.05, 0.02), DampingModel::none);
-  Obstacles& obs = m.system().add<Obstacles>(2e4);
-  const Plane ground{Vec3::Zero(), Vec3(0, 0, 1), 0.0};
-  (void)obs.add(ground);
-  integrate::NewtonEuler newton;
-  double deepest = 0;
-  int iterations = 0, worst = 0;
-  for (int s = 0; s < 300; ++s) {
-    const int it = newton.step(m.system(), 1e-2).iterations;
-    iterations += it;
-    worst = std::max(worst, it);
-    deepest = std::max(deepest, max_depth(m.system(), ground));
+  for (const DampingModel damping : {DampingModel::viscous, DampingModel::none}) {
+    CAPTURE(int(damping));
+    MssModel<3> m = cube(0.1, Vec3(-0.05, -0.05, 0.02), damping);
+    Obstacles& obs = m.system().add<Obstacles>(2e4);
+    const Plane ground{Vec3::Zero(), Vec3(0, 0, 1), 0.0};
+    (void)obs.add(ground);
+    integrate::NewtonEuler newton;
+    double deepest = 0;
+    int iterations = 0, worst = 0;
+    for (int s = 0; s < 300; ++s) {
+      const int it = newton.step(m.system(), 1e-2).iterations;
+      iterations += it;
+      worst = std::max(worst, it);
+      deepest = std::max(deepest, max_depth(m.system(), ground));
+    }
+    const double weight = weight_of(m), lift = contact_lift(m, obs);
+    const std::string which = damping == DampingModel::viscous ? "with per-spring viscosity" : "undamped";
+    MESSAGE("Newton, cube on the ground, " << which << ": contact "
+                                         << lift << " N of " << weight << " N, deepest " << deepest << " m, " << iterations
+                                         << " Newton iterations in 300 steps (worst " << worst << ")");
+    CHECK(m.system().kinetic_energy() < 1e-6 * weight * 0.02);
+    CHECK(lift == doctest::Approx(weight).epsilon(1e-3));
+    CHECK(deepest < 0.01);
   }
-  const double weight = weight_of(m), lift = contact_lift(m, obs);
-  MESSAGE("Newton, cube on the ground: contact " << lift << " N of " << weight << " N, deepest " << deepest << " m, "
-                                                 << iterations << " Newton iterations in 300 steps (worst " << worst << ")");
-  CHECK(m.system().kinetic_energy() < 1e-6 * weight * 0.02);
-  CHECK(lift == doctest::Approx(weight).epsilon(1e-3));
-  CHECK(deepest < 0.01);
+}
+
+// The Coulomb case above under Newton: friction enters Φ as h μλ ε_v F1(|v_T|/ε_v) with λ
+// frozen within the step. The block stops at the same distance, each step converged.
+TEST_CASE("obstacles under Newton: a block sliding on the ground stops at Coulomb's distance v0^2/(2 mu g)") {
+  const double mu = 0.5, v0 = 1.0, g = 9.81, k = 1e5, mass = 0.1;
+  for (const double eps_v : {1e-4, 1e-2}) {
+    CAPTURE(eps_v);
+    System sys;
+    const Index i = sys.nodes().add(Vec3(0, 0, -mass * g / k), Vec3(v0, 0, 0), mass);
+    sys.add<Gravity>(Vec3(0, 0, -g));
+    Obstacles& obs = sys.add<Obstacles>(k, eps_v);
+    (void)obs.add(Plane{Vec3::Zero(), Vec3(0, 0, 1), mu});
+    integrate::NewtonEuler newton;
+    const int steps = 500;
+    int iterations = 0, worst = 0;
+    for (int s = 0; s < steps; ++s) {
+      const int it = newton.step(sys, 1e-3).iterations;
+      iterations += it;
+      worst = std::max(worst, it);
+    }
+    const double travelled = sys.nodes().position(i).x();
+    const double exact = v0 * v0 / (2 * mu * g);
+    MESSAGE("Newton, sliding block (eps_v " << eps_v << " m/s): stopped after " << travelled << " m, Coulomb " << exact << " m; "
+                                             << iterations << " Newton iterations in " << steps << " steps (worst " << worst << ")");
+    CHECK(std::abs(sys.nodes().velocity(i).x()) < 1e-3);
+    CHECK(travelled == doctest::Approx(exact).epsilon(0.01));
+  }
 }

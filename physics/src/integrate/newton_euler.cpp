@@ -69,18 +69,34 @@ void NewtonEuler::prepare(System& sys, double h) {
   }
   for (std::size_t k = n3_ + na; k < total; ++k) inertia_[k] = 1.0;
   for (std::size_t k = 0; k < total; ++k) qhat_[k] = xn_[k] + h * vn_[k];
-  // Probe: do the terms that may depend on velocity (ForceTerm::velocity_dependent) do so
-  // here? Compare their F(x_n, 1) with F(x_n, 0); the others are not evaluated.
+  // Velocity-dependent forces enter Φ through the terms' dissipation potentials Ψ, lagged at
+  // x_n: f0_ = Σ F(x_n, 0) of the dissipative terms, so that F(x_n, v) - f0_ = -∂Ψ/∂v. A term
+  // whose forces depend on velocity without a Ψ cannot be minimised: probe each such term with
+  // a non-uniform velocity (a uniform one leaves springs' relative velocities zero) and refuse.
   std::fill(f0_.begin(), f0_.end(), 0.0);
-  std::fill(f_.begin(), f_.end(), 0.0);
-  std::fill(vel_.begin(), vel_.end(), 1.0);
-  for (const auto& t : sys.terms()) {
-    if (!t->velocity_dependent()) continue;
-    t->add_forces(view(sys, xn_, zeros_), f0_);
-    t->add_forces(view(sys, xn_, vel_), f_);
-  }
   damped_ = false;
-  for (std::size_t k = 0; k < total && !damped_; ++k) damped_ = f_[k] != f0_[k];
+  for (const auto& t : sys.terms()) {
+    if (t->dissipative()) {
+      damped_ = true;
+      t->add_forces(view(sys, xn_, zeros_), f0_);
+    } else if (t->velocity_dependent()) {
+      probe_velocity_dependence(sys, *t);
+    }
+  }
+}
+
+void NewtonEuler::probe_velocity_dependence(const System& sys, const ForceTerm& t) {
+  const std::size_t total = dof_count();
+  for (std::size_t k = 0; k < total; ++k) vel_[k] = 1.0 + 0.1 * static_cast<double>(k % 7);
+  std::fill(f_.begin(), f_.end(), 0.0);
+  std::fill(fv_.begin(), fv_.end(), 0.0);
+  t.add_forces(view(sys, xn_, zeros_), f_);
+  t.add_forces(view(sys, xn_, vel_), fv_);
+  for (std::size_t k = 0; k < total; ++k)
+    if (fv_[k] != f_[k])
+      throw InputError("newton euler: the term '" + std::string(t.name()) +
+                       "' has velocity-dependent forces but no dissipation potential (ForceTerm::dissipative), which "
+                       "backward Euler as an incremental potential needs");
 }
 
 StateView NewtonEuler::view(const System& sys, std::span<const double> q, std::span<const double> vel) const {
@@ -104,33 +120,24 @@ double NewtonEuler::evaluate(const System& sys, std::span<const double> q, bool 
   phi *= 0.5 / (h_ * h_);
   for (const auto& t : sys.terms()) phi += t->potential_energy(s);
   if (!want_gradient && !damped_) return phi;
-  // f_ = F(q, v) (when the gradient is wanted). With damping, the velocity-dependent terms go to fv_ = their F(q, v) and
-  // f0_ = their F(q, 0), then F_d = F(q, v) - F(q, 0) = fv_ - f0_ (the other terms cancel
-  // in that difference: they are evaluated once) and f_ += fv_.
+  // f_ = F(q, v) of the terms without dissipation; a dissipative term contributes its
+  // elastic part F(q, 0) and its damping at the lagged positions, F(x_n, v) - F(x_n, 0) (the
+  // last sum in f0_, from prepare()), and h Ψ(x_n, v) to Φ, whose q-gradient that damping is.
   std::fill(f_.begin(), f_.end(), 0.0);
-  if (damped_) {
-    std::fill(fv_.begin(), fv_.end(), 0.0);
-    std::fill(f0_.begin(), f0_.end(), 0.0);
-  }
+  const StateView lagged = view(sys, xn_, vel_);
   for (const auto& t : sys.terms()) {
-    if (!damped_ || !t->velocity_dependent()) {
-      if (want_gradient) t->add_forces(s, f_);  // else only D is wanted
+    if (!t->dissipative()) {
+      if (want_gradient) t->add_forces(s, f_);
       continue;
     }
-    t->add_forces(s, fv_);
-    t->add_forces(view(sys, q, zeros_), f0_);
-  }
-  if (damped_) {
-    // D = -½ Δq·F_d.
-    double d = 0.0;
-    for (std::size_t k = 0; k < n; ++k) {
-      d -= free_[k] * (q[k] - xn_[k]) * (fv_[k] - f0_[k]);
-      f_[k] += fv_[k];
-    }
-    phi += 0.5 * d;
+    phi += h_ * t->dissipation(lagged);
+    if (!want_gradient) continue;
+    t->add_forces(view(sys, q, zeros_), f_);
+    t->add_forces(lagged, f_);
   }
   if (want_gradient)
-    for (std::size_t k = 0; k < n; ++k) g_[k] = free_[k] * (inertia_[k] * (q[k] - qhat_[k]) / (h_ * h_) - f_[k]);
+    for (std::size_t k = 0; k < n; ++k)
+      g_[k] = free_[k] * (inertia_[k] * (q[k] - qhat_[k]) / (h_ * h_) - (f_[k] - f0_[k]));
   return phi;
 }
 

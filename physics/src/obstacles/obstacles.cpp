@@ -257,6 +257,24 @@ double Obstacles::potential_energy(const StateView& s) const {
   return E;
 }
 
+double Obstacles::dissipation(const StateView& s) const {
+  if (!has_friction()) return 0.0;
+  ensure_lambda(s);
+  double psi = 0;
+  for (Index i = 0; i < s.size(); ++i) {
+    if (s.mass[i] == 0) continue;
+    const Vec3 v = node_vec(s.v, i);
+    for (std::size_t o = 0; o < shapes_.size(); ++o) {
+      const Plane* p = std::get_if<Plane>(&shapes_[o]);
+      const double lam = p ? lambda_[i * shapes_.size() + o] : 0.0;
+      if (!(lam > 0)) continue;
+      const double y = (v - p->normal.dot(v) * p->normal).norm() / eps_v_;
+      psi += p->friction * lam * eps_v_ * (y < 1 ? y * y - y * y * y / 3 : y - 1.0 / 3);
+    }
+  }
+  return psi;
+}
+
 void Obstacles::add_jacobians(const StateView& s, const JacobianRequest& req) const {
   const bool fr = has_friction();
   if (fr) ensure_lambda(s);

@@ -77,9 +77,16 @@ ContinuumParts build_continuum(const Scene& scene, const std::vector<physics::Ma
 /// changes nothing. O(tetrahedra + triangles + hinges).
 void follow_cut(const ContinuumParts& parts, const physics::MssModel<3>& model);
 
-/// The first material director m1 of each listed element's rod edge at the current state (the
-/// zero vector for an element that is not a rod segment): the rods' material frame for output.
-std::vector<Point3> rod_directors(const ContinuumParts& parts, const physics::MssModel<3>& model,
-                                  std::span<const physics::Index> elements);
+/// The rods for .vtu output: each rod as the chain of its nodes in order (a closed rod's first
+/// node repeated at its end: one VTK poly-line per rod), and per model node the rods' material
+/// frame there (zero vectors off rods). The frame lives on edges; at an inner node m1 is the
+/// mean of its two edges' first directors, made normal to the node's tangent t (the mean of
+/// the two unit edge tangents) and unit, m2 = t × m1; an end node takes its edge's frame. A
+/// node on two rods keeps the frame of the first. O(rod nodes).
+struct RodOutput {
+  std::vector<std::vector<physics::Index>> chains;  ///< per rod, its nodes along the poly-line
+  std::vector<Point3> m1, m2;                       ///< per model node
+};
+RodOutput rod_output(const ContinuumParts& parts, const physics::MssModel<3>& model);
 
 }  // namespace sewn::app

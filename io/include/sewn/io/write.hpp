@@ -34,6 +34,9 @@ struct CellsView {
   std::span<const CellType> types;
   std::span<const std::uint32_t> offsets;  ///< types.size() + 1 entries, offsets[0] = 0
   std::span<const std::uint32_t> conn;
+  /// Empty, or per cell: non-zero for a VTK poly-line (type 4) through all of the cell's points
+  /// in order (its type must be segment; two or more points), such as a whole rod.
+  std::span<const std::uint8_t> poly_line = {};
   /// The cells of an IndexedMesh (which must outlive the view).
   static CellsView of(const IndexedMesh& m) { return {m.types, m.offsets, m.conn}; }
   /// Number of cells.

@@ -38,6 +38,9 @@ class MassDamping final : public ForceTerm {
   void set_coefficient(double c);
   void add_forces(const StateView& s, std::span<double> f) const override;
   [[nodiscard]] double potential_energy(const StateView& /*s*/) const override { return 0.0; }
+  [[nodiscard]] bool dissipative() const override { return true; }
+  /// Ψ = ½ c Σ m_i |V_i|². O(n).
+  [[nodiscard]] double dissipation(const StateView& s) const override;
   void add_jacobians(const StateView& s, const JacobianRequest& req) const override;
   void add_stability_rows(const StateView& s, StabilityRows& rows) const override;
 

@@ -172,11 +172,25 @@ class ForceTerm {
     add_forces(s, f);
   }
   /// False if this term's forces depend on the positions and angles only, never on s.v or
-  /// s.angle_rates. NewtonEuler's damping potential needs F(q, v) - F(q, 0): it evaluates only
-  /// the velocity-dependent terms twice (with Rayleigh damping, the shells and rods were
-  /// evaluated twice for a mass-proportional force). Default true: a term that does not say is
-  /// evaluated at both velocities, which is always right, only slower.
+  /// s.angle_rates. NewtonEuler evaluates only the velocity-dependent terms at a second
+  /// velocity, and probes the ones without a dissipation potential (below). Default true: a term
+  /// that does not say is evaluated at both velocities, which is always right, only slower.
   [[nodiscard]] virtual bool velocity_dependent() const { return true; }
+  /// True if this term's velocity-dependent forces derive from dissipation() (below). NewtonEuler
+  /// needs it of every term whose forces depend on velocity: backward Euler as an incremental
+  /// potential has no other way to include a force that is not linear in v.
+  [[nodiscard]] virtual bool dissipative() const { return false; }
+  /// The dissipation potential Ψ(x, v) ≥ 0 at s, convex in v with Ψ(x, 0) = 0, whose velocity
+  /// gradient is minus this term's velocity-dependent forces and whose velocity Hessian is minus
+  /// their velocity Jacobian:
+  ///     -∂Ψ/∂v = F(x, v) - F(x, 0)  (add_forces at s and at s with zero velocities),
+  ///     -∂²Ψ/∂v² = ∂F/∂v           (the cv part of add_jacobians),
+  /// with any history the forces read (friction's normal force) as they read it. So a term
+  /// supplies only Ψ's value; its gradient and Hessian are the forces and Jacobians it already
+  /// has. Linear damping F = -C(x) v has Ψ = ½ vᵀC(x)v; smoothed Coulomb friction
+  /// μλ ε_v F1(|v_T|/ε_v). NewtonEuler adds h Ψ(x_n, v) to Φ, the positions lagged at the
+  /// step's start (PHYSICS_NOTES §3.4). Cost: one pass over the elements.
+  [[nodiscard]] virtual double dissipation(const StateView& /*s*/) const { return 0.0; }
   /// Potential energy at state s. Cost: one pass over the elements.
   [[nodiscard]] virtual double potential_energy(const StateView& s) const = 0;
   [[nodiscard]] virtual EnergyKind energy_kind() const { return EnergyKind::internal; }

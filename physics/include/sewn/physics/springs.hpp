@@ -93,6 +93,10 @@ class Springs final : public ForceTerm {
   void add_forces(const StateView& s, std::span<double> f) const override;
   void set_forces(const StateView& s, std::span<double> f) const override;
   [[nodiscard]] double potential_energy(const StateView& s) const override;
+  [[nodiscard]] bool dissipative() const override { return damping_ != SpringDamping::none; }
+  /// Ψ = Σ ½ γ (ΔV·U)² (viscous) or Σ ½ β ΔVᵀK_sΔV (Rayleigh), degenerate springs left out as
+  /// their forces are. O(springs).
+  [[nodiscard]] double dissipation(const StateView& s) const override;
   [[nodiscard]] double energy_scale() const override;
   void collect_pairs(std::vector<NodePair>& out) const override;
   void bind_pattern(const BlockMatrix& pattern) override;

@@ -4,10 +4,14 @@
 //     q_{n+1} = argmin Φ(q),  Φ(q) = (1/2h²)(q - q̂)ᵀM(q - q̂) + E(q) + D(q),  q̂ = q_n + h v_n,
 // then sets v_{n+1} = (q_{n+1} - q_n)/h. E is the sum of the terms' potentials (external
 // fields such as gravity included: that is the -f_extᵀq part). Velocity-dependent forces
-// (MassDamping, spring damping) are evaluated at v = (q - q_n)/h; they enter the gradient
-// exactly and Φ through D(q) = -½(q - q_n)·F_d(q, v), which is the Rayleigh potential
-// (1/2h)(q - q_n)ᵀC(q - q_n) when F_d = -Cv is linear (the probe at the start of a step skips
-// D when no term depends on velocity).
+// (MassDamping, spring damping, friction on obstacles) enter through the terms' dissipation
+// potentials (ForceTerm::dissipation): D(q) = h Σ Ψ(x_n, v), v = (q - q_n)/h, the positions
+// lagged at the step's start (a spring's damping direction, friction's normal force frozen
+// as IPC does), so that ∂D/∂q = -F_d(x_n, v) exactly; for a linear damping F_d = -Cv it is the
+// Rayleigh potential (1/2h)(q - q_n)ᵀC(q - q_n). Newton's matrix takes the damping's ∂F/∂v at
+// q rather than x_n (one assembly; they differ only where a spring turns within the step). A
+// term whose forces depend on velocity without a dissipation potential is refused
+// (InputError): Φ would not be its integral.
 //
 // Newton: g = M(q - q̂)/h² - F(q, v), H = M/h² - ∂F/∂x - (1/h)∂F/∂v with every element Hessian
 // PSD-projected (JacobianOptions::project_element_hessians, clamp_compression); H p = -g is
@@ -140,6 +144,8 @@ class NewtonEuler {
  private:
   struct LdltCache;
   void prepare(System& sys, double h);
+  // Throws InputError if t's forces at x_n change with the velocity (t has no dissipation potential).
+  void probe_velocity_dependence(const System& sys, const ForceTerm& t);
   // The state view of flat arrays q, vel (positions, then angles).
   [[nodiscard]] StateView view(const System& sys, std::span<const double> q, std::span<const double> vel) const;
   [[nodiscard]] std::string describe_dof(std::size_t k) const;

@@ -95,8 +95,12 @@ class Obstacles final : public ForceTerm {
   [[nodiscard]] std::string_view name() const override { return "obstacles"; }
   /// Penalty and friction forces. O(nodes · obstacles).
   void add_forces(const StateView& s, std::span<double> f) const override;
-  /// Σ ½ k d² (friction has no potential). O(nodes · obstacles).
+  /// Σ ½ k d² (friction has no potential energy: it has a dissipation potential). O(nodes · obstacles).
   [[nodiscard]] double potential_energy(const StateView& s) const override;
+  [[nodiscard]] bool dissipative() const override { return has_friction(); }
+  /// Friction's Ψ = Σ μλ ε_v F1(|v_T|/ε_v), F1(y) = y² − y³/3 below 1 and y − 1/3 above
+  /// (F1' = f1), λ as the forces read it. O(nodes · obstacles).
+  [[nodiscard]] double dissipation(const StateView& s) const override;
   /// Diagonal blocks only: −k(∇d∇dᵀ + d∇²d) in x, friction's ∂F/∂v in v. O(nodes · obstacles).
   void add_jacobians(const StateView& s, const JacobianRequest& req) const override;
   void add_stability_rows(const StateView& s, StabilityRows& rows) const override;
