@@ -34,7 +34,8 @@ void set_thread_count(int threads);
 /// num_threads(4), which neither OMP_NUM_THREADS nor omp_set_num_threads() overrides: a "single
 /// thread" run then woke three more threads for every supernode (35 % of the frisbee's CPU time
 /// went to their wake-ups and spins). Nests (restores the previous setting); not thread-safe,
-/// like the solvers it guards. O(1).
+/// like the solvers it guards. It sets our OpenMP runtime's setting: with g++ that is the
+/// libgomp CHOLMOD uses; a clang build (libomp) cannot reach CHOLMOD's regions this way. O(1).
 class SerialLibraryRegions {
  public:
   SerialLibraryRegions();
