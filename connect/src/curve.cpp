@@ -90,6 +90,121 @@ struct Angles {
   bool degenerate = false;
 };
 
+// What the twist needs of a connection (EdgeConnection's members).
+struct EdgeView {
+  Index a;
+  const EdgeSide& m;
+  const EdgeSide& n;
+  int extra_m;
+  double sign_n, accepted;
+};
+
+// δ at q (stencil order; any scalar) by `update`.
+template <class T, class Q>
+Angles<T> edge_twist(const EdgeView& c, const Q& q, TwistUpdate update) {
+  using std::cos;
+  using std::sin;
+  const V3<T> d = vec_at<T>(q, 3) - vec_at<T>(q, 0);
+  const double dd = detail::value_of(detail::dot(d, d));
+  const V3<T> e = detail::normalized(d);
+  const SideFrame<T> fm = side_frame<T>(c.m, c.a, q, 6, e);
+  SideFrame<T> fn = side_frame<T>(c.n, c.a, q, 6 + c.extra_m, e);
+  fn.m1 = T(c.sign_n) * fn.m1;
+  Angles<T> out{signed_angle(fm.m1, fn.m1, e), 0.0, fm.degenerate || fn.degenerate || !(dd > 0)};
+  out.raw = detail::value_of(out.twist);
+  if (update == TwistUpdate::incremental_i) {
+    out.twist = out.twist + T(full_turn * std::round((c.accepted - out.raw) / full_turn));
+  } else if (update == TwistUpdate::incremental_ii) {
+    // Turn m1 by the accepted δ first: what is left is the step's increment (< π).
+    const V3<T> m1t = cos(T(c.accepted)) * fm.m1 + sin(T(c.accepted)) * detail::cross(e, fm.m1);
+    out.twist = T(c.accepted) + signed_angle(m1t, fn.m1, e);
+  }
+  return out;
+}
+
+// ∂δ/∂θ of a rod side: m1 turns by θ about its tangent t = ±e, i.e. by ±θ about e; δ is the
+// angle from m1 to n1, so it falls by that on side m and rises by it on side n (the sign rule
+// that flips n1 does not turn it). 0 if the side is not a rod.
+double twist_rate(const EdgeSide& side, Index a, int which) {
+  const auto* r = std::get_if<RodEdgeSide>(&side);
+  if (!r) return 0;
+  const double along = r->from == a ? 1.0 : -1.0;
+  return which == 0 ? -along : along;
+}
+
+// EdgeDerivatives::reduced: δ differentiated in y = the stencil's positions other than x_a,
+// relative to x_a (J's directions: 3 per position block after x_a), the θ slots exactly; then
+// with c = k l̄ and dt = δ − δ̄: dE/dq = c dt ∇δ, d²E/dq² = c (∇δ ∇δᵀ + dt ∇²δ), ∇δ = D ∇_y δ
+// with D the map y → q (x_a's rows minus the sum of the others').
+template <class J>
+void reduced_derivatives(const EdgeView& c, const Eigen::VectorXd& q, int extra_n, TwistUpdate update, double factor,
+                         double dt, Eigen::VectorXd& gradient, Eigen::MatrixXd* hessian) {
+  const int n = 6 + c.extra_m + extra_n;
+  // Each stencil slot's reduced direction: -1 for x_a and θ slots (handled apart).
+  std::array<int, edge_max_dofs> dir{};
+  std::array<int, edge_max_dofs> axis{};     // a position slot's axis (0, 1, 2)
+  std::array<double, edge_max_dofs> rate{};  // ∂δ/∂θ at θ slots
+  std::array<J, edge_max_dofs> qa;
+  int r = 0;
+  const Vec3 xa = q.segment<3>(0);
+  auto position_block = [&](int at) {
+    for (int k = 0; k < 3; ++k) {
+      const auto s = static_cast<std::size_t>(at + k);
+      dir[s] = at == 0 ? -1 : r;
+      axis[s] = k;
+      qa[s] = at == 0 ? J(0.0) : J::variable(q[at + k] - xa[k], r);
+      if (at != 0) ++r;
+    }
+  };
+  position_block(0);
+  position_block(3);
+  int at = 6;
+  for (int which = 0; which < 2; ++which) {
+    const EdgeSide& side = which == 0 ? c.m : c.n;
+    const int extra = which == 0 ? c.extra_m : extra_n;
+    if (std::holds_alternative<RodEdgeSide>(side)) {
+      const auto s = static_cast<std::size_t>(at);
+      dir[s] = -1;
+      rate[s] = twist_rate(side, c.a, which);
+      qa[s] = J(q[at]);
+    } else {
+      for (int b = 0; b < extra; b += 3) position_block(at + b);
+    }
+    at += extra;
+  }
+  const J twist = edge_twist<J>(c, qa, update).twist;
+  // ∇δ in stencil order.
+  Eigen::VectorXd grad_delta = Eigen::VectorXd::Zero(n);
+  for (int i = 0; i < n; ++i) {
+    const auto s = static_cast<std::size_t>(i);
+    if (dir[s] >= 0) {
+      const double gi = twist.g[static_cast<std::size_t>(dir[s])];
+      grad_delta[i] = gi;
+      grad_delta[axis[s]] -= gi;  // x_a: minus the sum of the other positions' (same axis)
+    } else if (i >= 6) {
+      grad_delta[i] = rate[s];
+    }
+  }
+  gradient = factor * dt * grad_delta;
+  if (!hessian) return;
+  // ∇²δ: only position-position entries (δ is affine in θ); x_a's rows and columns by D.
+  Eigen::MatrixXd Hd = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 3; i < n; ++i) {
+    const int di = dir[static_cast<std::size_t>(i)], ai = axis[static_cast<std::size_t>(i)];
+    if (di < 0) continue;
+    for (int j = 3; j < n; ++j) {
+      const int dj = dir[static_cast<std::size_t>(j)], aj = axis[static_cast<std::size_t>(j)];
+      if (dj < 0) continue;
+      const double h = twist.hessian(di, dj);
+      Hd(i, j) += h;
+      Hd(ai, j) -= h;
+      Hd(i, aj) -= h;
+      Hd(ai, aj) += h;
+    }
+  }
+  *hessian = factor * (grad_delta * grad_delta.transpose() + dt * Hd);
+}
+
 }  // namespace
 
 std::vector<Index> edge_stencil_nodes(Index a, Index b, const EdgeSide& m, const EdgeSide& n) {
@@ -148,73 +263,54 @@ int EdgeConnection::angle_slot(int side) const {
 }
 
 EdgeEval EdgeConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update, bool want_gradient,
-                                  Eigen::MatrixXd* hessian) const {
+                                  Eigen::MatrixXd* hessian, EdgeDerivatives method) const {
   if (q.size() != num_dofs())
     fail_edge(name_, "configuration has " + std::to_string(q.size()) + " entries, the stencil " + std::to_string(num_dofs()));
   if (!q.allFinite()) fail_edge(name_, "configuration is not finite");
-  auto run = [&](const auto& qt) {
-    using T = std::decay_t<decltype(qt[0])>;
-    using std::cos;
-    using std::sin;
-    const V3<T> d = vec_at<T>(qt, 3) - vec_at<T>(qt, 0);
-    const double dd = detail::value_of(detail::dot(d, d));
-    const V3<T> e = detail::normalized(d);
-    const SideFrame<T> fm = side_frame<T>(m_, a_, qt, 6, e);
-    SideFrame<T> fn = side_frame<T>(n_, a_, qt, 6 + extra_m_, e);
-    fn.m1 = T(sign_n_) * fn.m1;
-    Angles<T> out{signed_angle(fm.m1, fn.m1, e), 0.0, fm.degenerate || fn.degenerate || !(dd > 0)};
-    out.raw = detail::value_of(out.twist);
-    if (update == TwistUpdate::incremental_i) {
-      out.twist = out.twist + T(full_turn * std::round((accepted_twist_ - out.raw) / full_turn));
-    } else if (update == TwistUpdate::incremental_ii) {
-      // Turn m1 by the accepted δ first: what is left is the step's increment (< π).
-      const V3<T> m1t = cos(T(accepted_twist_)) * fm.m1 + sin(T(accepted_twist_)) * detail::cross(e, fm.m1);
-      out.twist = T(accepted_twist_) + signed_angle(m1t, fn.m1, e);
-    }
-    const T dt = out.twist - T(rest_twist_);
-    const T energy = T(0.5 * k_ * rest_length_) * dt * dt;
-    return std::pair{out, energy};
-  };
+  const EdgeView view{a_, m_, n_, extra_m_, sign_n_, accepted_twist_};
+  const double factor = k_ * rest_length_;  // E = ½ factor (δ − δ̄)²
   EdgeEval out;
+  const Angles<double> angles = edge_twist<double>(view, q, update);
+  out.twist = angles.twist;
+  out.twist_raw = angles.raw;
+  out.degenerate = angles.degenerate;
+  const double dt = out.twist - rest_twist_;
+  out.energy = 0.5 * factor * dt * dt;
+  if (!hessian && !want_gradient) return out;
   const int n = num_dofs();
-  auto finish = [&](const auto& result) {
-    out.twist = detail::value_of(result.first.twist);
-    out.twist_raw = result.first.raw;
-    out.degenerate = result.first.degenerate;
-    out.energy = detail::value_of(result.second);
-  };
-  if (hessian || want_gradient) {
-    auto differentiate = [&](auto tag) {
-      using J = decltype(tag);
-      std::array<J, edge_max_dofs> qa;
-      for (int i = 0; i < n; ++i) qa[static_cast<std::size_t>(i)] = J::variable(q[i], i);
-      const auto result = run(qa);
-      finish(result);
-      out.gradient.resize(n);
-      for (int i = 0; i < n; ++i) out.gradient[i] = result.second.g[static_cast<std::size_t>(i)];
-      if (hessian) {
-        hessian->resize(n, n);
-        for (int i = 0; i < n; ++i)
-          for (int j = 0; j < n; ++j) (*hessian)(i, j) = result.second.hessian(i, j);
-      }
-    };
-    // In as few directions as the stencil needs (a Hessian costs their square): a rod edge
-    // with a face (10: the frisbee's and the toy tunnel's rims), a rod or face on each side (12),
-    // a hinge (18). The forces too, which every line-search trial evaluates.
-    if (hessian && n <= 10)
-      differentiate(detail::Jet<10, true>{});
-    else if (hessian && n <= 12)
-      differentiate(detail::Jet<12, true>{});
+  if (method == EdgeDerivatives::reduced) {
+    // Reduced directions: the positions after x_a (n − 3 minus the θ slots). A Hessian costs
+    // their square: a rod along a face has 6 (the frisbee's and the toy tunnel's rims), two
+    // faces or a rod and a hinge 9, a hinge and a face 12, two hinges 15.
+    const int thetas = (std::holds_alternative<RodEdgeSide>(m_) ? 1 : 0) + (std::holds_alternative<RodEdgeSide>(n_) ? 1 : 0);
+    const int r = n - 3 - thetas;
+    auto run = [&](auto tag) { reduced_derivatives<decltype(tag)>(view, q, extra_n_, update, factor, dt, out.gradient, hessian); };
+    if (hessian && r <= 6)
+      run(detail::Jet<6, true>{});
+    else if (hessian && r <= 9)
+      run(detail::Jet<9, true>{});
     else if (hessian)
-      differentiate(detail::Jet<edge_max_dofs, true>{});
-    else if (n <= 10)
-      differentiate(detail::Jet<10, false>{});
-    else if (n <= 12)
-      differentiate(detail::Jet<12, false>{});
+      run(detail::Jet<edge_max_dofs - 3, true>{});
+    else if (r <= 6)
+      run(detail::Jet<6, false>{});
+    else if (r <= 9)
+      run(detail::Jet<9, false>{});
     else
-      differentiate(detail::Jet<edge_max_dofs, false>{});
-  } else {
-    finish(run(q));
+      run(detail::Jet<edge_max_dofs - 3, false>{});
+    return out;
+  }
+  // The reference: E itself differentiated to second order in every stencil DOF.
+  using J = detail::Jet<edge_max_dofs, true>;
+  std::array<J, edge_max_dofs> qa;
+  for (int i = 0; i < n; ++i) qa[static_cast<std::size_t>(i)] = J::variable(q[i], i);
+  const J dtj = edge_twist<J>(view, qa, update).twist - J(rest_twist_);
+  const J energy = J(0.5 * factor) * dtj * dtj;
+  out.gradient.resize(n);
+  for (int i = 0; i < n; ++i) out.gradient[i] = energy.g[static_cast<std::size_t>(i)];
+  if (hessian) {
+    hessian->resize(n, n);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) (*hessian)(i, j) = energy.hessian(i, j);
   }
   return out;
 }

@@ -6,6 +6,10 @@
 
 #include "sewn/physics/errors.hpp"
 
+#ifdef SEWN_HAVE_OPENMP
+#include <omp.h>
+#endif
+
 namespace sewn::physics {
 
 namespace {
@@ -43,6 +47,36 @@ bool parallel_build() {
 #else
   return false;
 #endif
+}
+
+SerialLibraryRegions::SerialLibraryRegions() {
+#ifdef SEWN_HAVE_OPENMP
+  if (thread_count() != 1) return;
+  // No active level allowed: every parallel region, whatever its num_threads clause, gets a
+  // team of one (the only OpenMP setting a library's explicit clause does not override).
+  saved_ = omp_get_max_active_levels();
+  omp_set_max_active_levels(0);
+#endif
+}
+
+SerialLibraryRegions::~SerialLibraryRegions() {
+#ifdef SEWN_HAVE_OPENMP
+  if (saved_ >= 0) omp_set_max_active_levels(saved_);
+#endif
+}
+
+int library_team_size(int requested) {
+  int team = 1;
+#ifdef SEWN_HAVE_OPENMP
+#pragma omp parallel num_threads(requested)
+  {
+#pragma omp single
+    team = omp_get_num_threads();
+  }
+#else
+  (void)requested;
+#endif
+  return team;
 }
 
 }  // namespace sewn::physics

@@ -141,6 +141,53 @@ TEST_CASE("curve connection: gradient and Hessian against central differences, e
   }
 }
 
+TEST_CASE("curve connection: the reduced derivatives equal the whole stencil's AD, rod sides either way round") {
+  // EdgeDerivatives::reduced differentiates δ in the positions relative to x_a and takes a rod's
+  // θ exactly; the reference differentiates E in every DOF. Every pair of sides (rod-rod too),
+  // a rod side running b → a as well as a → b, every update, after accepted turns.
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0, 0.05);
+  auto side = [](Kind k, int which, bool reversed) -> EdgeSide {
+    if (k == Kind::rod && reversed) return RodEdgeSide{1, 0, Vec3(-1, 0, 0), Vec3(0, 0, 1)};
+    return make_side(k, which);
+  };
+  const std::vector<Kind> kinds{Kind::rod, Kind::face, Kind::hinge};
+  double worst_g = 0, worst_h = 0;
+  int cases = 0;
+  for (const Kind m : kinds)
+    for (const Kind n : kinds)
+      for (const bool reversed_m : {false, true})
+        for (const bool reversed_n : {false, true}) {
+          if ((reversed_m && m != Kind::rod) || (reversed_n && n != Kind::rod)) continue;
+          for (TwistUpdate u : {TwistUpdate::direct, TwistUpdate::incremental_i, TwistUpdate::incremental_ii}) {
+            const Eigen::VectorXd q0 = rest_state(m, n);
+            EdgeConnection c("reduced", 0, 1, side(m, 0, reversed_m), side(n, 1, reversed_n), k_line, q0);
+            for (int turn = 1; turn <= 6; ++turn) c.accept(turn_second(q0, m, n, 0.5 * turn), u);  // accepted δ ≈ 3 rad
+            for (int trial = 0; trial < 3; ++trial) {
+              Eigen::VectorXd q = turn_second(q0, m, n, 3.0 + 0.3 * trial);
+              for (double& v : q) v += noise(rng);
+              Eigen::MatrixXd H, H_ref;
+              const EdgeEval e = c.evaluate(q, u, true, &H);
+              const EdgeEval ref = c.evaluate(q, u, true, &H_ref, sewn::connect::EdgeDerivatives::whole_stencil);
+              const EdgeEval grad_only = c.evaluate(q, u, true);
+              REQUIRE(e.energy == ref.energy);
+              if (u != TwistUpdate::direct)  // past π (a reversed rod n turns δ the other way): followed
+                REQUIRE(std::abs(std::abs(e.twist - c.rest_twist()) - 3.0 - 0.3 * trial) < 0.6);
+              const double gs = ref.gradient.cwiseAbs().maxCoeff(), hs = H_ref.cwiseAbs().maxCoeff();
+              worst_g = std::max(worst_g, (e.gradient - ref.gradient).cwiseAbs().maxCoeff() / gs);
+              worst_g = std::max(worst_g, (grad_only.gradient - ref.gradient).cwiseAbs().maxCoeff() / gs);
+              worst_h = std::max(worst_h, (H - H_ref).cwiseAbs().maxCoeff() / hs);
+              CHECK((H - H.transpose()).cwiseAbs().maxCoeff() <= 1e-15 * hs);
+              ++cases;
+            }
+          }
+        }
+  INFO("reduced against whole-stencil AD over " << cases << " states: gradient " << worst_g << ", Hessian " << worst_h);
+  CHECK(cases == 3 * 3 * 16);
+  CHECK(worst_g < 1e-12);
+  CHECK(worst_h < 1e-12);
+}
+
 TEST_CASE("curve connection: incremental angles past pi and 3 pi, derivatives exact there; the direct one wraps") {
   for (const auto& kinds : {std::pair{Kind::rod, Kind::face}, std::pair{Kind::hinge, Kind::face}}) {
     const Kind m = kinds.first, n = kinds.second;  // named: clang 14 cannot capture bindings (INFO)

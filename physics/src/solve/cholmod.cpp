@@ -15,6 +15,7 @@
 #include "kept_pcg.hpp"
 #include "sewn/physics/aligned.hpp"
 #include "sewn/physics/errors.hpp"
+#include "sewn/physics/threads.hpp"
 
 namespace sewn::physics::solve::detail {
 
@@ -152,7 +153,11 @@ class Factorization {
       L_ = cholmod_copy_factor(symbolic_, &c_);
       if (!L_) throw SolverError(std::string(who) + ": out of memory copying the symbolic analysis", 0, 0);
     }
-    const bool ok = cholmod_factorize(K_, L_, &c_) && c_.status == CHOLMOD_OK;
+    bool ok = false;
+    {
+      const SerialLibraryRegions serial;  // one thread means one: CHOLMOD's own regions too
+      ok = cholmod_factorize(K_, L_, &c_) && c_.status == CHOLMOD_OK;
+    }
     const std::size_t bad_pivot = ok ? nonpositive_pivot() : L_->minor;
     if (!ok && c_.status != CHOLMOD_NOT_POSDEF)
       throw SolverError(std::string(who) + ": CHOLMOD factorization failed (status " + std::to_string(c_.status) + ")", 0, 0);

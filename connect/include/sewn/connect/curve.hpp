@@ -55,6 +55,14 @@ struct EdgeEval {
   Eigen::VectorXd gradient;
 };
 
+/// How evaluate() differentiates. `reduced`: δ alone, in the positions relative to x_a (the
+/// energy does not change when the whole stencil moves, so x_a's derivatives are minus the sum
+/// of the others'), a rod side's θ exactly (δ is affine in it: ∂δ/∂θ = ∓1, no cross terms),
+/// then E = ½kl̄(δ − δ̄)² by the chain rule — 6 AD directions for a rod along a face instead of
+/// 10. `whole_stencil`: second-order AD of E in every stencil DOF at once (18 directions), the
+/// reference the tests compare against. Both exact to round-off.
+enum class EdgeDerivatives { reduced, whole_stencil };
+
 class EdgeConnection {
  public:
   /// Joins sides m and n along the edge (a, b) with stiffness `k_per_length` (N/rad, ≥ 0) at
@@ -80,10 +88,12 @@ class EdgeConnection {
   [[nodiscard]] double second_sign() const { return sign_n_; }
 
   /// Energy and angles at q; with `want_gradient` dE/dq, with `hessian` also d²E/dq² (exact,
-  /// forward-mode AD in one pass; symmetric, not projected). Throws physics::InputError naming
-  /// the connection if q has the wrong size or is not finite. O(1).
+  /// forward-mode AD by `method`; symmetric, not projected). The values are the same whatever
+  /// is asked. Throws physics::InputError naming the connection if q has the wrong size or is
+  /// not finite. O(1).
   [[nodiscard]] EdgeEval evaluate(const Eigen::VectorXd& q, TwistUpdate update, bool want_gradient,
-                                  Eigen::MatrixXd* hessian = nullptr) const;
+                                  Eigen::MatrixXd* hessian = nullptr,
+                                  EdgeDerivatives method = EdgeDerivatives::reduced) const;
   /// After an accepted step at q: the accepted δ moves on (by `update`) and a rod side's frame
   /// history is transported to its current tangent (as Rod::update_frames does). O(1).
   void accept(const Eigen::VectorXd& q, TwistUpdate update);

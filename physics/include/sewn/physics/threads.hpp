@@ -29,4 +29,26 @@ void set_thread_count(int threads);
 /// True if this build runs ranges in parallel (OpenMP found at build time).
 [[nodiscard]] bool parallel_build();
 
+/// While alive, with thread_count() == 1, the OpenMP regions of the libraries we call run on
+/// the calling thread alone. CHOLMOD's supernodal factorization opens its regions with a fixed
+/// num_threads(4), which neither OMP_NUM_THREADS nor omp_set_num_threads() overrides: a "single
+/// thread" run then woke three more threads for every supernode (35 % of the frisbee's CPU time
+/// went to their wake-ups and spins). Nests (restores the previous setting); not thread-safe,
+/// like the solvers it guards. It sets our OpenMP runtime's setting: with g++ that is the
+/// libgomp CHOLMOD uses; a clang build (libomp) cannot reach CHOLMOD's regions this way. O(1).
+class SerialLibraryRegions {
+ public:
+  SerialLibraryRegions();
+  ~SerialLibraryRegions();
+  SerialLibraryRegions(const SerialLibraryRegions&) = delete;
+  SerialLibraryRegions& operator=(const SerialLibraryRegions&) = delete;
+
+ private:
+  int saved_ = -1;  // the max-active-levels setting to restore, -1: unchanged
+};
+
+/// The team an OpenMP region opened here with num_threads(requested) gets (1 without OpenMP):
+/// what SerialLibraryRegions controls, for tests and diagnostics. O(one region).
+[[nodiscard]] int library_team_size(int requested);
+
 }  // namespace sewn::physics
