@@ -201,6 +201,7 @@ void CMap<D, A...>::subdivide_hexahedra(Mid&& middle) {
   std::vector<std::uint32_t> attr;
   if constexpr (has_attribute<0>) {
     attr.reserve(values.size());
+    store<0>().values.reserve(store<0>().values.capacity() + values.size());  // one growth, not several
     for (auto& v : values) attr.push_back(store<0>().values.create(std::move(v)));
   }
   const std::uint32_t fresh_count = 168 * hexes;
