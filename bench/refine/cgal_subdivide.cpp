@@ -162,7 +162,7 @@ void bench_subdivide(benchmark::State& st, const SubdivisionCase& c) {
 
 void register_peer() {
   // the same peer twice: against refine_all (all/<beam>, ours with the physics) and against our
-  // map's insertions alone (map/<beam>, map_subdivide.cpp: the like-for-like row)
+  // map alone (map/<beam>, map_subdivide.cpp: the map and its points, by the batch pass)
   for (const SubdivisionCase& c : subdivision_cases())
     for (const std::string against : {"all/", "map/"})
       peer("refine", "subdivision/" + against + c.name.substr(c.name.find('/') + 1),

@@ -391,6 +391,20 @@ class CMap {
     return with_new_vertex<I>(&CMap::split_edge, d, std::move(v));
   }
   /// True if insert_edge_in_face(a, b) may be called: a ≠ b, both live, b on a's closed β1 cycle.
+  /// Subdivides every hexahedron of a 3-map 1:8 in one pass: each edge split at a new vertex,
+  /// each face cut in 4 through a new centre, each volume cut by its three middle planes through
+  /// a new centre, as the insertions (insert_vertex_in_edge, insert_edge_in_face,
+  /// insert_face_in_volume) would make it, without their per-dart work: the new darts are
+  /// allocated at once and linked from a per-hexahedron table. The map's darts are kept (each
+  /// becomes the first half of its edge, in the child at its source). With vertex attributes,
+  /// `middle(a, b)` gives the value of the vertex between two vertex values: an edge's midpoint
+  /// from its ends, a face's centre from two opposite midpoints, a volume's from two opposite
+  /// face centres. Every volume must be a closed hexahedron of 6 quads (TopologyError, the map
+  /// unchanged, otherwise); volumes may be 3-free. Maps with vertex attributes only, no hooks
+  /// called. O(darts).
+  template <class Mid>
+  void subdivide_hexahedra(Mid&& middle);
+
   [[nodiscard]] bool is_insertable_edge_in_face(Dart a, Dart b) const;
   /// Splits the face of a and b by a new edge from a's start vertex to b's start vertex (D ≥ 2;
   /// also across every βj-sewn copy of the face, j ≥ 3). Returns the new dart that starts at a's
@@ -758,3 +772,4 @@ class CMap {
 #include "sewn/cmap/detail/cmap_insert.hpp"
 #include "sewn/cmap/detail/cmap_remove.hpp"
 #include "sewn/cmap/detail/cmap_validate.hpp"
+#include "sewn/cmap/detail/cmap_subdivide.hpp"

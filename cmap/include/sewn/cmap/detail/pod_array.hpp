@@ -190,6 +190,12 @@ class PodArray {
     std::fill(data_ + std::min(n, size_), data_ + n, v);
     size_ = n;
   }
+  /// Resizes without writing the new elements: for a caller that writes every one of them next
+  /// (the map's batch subdivision; a fill first would pass over the memory twice).
+  void resize_uninitialised(std::size_t n) {
+    if (n > cap_) grow_for(n);
+    size_ = n;
+  }
   void assign(std::size_t n, const T& v) {
     size_ = 0;
     resize(n, v);
