@@ -17,7 +17,7 @@ namespace {
 
 // Σ col[i] · w[i] over n entries, float values widened to double; eight partial sums in a
 // fixed order, so that the result does not depend on the build's vectorisation.
-double dot(const float* __restrict col, const double* __restrict w, std::size_t n) {
+double dot_widened(const float* __restrict col, const double* __restrict w, std::size_t n) {
   double part[8] = {};
   const std::size_t n8 = n - n % 8;
   for (std::size_t i = 0; i < n8; i += 8)
@@ -100,7 +100,7 @@ void FloatSupernodalFactor::solve(std::span<const double> rhs, std::span<double>
     for (std::size_t i = nc; i < nr; ++i) w[i] = y[rows[i]];
     for (std::size_t j = nc; j-- > 0;) {
       const float* col = blk + j * nr;
-      w[j] = (w[j] - dot(col + j + 1, w + j + 1, nr - j - 1)) / static_cast<double>(col[j]);
+      w[j] = (w[j] - dot_widened(col + j + 1, w + j + 1, nr - j - 1)) / static_cast<double>(col[j]);
     }
     std::copy_n(w, nc, y + c0);
   }
