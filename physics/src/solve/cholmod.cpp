@@ -5,6 +5,9 @@
 // axes.
 
 #include <cholmod.h>
+#ifdef SEWN_HAVE_OPENMP
+#include <omp.h>
+#endif
 
 #include <algorithm>
 #include <cstring>
@@ -30,6 +33,23 @@ constexpr double factor_flop_speedup = 4.0;
 #else
 constexpr double factor_flop_speedup = 1.0;
 #endif
+
+// CHOLMOD's supernodal factorization opens OpenMP regions of a team size fixed in its build:
+// perf of bench_solve's 8x8x10 beam showed 3 helper threads (Debian's libcholmod 3.0.14) taking
+// 28 % of the samples, mostly spinning in libgomp, and the stepping thread 6 % in libgomp too,
+// on a machine whose 2 cores are shared. The solver layer runs its CHOLMOD backends on the
+// calling thread (docs/solvers.md, Threads): while one lives, no OpenMP region of this thread
+// forks (max-active-levels 0; our kernels' ranges still all run, see parallel/ranges.hpp).
+class SerialOpenMp {
+ public:
+#ifdef SEWN_HAVE_OPENMP
+  SerialOpenMp() : saved_(omp_get_max_active_levels()) { omp_set_max_active_levels(0); }
+  ~SerialOpenMp() { omp_set_max_active_levels(saved_); }
+
+ private:
+  int saved_;
+#endif
+};
 
 // One CHOLMOD workspace, the filtered matrix in its upper-triangular CSC form, and its factor.
 class Factorization {
@@ -142,7 +162,11 @@ class Factorization {
   /// where a pivot was not positive.
   void factorize(const char* who, bool keep_values) {
     valid_ = false;
-    const bool ok = cholmod_factorize(K_, L_, &c_) && c_.status == CHOLMOD_OK;
+    bool ok = false;
+    {
+      const SerialOpenMp serial;
+      ok = cholmod_factorize(K_, L_, &c_) && c_.status == CHOLMOD_OK;
+    }
     const std::size_t bad_pivot = ok ? nonpositive_pivot() : L_->minor;
     if (!ok && c_.status != CHOLMOD_NOT_POSDEF)
       throw SolverError(std::string(who) + ": CHOLMOD factorization failed (status " + std::to_string(c_.status) + ")", 0, 0);
