@@ -133,6 +133,29 @@ TEST_CASE("every backend solves the 8x8x10 beam's implicit system, with and with
   }
 }
 
+TEST_CASE("cholmod-pcg solves in single precision, and in double where float cannot hold the factor") {
+  if (!solve::available(solve::Backend::cholmod_pcg)) return;
+  auto mp = beam_8x8x10();
+  MssModel<3>& m = *mp;
+  assemble(m.system(), 1e-3);
+  const BlockMatrix& A0 = m.system().matrix();
+  const Problem p0 = random_problem(A0, &m.nodes(), 0.2, 11);
+  // The beam's factor is supernodal: solved on its single-precision copy, CG still reaches a
+  // tight tolerance in a few iterations. Scaled by 1e±90 (a model in extreme units), the
+  // factor's entries (~1e±45) overflow float or fall below its normal range: the solver must
+  // then solve in double, not return infinities or report a false breakdown.
+  for (double scale : {1.0, 1e90, 1e-90}) {
+    CAPTURE(scale);
+    BlockMatrix A = A0;
+    for (Index k = 0; k < A.num_blocks(); ++k) A.block(k) *= scale;
+    Problem p = p0;
+    for (double& v : p.b) v *= scale;
+    const auto r = check_backend(solve::Backend::cholmod_pcg, A, p, 1e-10);
+    CHECK(r.factorizations == 1);
+    CHECK(r.iterations <= 4);
+  }
+}
+
 TEST_CASE("every backend solves random SPD block matrices with random fixed axes") {
   for (unsigned seed = 1; seed <= 5; ++seed) {
     BlockMatrix A;

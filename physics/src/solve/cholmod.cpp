@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "backends.hpp"
+#include "float_factor.hpp"
 #include "kept_pcg.hpp"
 #include "sewn/physics/aligned.hpp"
 #include "sewn/physics/errors.hpp"
@@ -34,9 +35,9 @@ constexpr double factor_flop_speedup = 1.0;
 // One CHOLMOD workspace, the filtered matrix in its upper-triangular CSC form, and its factor.
 class Factorization {
  public:
-  /// simplicial_solves: after each numeric factorization, convert the factor to simplicial
-  /// form for the triangular solves (see factorize()); for a factor solved with many times.
-  explicit Factorization(bool simplicial_solves = true) : simplicial_solves_(simplicial_solves) {
+  /// single_solves: after each numeric factorization of a supernodal analysis, solve on a copy
+  /// of the factor in single precision (see factorize()); for a factor kept as a preconditioner.
+  explicit Factorization(bool single_solves = true) : single_solves_(single_solves) {
     cholmod_start(&c_);
     c_.print = 0;  // failures are reported by our exceptions, not on stderr
     // LLᵀ: a simplicial LDLᵀ would succeed on an indefinite matrix (only a zero pivot stops
@@ -128,12 +129,6 @@ class Factorization {
     free_factor();
     L_ = cholmod_analyze(K_, &c_);
     if (!L_) throw SolverError("cholmod: symbolic analysis failed (status " + std::to_string(c_.status) + ")", 0, 0);
-    // A supernodal analysis is kept aside: factorize() converts L_ to simplicial form and needs
-    // the supernodal structure back for the next factorization.
-    if (simplicial_solves_ && L_->is_super) {
-      symbolic_ = cholmod_copy_factor(L_, &c_);
-      if (!symbolic_) throw SolverError("cholmod: out of memory copying the symbolic analysis", 0, 0);
-    }
     // One PCG iteration: two triangular solves (2 flops per entry of L each), the product with
     // A (2 per stored scalar, both triangles) and the vector passes (~10 per unknown).
     const double n = static_cast<double>(L_->n), upper = static_cast<double>(src_.size());
@@ -148,11 +143,6 @@ class Factorization {
   /// where a pivot was not positive.
   void factorize(const char* who, bool keep_values) {
     valid_ = false;
-    if (symbolic_ && !L_->is_super) {  // converted after the last factorization
-      cholmod_free_factor(&L_, &c_);
-      L_ = cholmod_copy_factor(symbolic_, &c_);
-      if (!L_) throw SolverError(std::string(who) + ": out of memory copying the symbolic analysis", 0, 0);
-    }
     bool ok = false;
     {
       const SerialLibraryRegions serial;  // one thread means one: CHOLMOD's own regions too
@@ -170,12 +160,12 @@ class Factorization {
                             std::to_string(dof / 3) + ", axis " + "xyz"[dof % 3] + ")",
                         0, 0);
     }
-    // Measured (docs/solvers.md): on Debian's reference BLAS the supernodal triangular solves
-    // run at half the speed of the simplicial ones (0.51 against 0.23 ms on the 8x8x10 beam),
-    // while the supernodal factorization is the faster one; the conversion costs ~1/10 of a
-    // factorization (0.46 ms there), repaid by the second solve.
-    if (simplicial_solves_ && L_->is_super && !cholmod_change_factor(CHOLMOD_REAL, 1, 0, 1, 1, L_, &c_))
-      throw SolverError(std::string(who) + ": CHOLMOD could not convert its factor (status " + std::to_string(c_.status) + ")", 0, 0);
+    // The triangular solves are memory bound (docs/solvers.md, "The N = 8 cantilever"): in
+    // single precision they stream half the bytes (the N = 8 cantilever's step 1.7x faster in
+    // CPU time under load, CG's iterations 6.0 -> 6.2 a step), at the cost of one O(entries)
+    // copy per factorization. A simplicial analysis (small or very sparse matrices), or a factor
+    // whose values float cannot hold (assign() says), keeps CHOLMOD's own double solves.
+    if (!(single_solves_ && L_->is_super && single_.assign(*L_))) single_.clear();
     if (keep_values) factored_.assign(static_cast<const double*>(K_->x), static_cast<const double*>(K_->x) + src_.size());
     valid_ = true;
   }
@@ -207,6 +197,10 @@ class Factorization {
 
   /// out = K⁻¹ rhs (3n values each; may alias). Two triangular solves, no allocation once sized.
   void solve(std::span<const double> rhs, std::span<double> out) {
+    if (!single_.empty()) {
+      single_.solve(rhs, out);
+      return;
+    }
     cholmod_dense B{};
     B.nrow = rhs.size();
     B.ncol = 1;
@@ -232,21 +226,21 @@ class Factorization {
   }
   void free_factor() {
     if (L_) cholmod_free_factor(&L_, &c_);
-    if (symbolic_) cholmod_free_factor(&symbolic_, &c_);
+    single_.clear();
     valid_ = false;
   }
 
   cholmod_common c_{};
   cholmod_sparse* K_ = nullptr;
   cholmod_factor* L_ = nullptr;
-  cholmod_factor* symbolic_ = nullptr;  // the supernodal analysis, when L_ is converted after factoring
   cholmod_dense *X_ = nullptr, *Y_ = nullptr, *E_ = nullptr;
   std::uint64_t pattern_ = 0;
   std::vector<std::size_t> src_;  // per entry of K: its index in A's value array
   std::vector<int> col_of_;       // per entry of K: its column
   std::vector<double> factored_;  // K's values when last factored (direct backend)
   bool valid_ = false;
-  bool simplicial_solves_;
+  bool single_solves_;
+  FloatSupernodalFactor single_;  // L_'s values in single precision, when single_solves_ and L_ is supernodal
   double setup_cost_ = 0;
 };
 
@@ -330,7 +324,7 @@ class CholmodDirect final : public LinearSolver {
   }
 
  private:
-  Factorization f_{false};  // one or two solves per factorization: no conversion
+  Factorization f_{false};  // double solves: the refinement passes need the factor's full precision
   AlignedVector<double> xt_, r_;
 };
 

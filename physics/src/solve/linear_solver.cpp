@@ -96,13 +96,12 @@ Backend parse_backend(std::string_view name) {
 
 Backend default_backend(std::size_t nodes) {
   (void)nodes;
-  // Measured (docs/solvers.md: bench/solve and a profile, CPU time per implicit step at equal or
-  // better error): block-Jacobi CG is the fastest or within 20 % of it on every case, from the
-  // 1890-tet beam (480 nodes; cholmod-pcg 1.2x faster over 1000 steps, 10 % slower on the
-  // 8x8x10 beam) to the N = 8 cantilever at h = 10 ms (6561 nodes, 600 iterations a step, where
-  // a kept factor's two triangular solves cost as much as 90 block-Jacobi iterations and the
-  // others are 2-9x slower). Half of a small model's step is the Jacobian's assembly, which no
-  // solver changes. So the rule is: jacobi at every size measured.
+  // Measured (docs/solvers.md: bench/solve and profiles, CPU time per implicit step at equal or
+  // better error): cholmod-pcg (single-precision solves) wins on the N = 8 cantilever at
+  // h = 10 ms (6561 nodes, ~1.4x) and the 1890-tet beam (480 nodes), and loses on the 8x8x10
+  // beam (891 nodes) and on 16^3 at h = 0.1 ms (4913 nodes, 5.6x slower); 32^3 and the N = 16
+  // cantilever cannot hold its factor. What decides is stiffness against mass (block-Jacobi's
+  // iteration count), not the node count, so no size rule follows: jacobi at every size.
   return Backend::jacobi;
 }
 
