@@ -15,6 +15,11 @@
 #include "kept_pcg.hpp"
 #include "sewn/physics/aligned.hpp"
 #include "sewn/physics/errors.hpp"
+#include "sewn/physics/threads.hpp"
+
+#ifdef SEWN_HAVE_OPENMP
+#include <omp.h>
+#endif
 
 namespace sewn::physics::solve::detail {
 
@@ -29,6 +34,37 @@ constexpr double factor_flop_speedup = 4.0;
 #else
 constexpr double factor_flop_speedup = 1.0;
 #endif
+
+// CHOLMOD's supernodal factorization and its solves run OpenMP loops of their own, with a
+// thread count fixed when CHOLMOD was compiled (Debian's: 4) whatever the program asks: on this
+// 2-vCPU machine a one-thread run then forks 4 threads per large-enough supernode, which wait on
+// each other. Measured (docs/paper_scenes.md): 20 % of the sticky hand's and 15 % of the
+// umbrella's CPU time per frame, spent in libgomp's waits and thread switches. So while the
+// physics runs on one thread (sewn/physics/threads.hpp), every CHOLMOD call runs with no active
+// OpenMP level (max-active-levels 0: its parallel regions get one thread), restored after.
+// The ICV is per task (OpenMP 5), so other threads' regions are unaffected. CHOLMOD's results
+// do not depend on its thread count (its parallel loops copy and scatter, they do not reduce).
+class SerialCholmod {
+ public:
+  SerialCholmod() {
+#ifdef SEWN_HAVE_OPENMP
+    if (thread_count() == 1) {
+      saved_ = omp_get_max_active_levels();
+      omp_set_max_active_levels(0);
+    }
+#endif
+  }
+  ~SerialCholmod() {
+#ifdef SEWN_HAVE_OPENMP
+    if (saved_ >= 0) omp_set_max_active_levels(saved_);
+#endif
+  }
+  SerialCholmod(const SerialCholmod&) = delete;
+  SerialCholmod& operator=(const SerialCholmod&) = delete;
+
+ private:
+  int saved_ = -1;
+};
 
 // One CHOLMOD workspace, the filtered matrix in its upper-triangular CSC form, and its factor.
 class Factorization {
@@ -124,6 +160,7 @@ class Factorization {
 
   /// Symbolic analysis (fill-reducing ordering, elimination tree). Milliseconds.
   void analyse() {
+    const SerialCholmod serial;
     free_factor();
     L_ = cholmod_analyze(K_, &c_);
     if (!L_) throw SolverError("cholmod: symbolic analysis failed (status " + std::to_string(c_.status) + ")", 0, 0);
@@ -146,6 +183,7 @@ class Factorization {
   /// Numeric factorization of K's current values; throws SolverError naming the node and axis
   /// where a pivot was not positive.
   void factorize(const char* who, bool keep_values) {
+    const SerialCholmod serial;
     valid_ = false;
     if (symbolic_ && !L_->is_super) {  // converted after the last factorization
       cholmod_free_factor(&L_, &c_);
@@ -202,6 +240,7 @@ class Factorization {
 
   /// out = K⁻¹ rhs (3n values each; may alias). Two triangular solves, no allocation once sized.
   void solve(std::span<const double> rhs, std::span<double> out) {
+    const SerialCholmod serial;
     cholmod_dense B{};
     B.nrow = rhs.size();
     B.ncol = 1;
