@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,27 @@ constexpr double factor_flop_speedup = 4.0;
 #else
 constexpr double factor_flop_speedup = 1.0;
 #endif
+
+// Whether a factor solved with many times (cholmod-pcg) is converted to simplicial form for its
+// triangular solves. On Debian's reference BLAS the supernodal solves run at half the speed of
+// the simplicial ones (docs/solvers.md: 0.51 against 0.23 ms on the 8x8x10 beam), and the
+// conversion (~1/10 of a factorization) is repaid by the second solve. With OpenBLAS the
+// supernodal solves are the faster: the umbrella's (9702 unknowns, 2.0e6 entries in L) 4.2
+// against 6.6 ms a CG iteration, thread CPU time, the sticky hand's (621) equal within noise
+// (docs/paper_scenes.md), and the conversion is saved.
+#if defined(SEWN_CHOLMOD_BLAS_OPTIMIZED)
+constexpr bool simplicial_kept_solves = false;
+#else
+constexpr bool simplicial_kept_solves = true;
+#endif
+
+// The fill-reducing ordering: AMD, and where its factorization is large also METIS and nested
+// dissection, keeping the least fill. The umbrella's 9702 unknowns factor in 6.1e8 flops with
+// METIS against 7.8e8 with AMD (its analysis 30-53 ms against 9, once per pattern); on the
+// sticky hand (621 unknowns, 2.1e6 flops) all three find AMD's ordering, and trying the other
+// two cost 2.0-2.6 ms against 0.5, about three of its factorizations, for nothing. Above this
+// many flops (a factorization of a few ms with OpenBLAS) the search pays.
+constexpr double ordering_search_flops = 3e7;
 
 // CHOLMOD's supernodal factorization and its solves run OpenMP loops of their own, with a
 // thread count fixed when CHOLMOD was compiled (Debian's: 4) whatever the program asks: on this
@@ -71,19 +93,12 @@ class Factorization {
  public:
   /// simplicial_solves: after each numeric factorization, convert the factor to simplicial
   /// form for the triangular solves (see factorize()); for a factor solved with many times.
-  explicit Factorization(bool simplicial_solves = true) : simplicial_solves_(simplicial_solves) {
+  explicit Factorization(bool simplicial_solves = simplicial_kept_solves) : simplicial_solves_(simplicial_solves) {
     cholmod_start(&c_);
     c_.print = 0;  // failures are reported by our exceptions, not on stderr
     // LLᵀ: a simplicial LDLᵀ would succeed on an indefinite matrix (only a zero pivot stops
     // it), and indefiniteness is what must be reported.
     c_.final_ll = 1;
-    // Fill-reducing ordering: the least fill of AMD, METIS and nested dissection (by default
-    // CHOLMOD tries METIS only where AMD's fill is large). The analysis runs once per pattern;
-    // the umbrella's 9702 unknowns factor in 6.0e8 flops with nested dissection, 7.8e8 with AMD.
-    c_.nmethods = 3;
-    c_.method[0].ordering = CHOLMOD_AMD;
-    c_.method[1].ordering = CHOLMOD_METIS;
-    c_.method[2].ordering = CHOLMOD_NESDIS;
   }
   ~Factorization() {
     free_factor();
@@ -162,8 +177,15 @@ class Factorization {
   void analyse() {
     const SerialCholmod serial;
     free_factor();
-    L_ = cholmod_analyze(K_, &c_);
+    L_ = analyse_with({CHOLMOD_AMD});
     if (!L_) throw SolverError("cholmod: symbolic analysis failed (status " + std::to_string(c_.status) + ")", 0, 0);
+    if (c_.fl >= ordering_search_flops) {
+      // CHOLMOD keeps the least fill of the methods it tries; AMD's is then found again (ms).
+      cholmod_factor* best = analyse_with({CHOLMOD_AMD, CHOLMOD_METIS, CHOLMOD_NESDIS});
+      if (!best) throw SolverError("cholmod: symbolic analysis failed (status " + std::to_string(c_.status) + ")", 0, 0);
+      cholmod_free_factor(&L_, &c_);
+      L_ = best;
+    }
     // A supernodal analysis is kept aside: factorize() converts L_ to simplicial form and needs
     // the supernodal structure back for the next factorization.
     if (simplicial_solves_ && L_->is_super) {
@@ -263,6 +285,13 @@ class Factorization {
     for (std::size_t j = 0; j < L_->n; ++j)
       if (!(lx[lp[j]] > 0.0)) return j;
     return L_->n;
+  }
+  // cholmod_analyze with these orderings tried (c_.fl and c_.lnz then describe its choice).
+  cholmod_factor* analyse_with(std::initializer_list<int> orderings) {
+    c_.nmethods = static_cast<int>(orderings.size());
+    int k = 0;
+    for (const int o : orderings) c_.method[k++].ordering = o;
+    return cholmod_analyze(K_, &c_);
   }
   void free_factor() {
     if (L_) cholmod_free_factor(&L_, &c_);
