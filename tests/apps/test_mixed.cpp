@@ -402,6 +402,18 @@ TEST_CASE("connections of a mixed mesh: the flap's edge line is curves, the rod'
   CHECK(connections_json(hm)["skipped"] == hm.skipped);
 }
 
+// Runs the scene `j` (named `name` in messages) writing nothing; returns its summary.
+RunSummary run_quietly(const nlohmann::json& j, const std::string& name) {
+  Scene scene = parse_scene(j, name + ".json");
+  scene.write_picture = scene.write_vtu = scene.write_csv = false;
+  RunOptions o;
+  o.out = std::filesystem::temp_directory_path() / ("sewn_mixed_" + name + "_" + std::to_string(::getpid()));
+  o.quiet = true;
+  const RunSummary sum = run(scene, o);
+  std::filesystem::remove_all(o.out);
+  return sum;
+}
+
 // A helix of 16 rod edges hanging from its first edge, stepped by Newton with the scene's
 // `solver` (nothing else written).
 RunSummary run_helix(const std::string& solver) {
@@ -415,14 +427,7 @@ RunSummary run_helix(const std::string& solver) {
                       {"fixed", {{{"where", {{"type", "points"}, {"indices", {0, 1}}}}}}},
                       {"integrator", {{"type", "newton"}, {"step", 0.01}, {"solver", solver}, {"newton_tolerance", 1e-3}}},
                       {"duration", 0.05}};
-  Scene scene = parse_scene(j, "helix.json");
-  scene.write_picture = scene.write_vtu = scene.write_csv = false;
-  RunOptions o;
-  o.out = std::filesystem::temp_directory_path() / ("sewn_mixed_helix_" + std::to_string(::getpid()));
-  o.quiet = true;
-  const RunSummary sum = run(scene, o);
-  std::filesystem::remove_all(o.out);
-  return sum;
+  return run_quietly(j, "helix");
 }
 
 TEST_CASE("Newton's solver `auto` solves a scene with rods by the direct factorization, others by block-Jacobi CG") {
@@ -441,14 +446,7 @@ TEST_CASE("Newton's solver `auto` solves a scene with rods by the direct factori
                       {"fixed", {{{"where", {{"type", "box"}, {"min", {-1, -1, -1}}, {"max", {0.001, 1, 1}}}}}}},
                       {"integrator", {{"type", "newton"}, {"step", 0.01}}},
                       {"duration", 0.02}};
-  Scene scene = parse_scene(j, "solid.json");
-  scene.write_picture = scene.write_vtu = scene.write_csv = false;
-  RunOptions o;
-  o.out = std::filesystem::temp_directory_path() / ("sewn_mixed_solid_" + std::to_string(::getpid()));
-  o.quiet = true;
-  const RunSummary solid = run(scene, o);
-  std::filesystem::remove_all(o.out);
-  CHECK(solid.linear_iterations > 0);
+  CHECK(run_quietly(j, "solid").linear_iterations > 0);
 }
 
 }  // namespace mixed_test
