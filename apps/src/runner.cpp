@@ -19,6 +19,7 @@
 #include "sewn/physics/integrate/newton_euler.hpp"
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
+#include "sewn/physics/rods/rods_term.hpp"
 #include "sewn/physics/solids/inversion.hpp"
 #include "sewn/physics/threads.hpp"
 #include "sewn/refine/cut.hpp"
@@ -108,6 +109,17 @@ physics::integrate::NewtonEulerOptions newton_options(const Scene& scene) {
   if (scene.solver == "ldlt" || scene.solver == "cholmod") o.solver = physics::integrate::LinearSolver::ldlt;
   if (scene.solver == "cholmod-pcg") o.solver = physics::integrate::LinearSolver::cholmod_pcg;
   return o;
+}
+
+// Whether the system simulates discrete elastic rods. Their bend-twist stiffness, orders of
+// magnitude above their stretch and bending in the mass-weighted metric, leaves block-Jacobi CG
+// with hundreds to tens of thousands of iterations a Newton system (a 16-edge helix at h = 10 ms:
+// 519 a step; docs/solvers.md), where a direct factorization solves it exactly: so a Newton
+// scene with rods and solver `auto` solves by `ldlt` (CHOLMOD when built, else Eigen's LDLᵀ).
+bool has_rods(const physics::System& sys) {
+  for (const auto& t : sys.terms())
+    if (dynamic_cast<const physics::rods::Rods*>(t.get()) != nullptr) return true;
+  return false;
 }
 
 // The warning for the first implicit step that created energy.
@@ -212,6 +224,7 @@ RunLoop::RunLoop(const Scene& scene, const RunOptions& options, Bodies& bodies, 
       use_implicit_(scene.integrator == "implicit" || use_midpoint_),
       use_newton_(scene.integrator == "newton"),
       bar_(!options.quiet && options.progress && isatty(STDERR_FILENO)) {
+  if (use_newton_ && scene.solver == "auto" && has_rods(model_.system())) newton_.options().solver = physics::integrate::LinearSolver::ldlt;
   for (std::size_t k = 0; k < scene.cuts.size(); ++k) cuts_.emplace_back(scene.cuts[k].time, k);
   std::stable_sort(cuts_.begin(), cuts_.end());
   if (resuming_ || options.checkpoint_every > 0) run_id_ = detail::run_hash(scene, model_, steps_, frames_);

@@ -418,4 +418,51 @@ TEST_CASE("connections of a mixed mesh: the flap's edge line is curves, the rod'
   CHECK(connections_json(hm)["skipped"] == hm.skipped);
 }
 
+// Runs the scene `j` (named `name` in messages) writing nothing; returns its summary.
+RunSummary run_quietly(const nlohmann::json& j, const std::string& name) {
+  Scene scene = parse_scene(j, name + ".json");
+  scene.write_picture = scene.write_vtu = scene.write_csv = false;
+  RunOptions o;
+  o.out = std::filesystem::temp_directory_path() / ("sewn_mixed_" + name + "_" + std::to_string(::getpid()));
+  o.quiet = true;
+  const RunSummary sum = run(scene, o);
+  std::filesystem::remove_all(o.out);
+  return sum;
+}
+
+// A helix of 16 rod edges hanging from its first edge, stepped by Newton with the scene's
+// `solver` (nothing else written).
+RunSummary run_helix(const std::string& solver) {
+  nlohmann::json pts = nlohmann::json::array();
+  for (int k = 0; k <= 16; ++k) pts.push_back({0.05 * std::cos(0.5 * k), 0.05 * std::sin(0.5 * k), -0.01 * k});
+  nlohmann::json j = {{"name", "helix"},
+                      {"materials", {{"wire", {{"young", 1e8}, {"poisson", 0.3}, {"density", 1500}}}}},
+                      {"meshes", {{{"type", "polyline"}, {"material", "wire"}, {"points", pts}}}},
+                      {"model", {{"type", "mixed"}, {"groups", {{{"tag", 0}, {"as", "rod"}, {"semi_axes", {0.004, 0.002}}}}}}},
+                      {"damping", {{"model", "rayleigh"}, {"alpha", 0.5}}},
+                      {"fixed", {{{"where", {{"type", "points"}, {"indices", {0, 1}}}}}}},
+                      {"integrator", {{"type", "newton"}, {"step", 0.01}, {"solver", solver}, {"newton_tolerance", 1e-3}}},
+                      {"duration", 0.05}};
+  return run_quietly(j, "helix");
+}
+
+TEST_CASE("Newton's solver `auto` solves a scene with rods by the direct factorization, others by block-Jacobi CG") {
+  // Block-Jacobi CG needs ~500 iterations a step here (hopeless on stiffer rods); `auto` must
+  // take ldlt's path: no CG iteration, the same Newton iterations and state as `ldlt`.
+  const RunSummary automatic = run_helix("auto"), direct = run_helix("ldlt"), jacobi = run_helix("jacobi");
+  CHECK(automatic.linear_iterations == 0);
+  CHECK(automatic.newton_iterations == direct.newton_iterations);
+  CHECK(automatic.kinetic_end == direct.kinetic_end);
+  CHECK(jacobi.linear_iterations > 100 * jacobi.steps);
+  // Without rods `auto` stays block-Jacobi CG (a Newton scene of tetrahedra).
+  nlohmann::json j = {{"materials", {{"m", {{"young", 1e6}, {"density", 1000}}}}},
+                      {"meshes", {{{"type", "tet_grid"}, {"material", "m"}, {"cells", {3, 1, 1}}, {"size", {0.3, 0.1, 0.1}}}}},
+                      {"model", {{"type", "solid"}}},
+                      {"damping", {{"model", "rayleigh"}, {"alpha", 1.0}}},
+                      {"fixed", {{{"where", {{"type", "box"}, {"min", {-1, -1, -1}}, {"max", {0.001, 1, 1}}}}}}},
+                      {"integrator", {{"type", "newton"}, {"step", 0.01}}},
+                      {"duration", 0.02}};
+  CHECK(run_quietly(j, "solid").linear_iterations > 0);
+}
+
 }  // namespace mixed_test

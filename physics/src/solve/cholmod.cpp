@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,14 @@ constexpr double factor_flop_speedup = 4.0;
 constexpr double factor_flop_speedup = 1.0;
 #endif
 
+// The fill-reducing ordering: AMD, and where its factorization is large also METIS and nested
+// dissection, keeping the least fill. The umbrella's 9702 unknowns factor in 6.1e8 flops with
+// METIS against 7.8e8 with AMD (its analysis 30-53 ms against 9, once per pattern); on the
+// sticky hand (621 unknowns, 2.1e6 flops) all three find AMD's ordering, and trying the other
+// two cost 2.0-2.6 ms against 0.5, about three of its factorizations, for nothing. Above this
+// many flops (a factorization of a few ms with OpenBLAS) the search pays.
+constexpr double ordering_search_flops = 3e7;
+
 // One CHOLMOD workspace, the filtered matrix in its upper-triangular CSC form, and its factor.
 class Factorization {
  public:
@@ -43,13 +52,6 @@ class Factorization {
     // LLᵀ: a simplicial LDLᵀ would succeed on an indefinite matrix (only a zero pivot stops
     // it), and indefiniteness is what must be reported.
     c_.final_ll = 1;
-    // Fill-reducing ordering: the least fill of AMD, METIS and nested dissection (by default
-    // CHOLMOD tries METIS only where AMD's fill is large). The analysis runs once per pattern;
-    // the umbrella's 9702 unknowns factor in 6.0e8 flops with nested dissection, 7.8e8 with AMD.
-    c_.nmethods = 3;
-    c_.method[0].ordering = CHOLMOD_AMD;
-    c_.method[1].ordering = CHOLMOD_METIS;
-    c_.method[2].ordering = CHOLMOD_NESDIS;
   }
   ~Factorization() {
     free_factor();
@@ -126,9 +128,17 @@ class Factorization {
 
   /// Symbolic analysis (fill-reducing ordering, elimination tree). Milliseconds.
   void analyse() {
+    const SerialLibraryRegions serial;
     free_factor();
-    L_ = cholmod_analyze(K_, &c_);
+    L_ = analyse_with({CHOLMOD_AMD});
     if (!L_) throw SolverError("cholmod: symbolic analysis failed (status " + std::to_string(c_.status) + ")", 0, 0);
+    if (c_.fl >= ordering_search_flops) {
+      // CHOLMOD keeps the least fill of the methods it tries; AMD's is then found again (ms).
+      cholmod_factor* best = analyse_with({CHOLMOD_AMD, CHOLMOD_METIS, CHOLMOD_NESDIS});
+      if (!best) throw SolverError("cholmod: symbolic analysis failed (status " + std::to_string(c_.status) + ")", 0, 0);
+      cholmod_free_factor(&L_, &c_);
+      L_ = best;
+    }
     // One PCG iteration: two triangular solves (2 flops per entry of L each), the product with
     // A (2 per stored scalar, both triangles) and the vector passes (~10 per unknown).
     const double n = static_cast<double>(L_->n), upper = static_cast<double>(src_.size());
@@ -201,6 +211,7 @@ class Factorization {
       single_.solve(rhs, out);
       return;
     }
+    const SerialLibraryRegions serial;  // CHOLMOD's supernodal solves open regions too
     cholmod_dense B{};
     B.nrow = rhs.size();
     B.ncol = 1;
@@ -223,6 +234,13 @@ class Factorization {
     for (std::size_t j = 0; j < L_->n; ++j)
       if (!(lx[lp[j]] > 0.0)) return j;
     return L_->n;
+  }
+  // cholmod_analyze with these orderings tried (c_.fl and c_.lnz then describe its choice).
+  cholmod_factor* analyse_with(std::initializer_list<int> orderings) {
+    c_.nmethods = static_cast<int>(orderings.size());
+    int k = 0;
+    for (const int o : orderings) c_.method[k++].ordering = o;
+    return cholmod_analyze(K_, &c_);
   }
   void free_factor() {
     if (L_) cholmod_free_factor(&L_, &c_);
