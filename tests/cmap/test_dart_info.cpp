@@ -142,24 +142,32 @@ TEST_CASE("dart info: insertions copy the argument dart, per the rule in cmap.hp
   }
 }
 
+// "d<i>", built by appending: GCC 12 reports a false -Wrestrict overlap in the inlined
+// `"d" + std::string&&` (its bug 105329) once this test shares a unity file with others.
+std::string label(std::uint32_t i) {
+  std::string s(1, 'd');
+  s += std::to_string(i);
+  return s;
+}
+
 TEST_CASE("dart info: contraction, compaction and copies keep each dart's value") {
   CMap<2, DartInfo<std::string>> m;  // a value that owns memory
   build(m, quad_grid(3, 3));
-  for (Dart d : m.darts()) m.info(d) = "d" + std::to_string(d.index());
+  for (Dart d : m.darts()) m.info(d) = label(d.index());
   const Dart e = *m.cells<1>().begin();
   REQUIRE(m.is_contractible<1>(e));
   const std::uint32_t before = m.num_darts(), gone = static_cast<std::uint32_t>(m.cell<1>(e).size());
   m.contract_cell<1>(e);
   require_valid(m);
   CHECK(m.num_darts() == before - gone);
-  for (Dart x : m.darts()) CHECK(m.info(x) == "d" + std::to_string(x.index()));
+  for (Dart x : m.darts()) CHECK(m.info(x) == label(x.index()));
   const CMap<2, DartInfo<std::string>> copy = m;
   const std::vector<Dart> to = m.compact();
   require_valid(m);
   for (std::uint32_t old = 0; old < to.size(); ++old) {
     if (to[old].is_null()) continue;
-    CHECK(m.info(to[old]) == "d" + std::to_string(old));
-    CHECK(copy.info(Dart(old)) == "d" + std::to_string(old));
+    CHECK(m.info(to[old]) == label(old));
+    CHECK(copy.info(Dart(old)) == label(old));
   }
   // the contracted edge's slots were compacted away: new darts start empty
   const Dart t = m.make_triangle();
