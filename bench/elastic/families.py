@@ -60,6 +60,12 @@ def dynamic_families(raw):
                             f"{m.group(1)}, {m.group(2)}, Newton BE {step_label(b['_h'])}", "nx"), {})[int(m.group(3))] = (
                 b["error %"], cost)
             continue
+        m = re.match(r"elastic/to_rest/rod/seg(\d+)/", name)
+        if m:
+            out.setdefault(("rod cantilever under its weight vs Euler-Bernoulli",
+                            f"discrete elastic rod, Newton BE {step_label(b['_h'])}", "segments"), {})[int(m.group(1))] = (
+                b["error %"], cost)
+            continue
         # the mass-spring beam run to rest by linearly implicit Euler (bench/mss/cantilever.cpp)
         m = re.match(r"elastic/cantilever/N(\d+)/implicit_h1e-2/", name)
         if m and "_tip_mm" in b:
