@@ -41,6 +41,17 @@ def step_label(h):
     return f"h = {h * 1e3:g} ms"
 
 
+# The runs to rest of to_rest.cpp: name pattern (its last group the size) -> (answer, family
+# with the pattern's other groups and the step filled in, size label).
+RUNS_TO_REST = [
+    (r"elastic/to_rest/tets/N(\d+)/", "StVK tet cantilever vs Timoshenko", "Kuhn tets, Newton BE {h}", "N"),
+    (r"elastic/to_rest/shell_strip/([a-z]+)/([a-z]+)/nx(\d+)/", "shell strip vs Euler-Bernoulli",
+     "{0}, {1}, Newton BE {h}", "nx"),
+    (r"elastic/to_rest/rod/seg(\d+)/", "rod cantilever under its weight vs Euler-Bernoulli",
+     "discrete elastic rod, Newton BE {h}", "segments"),
+]
+
+
 def dynamic_families(raw):
     """Runs from release to rest: cost per simulated second against the error of the rest state."""
     out = {}
@@ -49,23 +60,12 @@ def dynamic_families(raw):
             continue
         name = b.get("run_name", b["name"])
         cost = b["_cpu_s_per_simulated_s"]
-        m = re.match(r"elastic/to_rest/tets/N(\d+)/", name)
-        if m:
-            out.setdefault(("StVK tet cantilever vs Timoshenko", f"Kuhn tets, Newton BE {step_label(b['_h'])}", "N"), {})[
-                int(m.group(1))] = (b["error %"], cost)
-            continue
-        m = re.match(r"elastic/to_rest/shell_strip/([a-z]+)/([a-z]+)/nx(\d+)/", name)
-        if m:
-            out.setdefault(("shell strip vs Euler-Bernoulli",
-                            f"{m.group(1)}, {m.group(2)}, Newton BE {step_label(b['_h'])}", "nx"), {})[int(m.group(3))] = (
-                b["error %"], cost)
-            continue
-        m = re.match(r"elastic/to_rest/rod/seg(\d+)/", name)
-        if m:
-            out.setdefault(("rod cantilever under its weight vs Euler-Bernoulli",
-                            f"discrete elastic rod, Newton BE {step_label(b['_h'])}", "segments"), {})[int(m.group(1))] = (
-                b["error %"], cost)
-            continue
+        for pattern, answer, family, size in RUNS_TO_REST:
+            m = re.match(pattern, name)
+            if m:
+                key = (answer, family.format(*m.groups()[:-1], h=step_label(b["_h"])), size)
+                out.setdefault(key, {})[int(m.groups()[-1])] = (b["error %"], cost)
+                break
         # the mass-spring beam run to rest by linearly implicit Euler (bench/mss/cantilever.cpp)
         m = re.match(r"elastic/cantilever/N(\d+)/implicit_h1e-2/", name)
         if m and "_tip_mm" in b:
