@@ -56,7 +56,7 @@ double first_mode(double EI, double rho_A, double L) {
   return first_root * first_root * std::sqrt(EI / (rho_A * L * L * L * L));
 }
 
-// EI and ρA of a rectangular section, width w and height t (bending in t).
+// ω₁ of a rectangular section, width w and height t (bending in t).
 double first_mode_rectangle(double E, double rho, double L, double w, double t) {
   return first_mode(E * w * t * t * t / 12, rho * w * t, L);
 }
