@@ -9,6 +9,9 @@
 //   elastic/cantilever/static/N<n>/ours, elastic/cantilever/N<n>/implicit_h1e-2/ours
 //       the same beam as the mass-spring system of bench/mss (cubes of springs, the 2013
 //       paper's stiffnesses), its static tip and a run to rest (register_cantilever_springs).
+// The runs from release to rest of the tets, the shell strip and a rod (cost per simulated
+// second) are in to_rest.cpp; the static rows of the strip and the rod in shell_strip.cpp and
+// rod_elastica.cpp.
 #include <cmath>
 #include <ctime>
 #include <string>

@@ -1,5 +1,7 @@
 """The elastic suite's convergence families, read from a raw benchmark JSON (shared by derive
-and plot): family (answer, name, size label) -> {size: (error %, CPU ms per solve)}."""
+and plot). families(): the static solves, family (answer, name, size label) -> {size: (error %,
+CPU ms per solve)}; dynamic_families(): the runs from release to rest, the same keys ->
+{size: (error %, CPU s per simulated s)}."""
 
 import re
 
@@ -27,17 +29,47 @@ def families(raw):
         if m and "error vs Timoshenko %" in b:
             out.setdefault(("StVK tet cantilever vs Timoshenko", f"Kuhn tets, {m.group(2)}", "N"), {})[int(m.group(1))] = (
                 b["error vs Timoshenko %"], ms)
-        # the mass-spring beam (bench/mss/cantilever.cpp): its static tip, and runs to rest whose
-        # cost is per simulated second, both against the tets' continuum answer
+        # the mass-spring beam (bench/mss/cantilever.cpp): its static tip, against the tets' answer
         m = re.match(r"elastic/cantilever/static/N(\d+)/", name)
         if m and "_tip_mm" in b:
             out.setdefault(("mass-spring cantilever vs Timoshenko", "cubes of springs, static", "N"), {})[int(m.group(1))] = (
                 100.0 * abs(b["_tip_mm"] - TIMOSHENKO_MM) / TIMOSHENKO_MM, ms)
+    return out
+
+
+def step_label(h):
+    return f"h = {h * 1e3:g} ms"
+
+
+# The runs to rest of to_rest.cpp: name pattern (its last group the size) -> (answer, family
+# with the pattern's other groups and the step filled in, size label).
+RUNS_TO_REST = [
+    (r"elastic/to_rest/tets/N(\d+)/", "StVK tet cantilever vs Timoshenko", "Kuhn tets, Newton BE {h}", "N"),
+    (r"elastic/to_rest/shell_strip/([a-z]+)/([a-z]+)/nx(\d+)/", "shell strip vs Euler-Bernoulli",
+     "{0}, {1}, Newton BE {h}", "nx"),
+    (r"elastic/to_rest/rod/seg(\d+)/", "rod cantilever under its weight vs Euler-Bernoulli",
+     "discrete elastic rod, Newton BE {h}", "segments"),
+]
+
+
+def dynamic_families(raw):
+    """Runs from release to rest: cost per simulated second against the error of the rest state."""
+    out = {}
+    for b in raw["benchmarks"]:
+        if b.get("run_type", "iteration") != "iteration" or "_cpu_s_per_simulated_s" not in b:
             continue
+        name = b.get("run_name", b["name"])
+        cost = b["_cpu_s_per_simulated_s"]
+        for pattern, answer, family, size in RUNS_TO_REST:
+            m = re.match(pattern, name)
+            if m:
+                key = (answer, family.format(*m.groups()[:-1], h=step_label(b["_h"])), size)
+                out.setdefault(key, {})[int(m.groups()[-1])] = (b["error %"], cost)
+                break
+        # the mass-spring beam run to rest by linearly implicit Euler (bench/mss/cantilever.cpp)
         m = re.match(r"elastic/cantilever/N(\d+)/implicit_h1e-2/", name)
-        if m and "_tip_mm" in b and "_cpu_s_per_simulated_s" in b:
-            out.setdefault(("mass-spring cantilever vs Timoshenko", "cubes of springs, implicit h = 10 ms (ms per simulated s)",
-                            "N"), {})[int(m.group(1))] = (100.0 * abs(b["_tip_mm"] - TIMOSHENKO_MM) / TIMOSHENKO_MM,
-                                                          1e3 * b["_cpu_s_per_simulated_s"])
-            continue
+        if m and "_tip_mm" in b:
+            out.setdefault(("mass-spring cantilever vs Timoshenko",
+                            f"cubes of springs, linearly implicit Euler {step_label(b['_h'])}", "N"), {})[int(m.group(1))] = (
+                100.0 * abs(b["_tip_mm"] - TIMOSHENKO_MM) / TIMOSHENKO_MM, cost)
     return out

@@ -154,12 +154,18 @@ inline Strip strip_mesh(Mesh mesh, int nx, const Shape& shape = {}) {
   return s;
 }
 
-/// Builds the strip with `bending`, solves it and returns the tip deflection (positive down).
-/// Throws what Newton throws.
-inline Result solve(Mesh mesh, Bending bending, int nx, const Shape& shape = {}) {
+/// The strip as a system at rest, undeformed: nodes with lumped masses (the x ≤ 0 columns
+/// held), membranes, the bending model, gravity; `tip` lists the x = L nodes.
+struct Built {
+  physics::System sys;
+  std::vector<physics::Index> tip;
+  std::size_t triangles = 0;
+};
+
+inline void build(Built& out, Mesh mesh, Bending bending, int nx, const Shape& shape = {}) {
   using physics::Index;
   const Strip s = strip_mesh(mesh, nx, shape);
-  physics::System sys;
+  physics::System& sys = out.sys;
   const Index n = static_cast<Index>(s.rest.size() / 3);
   std::vector<double> mass(n, 0.0);
   auto at = [&](Index i) { return Eigen::Vector3d(s.rest[3 * i], s.rest[3 * i + 1], s.rest[3 * i + 2]); };
@@ -190,22 +196,34 @@ inline Result solve(Mesh mesh, Bending bending, int nx, const Shape& shape = {})
       (void)physics::shells::add_patch_bending(sys, s.triangles, s.rest, mat, clamp);
   }
   sys.add<physics::Gravity>(Eigen::Vector3d(0, 0, -gravity));
-  std::vector<Index> tip;
   for (Index i = 0; i < n; ++i) {
     if (s.rest[3 * i] <= 1e-12) sys.nodes().fix(i);
-    if (std::abs(s.rest[3 * i] - length) < 1e-12) tip.push_back(i);
+    if (std::abs(s.rest[3 * i] - length) < 1e-12) out.tip.push_back(i);
   }
+  out.triangles = s.triangles.size();
+}
+
+/// The tip's deflection (mean z of the x = L nodes, positive down), in m.
+inline double tip_m(const Built& b) {
+  double z = 0;
+  for (physics::Index i : b.tip) z += b.sys.nodes().position(i).z();
+  return -z / static_cast<double>(b.tip.size());
+}
+
+/// Builds the strip with `bending`, solves it and returns the tip deflection (positive down).
+/// Throws what Newton throws.
+inline Result solve(Mesh mesh, Bending bending, int nx, const Shape& shape = {}) {
+  Built b;
+  build(b, mesh, bending, nx, shape);
   const double h = 1e3;  // inertia M/h² ~1e-12 of the bending stiffness
   physics::integrate::NewtonEulerOptions opt;
   opt.solver = physics::integrate::LinearSolver::ldlt;
   opt.velocity_tolerance = 1e-13 / h;  // |p|∞ below 1e-13 m
   physics::integrate::NewtonEuler newton(opt);
   Result r;
-  r.newton = newton.step(sys, h).iterations;
-  double z = 0;
-  for (Index i : tip) z += sys.nodes().position(i).z();
-  r.tip_m = -z / static_cast<double>(tip.size());
-  r.triangles = s.triangles.size();
+  r.newton = newton.step(b.sys, h).iterations;
+  r.tip_m = tip_m(b);
+  r.triangles = b.triangles;
   return r;
 }
 
