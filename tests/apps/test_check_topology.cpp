@@ -3,6 +3,8 @@
 
 #include "sewn/apps/check_topology.hpp"
 
+namespace test_check_topology {
+
 using namespace sewn;
 
 TEST_CASE("sewn check reports the topology of a mesh") {
@@ -53,3 +55,5 @@ TEST_CASE("sewn check reports the topology of a mesh") {
     CHECK(app::topology_json(t)["skipped"].get<std::string>().find("1 volumes, 1 surface cells") != std::string::npos);
   }
 }
+
+}  // namespace test_check_topology

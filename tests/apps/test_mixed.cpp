@@ -27,6 +27,8 @@
 
 #include "force_check.hpp"
 
+namespace test_mixed {
+
 using namespace sewn;
 using namespace sewn::app;
 
@@ -466,3 +468,5 @@ TEST_CASE("Newton's solver `auto` solves a scene with rods by the direct factori
 }
 
 }  // namespace mixed_test
+
+}  // namespace test_mixed

@@ -8,6 +8,8 @@
 #include "sewn/apps/runner.hpp"
 #include "sewn/apps/scene.hpp"
 
+namespace test_obstacle_keys {
+
 using namespace sewn::app;
 using nlohmann::json;
 
@@ -90,3 +92,5 @@ TEST_CASE("scene obstacles: the ground stops a falling cube") {
   CHECK(rest.kinetic_end < 1e-4 * rest.kinetic_max);
   std::filesystem::remove_all(opt.out);
 }
+
+}  // namespace test_obstacle_keys

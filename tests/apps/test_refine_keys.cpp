@@ -18,6 +18,8 @@
 #include "sewn/refine/cut.hpp"
 #include "sewn/refine/hierarchy.hpp"
 
+namespace test_refine_keys {
+
 using namespace sewn::app;
 using nlohmann::json;
 
@@ -364,3 +366,5 @@ TEST_CASE("scenes/refine_fig08_cut_path.json: membrane quads refined where the c
 }
 
 }  // namespace refine_keys_test
+
+}  // namespace test_refine_keys

@@ -20,6 +20,8 @@
 #include "sewn/physics/errors.hpp"
 
 namespace fs = std::filesystem;
+namespace test_run {
+
 using namespace sewn::app;
 
 namespace {
@@ -543,3 +545,5 @@ TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped b
     expect_run_error<SceneError>(rod, "cutting is supported on solid tetrahedra and shells only, and this scene has 2 rod segments");
   }
 }
+
+}  // namespace test_run

@@ -10,6 +10,8 @@
 #include "sewn/apps/scene.hpp"
 #include "sewn/physics/integrators.hpp"
 
+namespace test_scene {
+
 using namespace sewn::app;
 using nlohmann::json;
 
@@ -221,3 +223,5 @@ TEST_CASE("threads: the scene key sets the count, 0 (the default) leaves it to S
   j["threads"] = 1000;
   expect_error(j, "threads", "256");
 }
+
+}  // namespace test_scene

@@ -14,6 +14,8 @@
 #include "sewn/physics/errors.hpp"
 
 namespace fs = std::filesystem;
+namespace test_scene_robustness {
+
 using namespace sewn::app;
 using nlohmann::json;
 
@@ -236,3 +238,5 @@ TEST_CASE("a mass that underflows to zero is refused when the model is built") {
   opt.out = scratch_file("x", "").parent_path() / "mass_ok";
   CHECK_NOTHROW(run(parse_scene(j, "light.json"), opt));
 }
+
+}  // namespace test_scene_robustness

@@ -17,6 +17,8 @@
 
 #include "force_check.hpp"
 
+namespace test_solid_cuts {
+
 using namespace sewn;
 using namespace sewn::app;
 
@@ -157,3 +159,5 @@ TEST_CASE("solid pierce: random tetrahedra pierced away or loosened, energy and 
 }
 
 }  // namespace solid_cuts_test
+
+}  // namespace test_solid_cuts

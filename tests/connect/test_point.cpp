@@ -15,11 +15,11 @@
 #include "sewn/connect/point.hpp"
 #include "sewn/physics/rods/stencils.hpp"
 
+namespace test_point {
+
 using namespace sewn;
 using namespace sewn::connect;
 using Eigen::VectorXd;
-
-namespace test_point {  // one namespace per file: the unity build compiles several files as one
 
 namespace {
 

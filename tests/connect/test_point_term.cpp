@@ -19,6 +19,8 @@
 #include "sewn/physics/springs.hpp"
 #include "sewn/physics/system.hpp"
 
+namespace test_point_term {
+
 using namespace sewn;
 using namespace sewn::connect;
 using physics::Index;
@@ -281,3 +283,5 @@ TEST_CASE("point connections term: a rod side needs the rods' twist as angle DOF
 }
 
 }  // namespace point_term_test
+
+}  // namespace test_point_term

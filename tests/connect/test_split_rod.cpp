@@ -12,13 +12,13 @@
 
 #include "sewn/connect/point.hpp"
 
+namespace test_split_rod {
+
 using namespace sewn;
 using namespace sewn::connect;
 using physics::rods::Points;
 using physics::rods::Rod;
 using physics::rods::Section;
-
-namespace test_split_rod {  // one namespace per file: the unity build compiles several files as one
 
 namespace {
 

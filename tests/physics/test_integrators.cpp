@@ -13,6 +13,8 @@
 
 #include "helpers.hpp"
 
+namespace test_integrators {
+
 using namespace sewn::physics;
 using namespace sewn::physics::test;
 using doctest::Approx;
@@ -551,3 +553,5 @@ TEST_CASE("integrators refuse bad steps and non-symmetric solver matrices; the p
   ie.options().jacobian.drop_viscous_position_terms = false;
   CHECK_THROWS_WITH_AS((void)ie.step(sys, 1e-3), doctest::Contains("'springs'"), InputError);
 }
+
+}  // namespace test_integrators

@@ -18,6 +18,8 @@
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/obstacles/obstacles.hpp"
 
+namespace test_obstacles {
+
 using namespace sewn;
 using namespace sewn::physics;
 using namespace sewn::physics::obstacles;
@@ -322,3 +324,5 @@ TEST_CASE("obstacles under Newton: a block sliding on the ground stops at Coulom
     CHECK(travelled == doctest::Approx(exact).epsilon(0.01));
   }
 }
+
+}  // namespace test_obstacles

@@ -20,6 +20,8 @@
 #include "sewn/physics/integrate/newton_euler.hpp"
 #include "sewn/physics/rods/rods_term.hpp"
 
+namespace test_rod_angle_dofs {
+
 using namespace sewn::physics;
 using namespace sewn::physics::rods;
 
@@ -354,3 +356,5 @@ TEST_CASE("rod angle DOFs: a hanging rod twisted past pi and back under Newton, 
 }
 
 }  // namespace angle_dofs_test
+
+}  // namespace test_rod_angle_dofs

@@ -12,6 +12,8 @@
 
 #include "sewn/physics/rods/static_solve.hpp"
 
+namespace test_rod_statics {
+
 using namespace sewn::physics;
 using namespace sewn::physics::rods;
 
@@ -249,3 +251,5 @@ TEST_CASE("rods: an elliptic cantilever bends by EI1 along m1 and EI2 along m2, 
     CHECK(d.z() / d.y() == doctest::Approx(expected).epsilon(1e-4));
   }
 }
+
+}  // namespace test_rod_statics

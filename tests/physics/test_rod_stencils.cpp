@@ -14,6 +14,8 @@
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/rods/stencils.hpp"
 
+namespace test_rod_stencils {
+
 using namespace sewn::physics;
 using namespace sewn::physics::rods;
 
@@ -259,3 +261,5 @@ TEST_CASE("rod stencil: cost of the closed-form gradient and the AD Hessian (rep
   MESSAGE("bend-twist stencil (fastest of 30 batches): gradient " << g_us << " us, gradient+Hessian (AD) " << h_us << " us");
   CHECK(std::isfinite(sink));
 }
+
+}  // namespace test_rod_stencils

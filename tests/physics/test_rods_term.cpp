@@ -17,6 +17,8 @@
 #include "sewn/physics/rods/rods_term.hpp"
 #include "sewn/physics/rods/static_solve.hpp"
 
+namespace test_rods_term {
+
 using namespace sewn::physics;
 using namespace sewn::physics::rods;
 
@@ -348,3 +350,5 @@ TEST_CASE("rods term: a term built alike and given history() continues bit for b
   CHECK_THROWS_AS(b.rods->restore({}), InputError);
   CHECK(a.rods->rod(0).theta()[4] == b.rods->rod(0).theta()[4]);
 }
+
+}  // namespace test_rods_term

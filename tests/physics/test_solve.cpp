@@ -19,6 +19,8 @@
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/solve/linear_solver.hpp"
 
+namespace test_solve {
+
 using namespace sewn;
 using namespace sewn::physics;
 using Eigen::Vector3d;
@@ -491,3 +493,5 @@ TEST_CASE("the refresh rule keeps a preconditioner while solves stay cheap, and 
     CHECK(refreshes >= 1);
   }
 }
+
+}  // namespace test_solve

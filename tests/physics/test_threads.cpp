@@ -15,6 +15,8 @@
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/threads.hpp"
 
+namespace test_threads {
+
 using namespace sewn;
 using namespace sewn::physics;
 
@@ -234,3 +236,5 @@ TEST_CASE("threads: trajectories repeat bitwise at 2 threads and agree with 1 th
       CHECK(relative < 1e-12);  // measured: 2e-16 to 1.2e-15
     }
 }
+
+}  // namespace test_threads

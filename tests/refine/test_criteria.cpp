@@ -11,6 +11,8 @@
 #include "sewn/refine/subdivide.hpp"
 #include "support.hpp"
 
+namespace test_criteria {
+
 using namespace sewn;
 using namespace sewn::physics;
 using namespace sewn::refine;
@@ -150,3 +152,5 @@ TEST_CASE("a kinematic face keeps its motion on the particles refinement adds") 
 }
 
 }  // namespace criteria_test
+
+}  // namespace test_criteria

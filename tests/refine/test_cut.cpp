@@ -12,12 +12,12 @@
 #include "sewn/physics/stiffness.hpp"
 #include "sewn/refine/cut.hpp"
 
+namespace test_cut {
+
 using namespace sewn;
 using namespace sewn::physics;
 using namespace sewn::refine;
 using Eigen::Vector3d;
-
-namespace test_cut {  // one namespace per file: the unity build compiles several files as one
 
 namespace {
 

@@ -15,13 +15,13 @@
 #include "sewn/refine/subdivide.hpp"
 #include "support.hpp"
 
+namespace test_refine_hex {
+
 using namespace sewn;
 using namespace sewn::physics;
 using namespace sewn::refine;
 using namespace refine_test;
 using Eigen::Vector3d;
-
-namespace test_refine_hex {  // one namespace per file: the unity build compiles several files as one
 
 namespace {
 

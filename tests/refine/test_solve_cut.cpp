@@ -9,12 +9,12 @@
 #include "sewn/physics/solve/linear_solver.hpp"
 #include "sewn/refine/cut.hpp"
 
+namespace test_solve_cut {
+
 using namespace sewn;
 using namespace sewn::physics;
 using namespace sewn::refine;
 using Eigen::Vector3d;
-
-namespace test_solve_cut {  // one namespace per file: the unity build compiles several files as one
 
 namespace {
 

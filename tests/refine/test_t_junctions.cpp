@@ -13,12 +13,12 @@
 #include "sewn/refine/hierarchy.hpp"
 #include "sewn/refine/subdivide.hpp"
 
+namespace test_t_junctions {
+
 using namespace sewn;
 using namespace sewn::physics;
 using namespace sewn::refine;
 using Eigen::Vector3d;
-
-namespace test_t_junctions {  // one namespace per file: the unity build compiles several files as one
 
 namespace {
 
