@@ -1,8 +1,9 @@
 """What the VTK read-back checks run by CTest share (tests/io/tools/vtk_check.py,
-tests/apps/vtk_check_*.py): importing VTK's Python bindings, or skipping without them, and
-collecting failed checks."""
+tests/apps/vtk_check_*.py): importing VTK's Python bindings, or skipping without them, reading
+a .vtu with VTK's reader and a series' frame list, and collecting failed checks."""
 import os
 import sys
+import xml.etree.ElementTree as ET
 
 
 def import_vtk(script):
@@ -28,3 +29,17 @@ class Checks:
     def check(self, cond, what):
         if not cond:
             self.failures.append(what)
+
+
+def read_vtu(vtk, path, check):
+    """The unstructured grid VTK's own XML reader makes of path; a reader error is a failed check."""
+    r = vtk.vtkXMLUnstructuredGridReader()
+    r.SetFileName(path)
+    r.Update()
+    check(r.GetErrorCode() == 0, path + ": VTK reports error code %d" % r.GetErrorCode())
+    return r.GetOutput()
+
+
+def pvd_frames(path):
+    """The .vtu files a .pvd collection lists, in its order (VTK has no .pvd reader outside ParaView)."""
+    return [ds.get("file") for ds in ET.parse(path).getroot().iter("DataSet")]

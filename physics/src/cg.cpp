@@ -5,6 +5,7 @@
 
 #include <Eigen/LU>
 
+#include "dot8.hpp"
 #include "parallel/ranges.hpp"
 
 #if defined(__AVX512F__) && defined(__AVX512VL__)
@@ -21,19 +22,7 @@ using detail::run_parts;
 // Nodes per thread below which CG uses fewer threads: an iteration forks four times.
 constexpr std::size_t cg_grain = 1024;
 
-// Eight independent partial sums: a single running sum is bound by the add latency, and
-// the compiler may not reorder it itself (no -ffast-math). Fixed order: deterministic.
-double dot_range(const double* __restrict x, const double* __restrict y, std::size_t n) {
-  double part[8] = {};
-  const std::size_t n8 = n - n % 8;
-  for (std::size_t k = 0; k < n8; k += 8)
-    for (std::size_t q = 0; q < 8; ++q) part[q] += x[k + q] * y[k + q];
-  double s = ((part[0] + part[1]) + (part[2] + part[3])) + ((part[4] + part[5]) + (part[6] + part[7]));
-  for (std::size_t k = n8; k < n; ++k) s += x[k] * y[k];
-  return s;
-}
-
-double dot(std::span<const double> a, std::span<const double> b) { return dot_range(a.data(), b.data(), a.size()); }
+double dot(std::span<const double> a, std::span<const double> b) { return detail::dot8(a.data(), b.data(), a.size()); }
 
 // z = S P S r for nodes [first, last).
 void apply_precond(std::span<const double> P, std::span<const double> r, std::span<const double> free_dof,
@@ -74,8 +63,8 @@ CgResult pcg_threads(const BlockMatrix& A, std::span<const double> b, std::span<
     for (std::size_t k = k0; k < k1; ++k) r[k] = free_dof[k] * (b[k] - q[k]);
     apply_precond(P, r, free_dof, z, i0, i1);
     for (std::size_t k = k0; k < k1; ++k) p[k] = z[k];
-    part_a[t] = dot_range(r.data() + k0, r.data() + k0, k1 - k0);
-    part_b[t] = dot_range(r.data() + k0, z.data() + k0, k1 - k0);
+    part_a[t] = detail::dot8(r.data() + k0, r.data() + k0, k1 - k0);
+    part_b[t] = detail::dot8(r.data() + k0, z.data() + k0, k1 - k0);
   });
   double r_norm = std::sqrt(sum(part_a));
   double rz = sum(part_b);
@@ -87,7 +76,7 @@ CgResult pcg_threads(const BlockMatrix& A, std::span<const double> b, std::span<
       const std::size_t i0 = node(t), i1 = node(t + 1), k0 = 3 * i0, k1 = 3 * i1;
       A.multiply_rows(p, q, static_cast<Index>(i0), static_cast<Index>(i1));
       for (std::size_t k = k0; k < k1; ++k) q[k] *= free_dof[k];
-      part_a[t] = dot_range(p.data() + k0, q.data() + k0, k1 - k0);
+      part_a[t] = detail::dot8(p.data() + k0, q.data() + k0, k1 - k0);
     });
     const double pq = sum(part_a);
     if (!(pq > 0.0)) {
@@ -103,8 +92,8 @@ CgResult pcg_threads(const BlockMatrix& A, std::span<const double> b, std::span<
         r[k] -= alpha * q[k];
       }
       apply_precond(P, r, free_dof, z, i0, i1);
-      part_a[t] = dot_range(r.data() + k0, r.data() + k0, k1 - k0);
-      part_b[t] = dot_range(r.data() + k0, z.data() + k0, k1 - k0);
+      part_a[t] = detail::dot8(r.data() + k0, r.data() + k0, k1 - k0);
+      part_b[t] = detail::dot8(r.data() + k0, z.data() + k0, k1 - k0);
     });
     ++it;
     r_norm = std::sqrt(sum(part_a));

@@ -8,10 +8,9 @@ Prints SEWN-SKIP and succeeds when VTK's Python bindings are missing, unless SEW
 import math
 import os
 import sys
-import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from vtk_checks import Checks, import_vtk  # noqa: E402
+from vtk_checks import Checks, import_vtk, pvd_frames, read_vtu  # noqa: E402
 
 vtk = import_vtk("vtk_check_rods")
 
@@ -20,7 +19,7 @@ checks = Checks()
 check = checks.check
 failures = checks.failures
 
-frames = [ds.get("file") for ds in ET.parse(os.path.join(out, "tiny_rod.pvd")).getroot().iter("DataSet")]
+frames = pvd_frames(os.path.join(out, "tiny_rod.pvd"))
 check(len(frames) == 5, "the .pvd lists %d frames, expected 5" % len(frames))
 tip_z = []
 
@@ -35,10 +34,7 @@ def cross(a, b):
 
 
 for name in frames:
-    reader = vtk.vtkXMLUnstructuredGridReader()
-    reader.SetFileName(os.path.join(out, name))
-    reader.Update()
-    grid = reader.GetOutput()
+    grid = read_vtu(vtk, os.path.join(out, name), check)
     check(grid.GetNumberOfPoints() == 11, "%s: %d points, expected 11" % (name, grid.GetNumberOfPoints()))
     check(grid.GetNumberOfCells() == 1, "%s: %d cells, expected 1 (the rod)" % (name, grid.GetNumberOfCells()))
     m1s, m2s = (grid.GetPointData().GetArray(a) for a in ("rod_m1", "rod_m2"))

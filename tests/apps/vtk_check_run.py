@@ -6,10 +6,9 @@ and that the displacement array equals position minus the first frame's position
 Prints SEWN-SKIP and succeeds when VTK's Python bindings are missing, unless SEWN_CI is set."""
 import os
 import sys
-import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from vtk_checks import Checks, import_vtk  # noqa: E402
+from vtk_checks import Checks, import_vtk, pvd_frames, read_vtu  # noqa: E402
 
 vtk = import_vtk("vtk_check_run")
 
@@ -18,15 +17,11 @@ checks = Checks()
 check = checks.check
 failures = checks.failures
 
-frames = [ds.get("file") for ds in ET.parse(os.path.join(out, "tiny.pvd")).getroot().iter("DataSet")]
+frames = pvd_frames(os.path.join(out, "tiny.pvd"))
 check(len(frames) == 5, "the .pvd lists %d frames, expected 5 (frame 0 and 4 more)" % len(frames))
 first = None
 for i, name in enumerate(frames):
-    r = vtk.vtkXMLUnstructuredGridReader()
-    r.SetFileName(os.path.join(out, name))
-    r.Update()
-    check(r.GetErrorCode() == 0, name + ": VTK reports an error")
-    g = r.GetOutput()
+    g = read_vtu(vtk, os.path.join(out, name), check)
     cut = i >= 3  # the cut happens at t = 0.1 s, between frames 2 (0.1 s) and 3
     points = 63 + (9 if cut else 0)
     check(g.GetNumberOfPoints() == points, "%s: %d points, expected %d" % (name, g.GetNumberOfPoints(), points))

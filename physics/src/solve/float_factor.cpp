@@ -11,23 +11,11 @@
 #include <cmath>
 #include <limits>
 
+#include "../dot8.hpp"
+
 namespace sewn::physics::solve::detail {
 
-namespace {
-
-// Σ col[i] · w[i] over n entries, float values widened to double; eight partial sums in a
-// fixed order, so that the result does not depend on the build's vectorisation.
-double dot_widened(const float* __restrict col, const double* __restrict w, std::size_t n) {
-  double part[8] = {};
-  const std::size_t n8 = n - n % 8;
-  for (std::size_t i = 0; i < n8; i += 8)
-    for (std::size_t q = 0; q < 8; ++q) part[q] += static_cast<double>(col[i + q]) * w[i + q];
-  double s = ((part[0] + part[1]) + (part[2] + part[3])) + ((part[4] + part[5]) + (part[6] + part[7]));
-  for (std::size_t i = n8; i < n; ++i) s += static_cast<double>(col[i]) * w[i];
-  return s;
-}
-
-}  // namespace
+using physics::detail::dot8;
 
 bool FloatSupernodalFactor::assign(const cholmod_factor& L) {
   const std::size_t ns = L.nsuper;
@@ -100,7 +88,7 @@ void FloatSupernodalFactor::solve(std::span<const double> rhs, std::span<double>
     for (std::size_t i = nc; i < nr; ++i) w[i] = y[rows[i]];
     for (std::size_t j = nc; j-- > 0;) {
       const float* col = blk + j * nr;
-      w[j] = (w[j] - dot_widened(col + j + 1, w + j + 1, nr - j - 1)) / static_cast<double>(col[j]);
+      w[j] = (w[j] - dot8(col + j + 1, w + j + 1, nr - j - 1)) / static_cast<double>(col[j]);
     }
     std::copy_n(w, nc, y + c0);
   }

@@ -5,20 +5,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "../dot8.hpp"
+
 namespace sewn::physics::solve::detail {
 
 namespace {
 
-// Eight partial sums in a fixed order (deterministic; see cg.cpp).
-double dot(const double* __restrict x, const double* __restrict y, std::size_t n) {
-  double part[8] = {};
-  const std::size_t n8 = n - n % 8;
-  for (std::size_t k = 0; k < n8; k += 8)
-    for (std::size_t q = 0; q < 8; ++q) part[q] += x[k + q] * y[k + q];
-  double s = ((part[0] + part[1]) + (part[2] + part[3])) + ((part[4] + part[5]) + (part[6] + part[7]));
-  for (std::size_t k = n8; k < n; ++k) s += x[k] * y[k];
-  return s;
-}
+using physics::detail::dot8;
 
 // |S b| over the free axes (S the free-axis mask).
 double free_norm(std::span<const double> b, std::span<const double> free_dof) {
@@ -41,11 +34,11 @@ PcgOutcome zero_solution(std::span<double> x, std::span<const double> free_dof) 
 template <class Product, class Apply>
 void cg_iterate(std::size_t n, double* x, double* r, double* z, double* p, const double* q, double stop,
                 int max_iterations, Product&& product, Apply&& apply, PcgOutcome& out) {
-  double r_norm = std::sqrt(dot(r, r, n));
+  double r_norm = std::sqrt(dot8(r, r, n));
   if (r_norm > stop) apply();
   else std::fill(z, z + n, 0.0);
   std::copy(z, z + n, p);
-  double rz = dot(r, z, n);
+  double rz = dot8(r, z, n);
   int it = 0;
   while (r_norm > stop && it < max_iterations) {
     const double pq = product();
@@ -59,10 +52,10 @@ void cg_iterate(std::size_t n, double* x, double* r, double* z, double* p, const
       r[k] -= alpha * q[k];
     }
     ++it;
-    r_norm = std::sqrt(dot(r, r, n));
+    r_norm = std::sqrt(dot8(r, r, n));
     if (r_norm <= stop) break;
     apply();
-    const double rz_new = dot(r, z, n);
+    const double rz_new = dot8(r, z, n);
     const double beta = rz_new / rz;
     rz = rz_new;
     for (std::size_t k = 0; k < n; ++k) p[k] = z[k] + beta * p[k];
@@ -89,7 +82,7 @@ PcgOutcome pcg_with(const BlockMatrix& A, std::span<const double> b, std::span<d
   auto product = [&] {
     A.multiply(p, q);
     for (std::size_t k = 0; k < n3; ++k) q[k] *= free_dof[k];
-    return dot(p.data(), q.data(), n3);
+    return dot8(p.data(), q.data(), n3);
   };
   auto apply = [&] {
     precondition(r, z);

@@ -7,7 +7,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../.."))
-from vtk_checks import Checks, import_vtk  # noqa: E402
+from vtk_checks import Checks, import_vtk, read_vtu as read_with_vtk  # noqa: E402
 
 vtk = import_vtk("vtk_check")
 
@@ -16,11 +16,7 @@ check = checks.check
 failures = checks.failures
 
 def read_vtu(path):
-    r = vtk.vtkXMLUnstructuredGridReader()
-    r.SetFileName(path)
-    r.Update()
-    check(r.GetErrorCode() == 0, path + ": VTK reports error code %d" % r.GetErrorCode())
-    return r.GetOutput()
+    return read_with_vtk(vtk, path, check)
 
 
 def close(a, b):
