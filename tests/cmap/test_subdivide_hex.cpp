@@ -10,6 +10,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <map>
+#include <optional>
 #include <random>
 #include <span>
 #include <string>
@@ -207,6 +209,52 @@ TEST_CASE("subdivide_hexahedra keeps the darts it had: each starts the first hal
   for (Dart d : m.darts()) before.emplace_back(d, mid(point(m, d), point(m, b1(m, d))));
   m.subdivide_hexahedra(mid);
   for (const auto& [d, middle] : before) CHECK(point(m, b1(m, d)) == middle);
+}
+
+TEST_CASE("subdivide_hexahedra with edge and volume attributes: every fine cell gets its own, from its parent's") {
+  using Full = sewn::CMap<3, Point3, long, int, long>;  // faces carry none: none is made for them
+  for (int erased : {0, 1}) {
+    CAPTURE(erased);
+    Full m;
+    const sewn::IndexedMesh mesh = sewn::hex_grid(2, 2, 1);
+    const sewn::BuildResult built = sewn::build(m, mesh);
+    m.create_attributes<0>([&](Dart d) { return mesh.points[built.vertex_of_dart[d.index()]]; });
+    if (erased == 1) m.erase_dart(m.create_dart());  // a free slot for the pass to reuse
+    long next = 0;
+    (void)m.create_attributes<1>([&](Dart) { return 100 * ++next; });
+    (void)m.create_attributes<3>([&](Dart) { return 1000 * ++next; });
+    const std::uint32_t edges0 = m.num_attributes<1>(), volumes0 = m.num_attributes<3>();
+    int halves = 0, inner = 0;
+    m.subdivide_hexahedra(mid, [&](auto dim, const sewn::FineCell& c) {
+      constexpr int I = decltype(dim)::value;
+      if constexpr (I == 1) {
+        (c.parent == Dart::null_index ? inner : halves) += 1;
+        return c.parent == Dart::null_index ? std::optional<long>(-1) : std::optional<long>(m.attribute_container<1>().value(c.parent) + c.piece);
+      } else if constexpr (I == 3) {
+        REQUIRE(c.parent != Dart::null_index);
+        REQUIRE(c.darts.size() == 24);
+        REQUIRE(c.parent_darts.size() == 24);
+        CHECK(c.darts[static_cast<std::size_t>(3 * c.piece)] == c.parent_darts[static_cast<std::size_t>(3 * c.piece)]);
+        return std::optional<long>(m.attribute_container<3>().value(c.parent) + c.piece);
+      } else {
+        FAIL("faces carry no attribute: none is asked for");
+        return std::optional<int>();
+      }
+    });
+    const auto report = m.validate();
+    INFO(report.str());
+    REQUIRE(report.ok());
+    CHECK(halves == static_cast<int>(2 * edges0));
+    CHECK(m.num_attributes<1>() == m.count_all()[1]);
+    CHECK(m.num_attributes<1>() == static_cast<std::uint32_t>(halves + inner));
+    CHECK(m.num_attributes<3>() == 8 * volumes0);
+    CHECK(m.num_attributes<2>() == 0);
+    // every fine edge's value names its parent (a multiple of 100) and its half, each half once
+    std::map<long, int> seen;
+    for (auto a : m.attributes<1>()) ++seen[m.value(a)];
+    for (const auto& [v, n] : seen) CHECK(n == (v == -1 ? inner : 1));
+    for (Dart d : m.cells<1>()) CHECK(m.attribute<1>(d));
+  }
 }
 
 TEST_CASE("subdivide_hexahedra refuses anything but closed hexahedra of quads, the map unchanged") {

@@ -59,6 +59,18 @@ namespace sewn {
 /// Darts of an orbit or cell, in breadth-first order from the dart asked for (which comes first).
 using DartList = boost::container::small_vector<Dart, 32>;
 
+/// A fine cell made by CMap::subdivide_hexahedra(middle, fine), as its `fine` sees it.
+struct FineCell {
+  std::uint32_t parent = Dart::null_index;  ///< the parent cell's attribute index (null if none or new)
+  /// Edges and faces: 0 for the piece holding the parent attribute's recorded dart, else 1.
+  /// Volumes: the child v, the octant at corner v of the reference cube (see parent_darts).
+  int piece = 0;
+  std::span<const std::uint32_t> darts;  ///< its darts (volumes: the child's 24, by label 3s + i)
+  /// Volumes only: the parent's 24 darts by label 3s + i (dart 3s + i leaves corner s of the
+  /// reference cube, s = a + 2b + 4c, along axis i); parent dart 3v + i is child v's dart 3v + i.
+  std::span<const std::uint32_t> parent_darts;
+};
+
 /// A face table checked once and ready to instantiate: each half-edge (a dart-to-be, in table
 /// order) with its local start and end vertex and the index of its opposite half-edge.
 struct CellTemplate {
@@ -404,6 +416,15 @@ class CMap {
   /// called. O(darts).
   template <class Mid>
   void subdivide_hexahedra(Mid&& middle);
+  /// As subdivide_hexahedra(middle), on a map whose edges, faces or volumes may carry
+  /// attributes. For each I ≥ 1 with attributes, if any I-cell carried one before the pass, every
+  /// fine I-cell gets the value `fine(std::integral_constant<int, I>{}, const FineCell&)` returns
+  /// (a std::optional: nullopt leaves the cell without), and the parents' I-attributes are
+  /// released afterwards. No hooks are called: the caller makes the new cells' values from
+  /// their parents' (FineCell names the parent's attribute, still readable during the calls).
+  /// Fine cells are visited with the vertex attributes already in place. O(darts).
+  template <class Mid, class Fine>
+  void subdivide_hexahedra(Mid&& middle, Fine&& fine);
 
   [[nodiscard]] bool is_insertable_edge_in_face(Dart a, Dart b) const;
   /// Splits the face of a and b by a new edge from a's start vertex to b's start vertex (D ≥ 2;
@@ -707,6 +728,9 @@ class CMap {
   template <int I>
   void relabel(std::span<const std::uint32_t> cell, std::uint32_t from, std::uint32_t to);
   void flush_erased();
+  // subdivide_hexahedra: gives the darts of a fine I-cell the attribute `value` (a std::optional).
+  template <int I, class V>
+  void give_fine_attribute(V&& value, std::span<const std::uint32_t> cell);
 
   // Gives `to` the attributes of `from` for every dimension whose bit is set in dims.
   void inherit_attributes(std::uint32_t from, std::uint32_t to, unsigned dims);

@@ -13,8 +13,11 @@
 // are. The parent's darts are kept: parent dart 3s + i becomes child s's dart 3s + i (same
 // source, along the same edge, in the same face), as the insertion operations would keep it.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
+#include <span>
+#include <type_traits>
 #include <string>
 #include <vector>
 
@@ -101,9 +104,16 @@ namespace sewn {
 template <int D, class... A>
 template <class Mid>
 void CMap<D, A...>::subdivide_hexahedra(Mid&& middle) {
+  static_assert(!has_attribute<1> && !has_attribute<2> && !has_attribute<3>,
+                "subdivide_hexahedra: a map with edge, face or volume attributes needs the `fine` argument");
+  subdivide_hexahedra(std::forward<Mid>(middle), [](auto, const FineCell&) {});
+}
+
+template <int D, class... A>
+template <class Mid, class Fine>
+void CMap<D, A...>::subdivide_hexahedra(Mid&& middle, Fine&& fine) {
   static_assert(D == 3, "subdivide_hexahedra: a 3-map only");
-  static_assert(!has_attribute<1> && !has_attribute<2> && !has_attribute<3> && !has_dart_info,
-                "subdivide_hexahedra: maps with vertex attributes only (it gives new cells no other attribute)");
+  static_assert(!has_dart_info, "subdivide_hexahedra: maps without dart info only (it gives new darts none)");
   constexpr auto& T = detail::hex_labels;
   constexpr std::uint32_t null = detail::null_index;
   constexpr std::uint8_t none = detail::HexLabels::none;
@@ -197,6 +207,12 @@ void CMap<D, A...>::subdivide_hexahedra(Mid&& middle) {
     }
   }
 
+  // which dimensions above 0 carry attributes before the pass (their fine cells get them too)
+  std::array<bool, 4> had{};
+  for_each_dim([&](auto kk) {
+    if constexpr (kk() > 0 && has_attribute<kk()>) had[kk()] = store<kk()>().values.size() > 0;
+  });
+
   // 3) commit: attributes, then 168 new darts per volume (21 per child), every row written once
   std::vector<std::uint32_t> attr;
   if constexpr (has_attribute<0>) {
@@ -211,6 +227,9 @@ void CMap<D, A...>::subdivide_hexahedra(Mid&& middle) {
     x0 = cap;
     beta_.resize_uninitialised(std::size_t{cap} + fresh_count);
     if constexpr (has_attribute<0>) store<0>().of_dart.resize_uninitialised(std::size_t{cap} + fresh_count);
+    for_each_dim([&](auto kk) {
+      if constexpr (kk() > 0 && has_attribute<kk()>) store<kk()>().of_dart.resize(std::size_t{cap} + fresh_count, null);
+    });
     if ((x0 + 63) / 64 != (x0 + fresh_count + 63) / 64) marks_.resize(x0 + fresh_count);
     alive_ += fresh_count;
   } else {
@@ -279,6 +298,69 @@ void CMap<D, A...>::subdivide_hexahedra(Mid&& middle) {
       }
     }
   }
+
+  // 4) the fine edges', faces' and volumes' attributes, from the caller, and the parents' released
+  if constexpr (has_attribute<3>)
+    if (had[3]) {
+      auto& st = store<3>();
+      std::array<std::uint32_t, 24> child{};
+      for (std::uint32_t h = 0; h < hexes; ++h) {
+        const std::uint32_t* pd = hex_darts.data() + 24 * std::size_t{h};
+        const std::uint32_t parent = st.of_dart[pd[0]];
+        for (int v = 0; v < 8; ++v) {
+          for (int l = 0; l < 24; ++l) child[static_cast<std::size_t>(l)] = child_dart(h, pd, v, l);
+          const FineCell cell{parent, v, child, std::span<const std::uint32_t>(pd, 24)};
+          give_fine_attribute<3>(fine(std::integral_constant<int, 3>{}, cell), child);
+        }
+        if (parent != null) st.values.erase(parent);  // no hook: the caller made its successors
+      }
+    }
+  auto cells_of = [&](auto kk) {
+    constexpr int I = decltype(kk)::value;
+    if constexpr (I < 3 && has_attribute<I>) {
+      if (!had[I]) return;
+      auto& st = store<I>();
+      const Mark m = marks_.reserve();
+      std::vector<std::uint32_t> cell, parents;
+      const auto n = static_cast<std::uint32_t>(beta_.size());
+      for (std::uint32_t x = 0; x < n; ++x) {
+        if (!is_live_index(x) || marks_.test(x, m)) continue;
+        cell.clear();
+        collect_cell<I>(x, m, cell);
+        std::uint32_t parent = null;
+        for (std::uint32_t y : cell)
+          if (st.of_dart[y] != null) {
+            parent = st.of_dart[y];
+            break;
+          }
+        int piece = 0;
+        if (parent != null) {
+          parents.push_back(parent);
+          piece = std::find(cell.begin(), cell.end(), st.values.dart(parent)) != cell.end() ? 0 : 1;
+        }
+        give_fine_attribute<I>(fine(std::integral_constant<int, I>{}, FineCell{parent, piece, cell, {}}), cell);
+      }
+      free_mark(m);
+      std::sort(parents.begin(), parents.end());
+      parents.erase(std::unique(parents.begin(), parents.end()), parents.end());
+      for (std::uint32_t a : parents) st.values.erase(a);  // no hook: the caller made its successors
+    }
+  };
+  cells_of(std::integral_constant<int, 1>{});
+  cells_of(std::integral_constant<int, 2>{});
+}
+
+template <int D, class... A>
+template <int I, class V>
+void CMap<D, A...>::give_fine_attribute(V&& value, std::span<const std::uint32_t> cell) {
+  auto& st = store<I>();
+  std::uint32_t a = detail::null_index;
+  if (value) {
+    a = st.values.create(std::move(*value));
+    st.values.add_count(a, static_cast<std::int64_t>(cell.size()));
+    st.values.set_dart(a, cell.front());
+  }
+  for (std::uint32_t y : cell) st.of_dart[y] = a;
 }
 
 }  // namespace sewn
