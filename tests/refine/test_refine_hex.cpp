@@ -7,6 +7,8 @@
 #include <map>
 #include <random>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "sewn/physics/integrators.hpp"
 #include "sewn/refine/coarsen.hpp"
@@ -111,7 +113,157 @@ std::vector<Index> live(const MssModel<3>& m) {
   return out;
 }
 
+// Live elements matched by rest centroid: same level, measure, stiffnesses, corner particles (by
+// rest place) and parent (by its rest centroid).
+void same_elements(const MssModel<3>& a, const MssModel<3>& b) {
+  std::map<Key, Index> in_b;
+  for (Index e : live(b)) REQUIRE(in_b.emplace(key(b.element_centroid(e)), e).second);
+  REQUIRE(live(a).size() == in_b.size());
+  for (Index e : live(a)) {
+    CAPTURE(e);
+    REQUIRE(in_b.count(key(a.element_centroid(e))) == 1);
+    const Index f = in_b.at(key(a.element_centroid(e)));
+    const Element &x = a.elements()[e], &y = b.elements()[f];
+    CHECK(x.level == y.level);
+    CHECK(close(x.measure, y.measure));
+    CHECK(close(x.diagonal_k, y.diagonal_k));
+    for (std::size_t k = 0; k < 12; ++k) CHECK(close(x.edge_k[k], y.edge_k[k]));
+    const auto na = a.element_nodes(e), nb = b.element_nodes(f);
+    for (std::size_t k = 0; k < 8; ++k) CHECK(key(a.rest_position(na[k])) == key(b.rest_position(nb[k])));
+    REQUIRE((x.parent == invalid_index) == (y.parent == invalid_index));
+    if (x.parent != invalid_index) CHECK(key(a.element_centroid(x.parent)) == key(b.element_centroid(y.parent)));
+  }
+}
+
+// As same_model, where a cut has duplicated particles (several at one rest place): particles and
+// springs compared as sorted lists (by rest places, then values), pairwise to round-off.
+void same_model_cut(const MssModel<3>& a, const MssModel<3>& b) {
+  using NodeRow = std::tuple<Key, double, std::array<double, 6>>;
+  using SpringRow = std::tuple<Key, Key, int, std::array<double, 3>>;
+  auto rows = [](const MssModel<3>& m) {
+    std::vector<NodeRow> nodes;
+    for (Index i = 0; i < m.nodes().size(); ++i)
+      if (m.nodes().is_alive(i)) {
+        const Vector3d x = m.nodes().position(i), v = m.nodes().velocity(i);
+        nodes.emplace_back(key(m.rest_position(i)), m.nodes().mass(i), std::array{x.x(), x.y(), x.z(), v.x(), v.y(), v.z()});
+      }
+    std::vector<SpringRow> springs;
+    const Springs& sp = m.springs();
+    for (Index k = 0; k < sp.size(); ++k) {
+      if (!sp.is_alive(k)) continue;
+      Key i = key(m.rest_position(sp.node_i(k))), j = key(m.rest_position(sp.node_j(k)));
+      if (j < i) std::swap(i, j);
+      springs.emplace_back(i, j, static_cast<int>(sp.kind(k)), std::array{sp.stiffness(k), sp.rest_length(k), sp.viscosity(k)});
+    }
+    std::sort(nodes.begin(), nodes.end());
+    std::sort(springs.begin(), springs.end());
+    return std::make_pair(nodes, springs);
+  };
+  const auto [na, sa] = rows(a);
+  const auto [nb, sb] = rows(b);
+  REQUIRE(na.size() == nb.size());
+  REQUIRE(sa.size() == sb.size());
+  for (std::size_t i = 0; i < na.size(); ++i) {
+    REQUIRE(std::get<0>(na[i]) == std::get<0>(nb[i]));
+    CHECK(close(std::get<1>(na[i]), std::get<1>(nb[i])));
+    for (std::size_t c = 0; c < 6; ++c) CHECK(std::abs(std::get<2>(na[i])[c] - std::get<2>(nb[i])[c]) <= 1e-12);
+  }
+  for (std::size_t i = 0; i < sa.size(); ++i) {
+    REQUIRE(std::get<0>(sa[i]) == std::get<0>(sb[i]));
+    REQUIRE(std::get<1>(sa[i]) == std::get<1>(sb[i]));
+    REQUIRE(std::get<2>(sa[i]) == std::get<2>(sb[i]));
+    for (std::size_t c = 0; c < 3; ++c) CHECK(close(std::get<3>(sa[i])[c], std::get<3>(sb[i])[c]));
+  }
+}
+
+// The held axes of every particle, by rest place.
+std::multimap<Key, AxisMask> held(const MssModel<3>& m) {
+  std::vector<std::pair<Key, AxisMask>> out;
+  for (Index i = 0; i < m.nodes().size(); ++i)
+    if (m.nodes().is_alive(i)) out.emplace_back(key(m.rest_position(i)), m.nodes().fixed(i));
+  std::sort(out.begin(), out.end());
+  return {out.begin(), out.end()};
+}
+
+// Element by element, the reference for refine_all's batch pass.
+void refine_each(MssModel<3>& m) {
+  for (Index e : live(m)) (void)refine_element(m, e);
+}
+
 }  // namespace
+
+TEST_CASE("refine_all on a conforming hexahedral model: the batch pass makes the model element-by-element refinement makes") {
+  for (int cuts : {0, 2}) {
+    CAPTURE(cuts);
+    MssOptions o;  // gravity and the paper's viscous damping: masses and viscosities matter
+    MssModel<3> batch(grid(3, 2, 2, 1.0), {material}, {}, o), each(grid(3, 2, 2, 1.0), {material}, {}, o);
+    for (MssModel<3>* m : {&batch, &each}) {
+      affine_state(*m);
+      for (Index i = 0; i < m->nodes().size(); ++i)
+        if (m->rest_position(i).x() < 0.15) m->nodes().fix(i, i % 2 == 0 ? all_axes : axis_y);  // some held, some on one axis
+      const std::vector<Facet> inner = inner_facets(*m);
+      for (int c = 0; c < cuts; ++c) (void)cut(*m, std::vector<Facet>{inner[static_cast<std::size_t>(5 * c + 1)]});
+    }
+    const double mass0 = batch.node_mass();
+    const Vector3d p0 = momentum(batch.nodes());
+    for (int pass = 1; pass <= 2; ++pass) {
+      CAPTURE(pass);
+      REQUIRE(refines_in_one_pass(batch));
+      const RefineReport r = refine_all(batch);
+      refine_each(each);
+      check_all(batch);
+      check_all(each);
+      CHECK(r.children.size() == 8 * r.elements);
+      CHECK(batch.system().slaves().empty());
+      if (cuts == 0) same_model(batch, each);
+      same_model_cut(batch, each);
+      same_elements(batch, each);
+      CHECK(held(batch) == held(each));
+      CHECK(std::abs(batch.node_mass() - mass0) <= 1e-13 * mass0);
+      CHECK((momentum(batch.nodes()) - p0).norm() <= 1e-12 * p0.norm());
+      for (Index e : live(batch)) CHECK(level_index(batch.elements()[e].level) == 1 + pass);
+    }
+  }
+}
+
+TEST_CASE("refine_all: the batch pass k times is the grid built at the fine size; T-junctions take the element path") {
+  for (int k = 1; k <= 2; ++k) {
+    CAPTURE(k);
+    MssModel<3> m(grid(2, 1, 1, 1.0), {material}, {}, no_gravity());
+    affine_state(m);
+    for (int pass = 0; pass < k; ++pass) {
+      REQUIRE(refines_in_one_pass(m));
+      (void)refine_all(m);
+      check_all(m);
+    }
+    const std::uint32_t n = 1u << k;
+    MssModel<3> fine(grid(2 * n, n, n, 1.0 / n), {material}, {}, no_gravity());
+    affine_state(fine);
+    same_model(m, fine);
+  }
+  MssModel<3> m(grid(2, 1, 1, 1.0), {material}, {}, no_gravity());
+  (void)refine_element(m, 0);
+  CHECK_FALSE(refines_in_one_pass(m));  // element 1 has T-junctions on the shared face
+  const RefineReport r = refine_all(m);
+  CHECK(r.elements == 9);
+  check_all(m);
+  check_constraints_fresh(m);
+}
+
+TEST_CASE("refine_all: a level beyond the maximum is refused before the batch pass, the model unchanged") {
+  MssModel<3> m(grid(2, 1, 1, 1.0), {material}, {}, no_gravity());
+  RefineOptions o;
+  o.max_level = 2;
+  (void)refine_all(m, o);
+  const auto darts = m.map().num_darts();
+  const auto nodes = m.nodes().num_alive();
+  const auto springs = m.springs().num_alive();
+  CHECK_THROWS_WITH_AS(refine_all(m, o), doctest::Contains("maximum level 2"), InputError);
+  CHECK(m.map().num_darts() == darts);
+  CHECK(m.nodes().num_alive() == nodes);
+  CHECK(m.springs().num_alive() == springs);
+  check_all(m);
+}
 
 TEST_CASE("refine hexahedra: uniform refinement k times is the grid built at the fine size") {
   for (int k = 1; k <= 2; ++k) {

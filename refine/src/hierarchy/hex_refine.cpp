@@ -14,6 +14,7 @@
 #include "hierarchy/refiner_base.hpp"
 #include "hierarchy/segment_walk.hpp"
 #include "hierarchy/sides.hpp"
+#include "hierarchy/hex_child.hpp"
 #include "hierarchy/hex_codes.hpp"
 
 namespace sewn::refine::detail {
@@ -171,34 +172,11 @@ class HexRefiner : RefinerBase<3> {
       }
       const DartList vol = piece(v);
       const Dart dart = walk_segment(m_, std::span<const Dart>(vol.data(), vol.size()), corner[0], corner[1]).front();
-      elements.push_back(make_child(parent, e, dart, corner));
+      elements.push_back(make_hex_child(m_, parent, e, dart, corner));
       map_.template set_attribute<3>(dart, physics::ElementRef{first + static_cast<Index>(v)});
       code_hex_volume(m_, vol, corner);
     }
     retire(e, first, 8);
-  }
-
-  Element make_child(const Element& parent, Index e, Dart dart, const std::array<Index, 8>& corner) const {
-    const physics::MaterialParams& mat = m_.materials()[parent.material];
-    auto r = [&](int k) { return m_.rest_position(corner[static_cast<std::size_t>(k)]); };
-    Element el;
-    el.kind = ElementKind::hexahedron;
-    el.material = parent.material;
-    el.mesh_cell = parent.mesh_cell;
-    el.dart = dart;
-    el.level = 2 * parent.level;
-    el.parent = e;
-    // the model's own rules for a hexahedron (MssModel's make_element), at the child's rest size
-    std::array<double, 3> len{};
-    for (std::size_t k = 0; k < 12; ++k) len[k / 4] += (r(hex_edge_ends[k][1]) - r(hex_edge_ends[k][0])).norm() / 4;
-    physics::BoxStiffness s = physics::baudet_box(mat.young, mat.poisson, len[0], len[1], len[2]);
-    if (!s.valid()) s = physics::clamp_edges(s, 0.0);  // only a parent built under the clamp policy gets here
-    for (std::size_t k = 0; k < 12; ++k) el.edge_k[k] = s.edge[k / 4];
-    el.diagonal_k = s.diagonal;
-    static constexpr int kuhn[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6}, {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
-    for (const auto& t : kuhn) el.measure += physics::tet_volume(r(t[0]), r(t[1]), r(t[2]), r(t[3]));
-    for (std::size_t k = 0; k < 4; ++k) el.diagonal[k] = m_.springs().add(0, 1, el.diagonal_k, 0.0, physics::SpringKind::diagonal);
-    return el;
   }
 
   std::uint32_t level_ = 1;

@@ -68,6 +68,8 @@ struct ModelAccess {
   }
   static void set_live_elements(Model& m, Index n) { m.live_elements_ = n; }
   static void attach_diagonals(Model& m, Index e) { m.attach_diagonals(e); }
+  /// Codes every dart of element e (a closed cell) from its canonical dart, as the builder does.
+  static void index_darts(Model& m, Index e) { m.index_darts(e); }
 };
 
 }  // namespace sewn::refine::detail

@@ -13,6 +13,21 @@
 
 namespace sewn::refine::detail {
 
+/// Element e stops being an element: not alive, its `children` (appended from `first`) in its
+/// place, its diagonal springs removed.
+template <int D>
+void retire_parent(physics::MssModel<D>& m, physics::Index e, physics::Index first, physics::Index children) {
+  physics::Element& p = ModelAccess<D>::elements(m)[e];
+  p.alive = false;
+  p.first_child = first;
+  for (physics::Index& s : p.diagonal)
+    if (s != physics::invalid_index) {
+      m.springs().remove(s);
+      s = physics::invalid_index;
+    }
+  ModelAccess<D>::set_live_elements(m, m.num_live_elements() + children - 1);
+}
+
 template <int D>
 class RefinerBase {
  public:
@@ -88,15 +103,7 @@ class RefinerBase {
 
   /// The parent stops being an element; its children (already appended) replace it.
   void retire(Index e, Index first, Index children) {
-    physics::Element& p = A::elements(m_)[e];
-    p.alive = false;
-    p.first_child = first;
-    for (Index& s : p.diagonal)
-      if (s != physics::invalid_index) {
-        m_.springs().remove(s);
-        s = physics::invalid_index;
-      }
-    A::set_live_elements(m_, m_.num_live_elements() + children - 1);
+    retire_parent(m_, e, first, children);
     for (Index k = 0; k < children; ++k) {
       A::attach_diagonals(m_, first + k);
       report_.children.push_back(first + k);
@@ -113,5 +120,13 @@ class RefinerBase {
 template <int D>
 void refine_quad(physics::MssModel<D>& m, physics::Index e, RefineReport& report);
 void refine_hex(physics::MssModel<3>& m, physics::Index e, RefineReport& report);
+
+/// True if refine_all may take the batch pass (hex_batch.cpp): every live element a hexahedron of
+/// one level, each a closed volume of 24 darts (no T-junction anywhere, no slave node), every edge
+/// of that level with a live spring of its own (no segment), no face element. O(elements + edges).
+[[nodiscard]] bool batch_refinable(const physics::MssModel<3>& m);
+/// Every live hexahedron refined 1:8 by the map's batch pass, the physics rebuilt in bulk; inside
+/// MssModel::edit() with the refining flag set, after the elements were checked. O(model).
+void refine_all_hexahedra(physics::MssModel<3>& m, RefineReport& report);
 
 }  // namespace sewn::refine::detail

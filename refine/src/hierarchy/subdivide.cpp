@@ -146,9 +146,28 @@ RefineReport refine_all(MssModel<D>& m, const RefineOptions& options) {
   std::vector<Index> live;
   for (Index e = 0; e < m.elements().size(); ++e)
     if (m.elements()[e].alive) live.push_back(e);
+  if constexpr (D == 3)
+    if (!live.empty() && refines_in_one_pass(m)) {
+      // a conforming hexahedral model: the map's batch pass and one rebuild of the physics (no
+      // T-junction before or after, so the constraints stay empty)
+      for (Index e : live) check_refinable(m, e, options);
+      RefineReport report;
+      in_one_edit(m, [&] { detail::refine_all_hexahedra(m, report); });
+      return report;
+    }
   return refine_elements(m, std::span<const Index>(live), options);
 }
 
+template <int D>
+bool refines_in_one_pass(const MssModel<D>& m) {
+  if constexpr (D == 3)
+    return detail::batch_refinable(m);
+  else
+    return false;
+}
+
+template bool refines_in_one_pass(const MssModel<2>&);
+template bool refines_in_one_pass(const MssModel<3>&);
 template RefineReport refine_element(MssModel<2>&, Index, const RefineOptions&);
 template RefineReport refine_element(MssModel<3>&, Index, const RefineOptions&);
 template RefineReport refine_elements(MssModel<2>&, std::span<const Index>, const RefineOptions&);

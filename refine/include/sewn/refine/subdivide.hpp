@@ -74,8 +74,19 @@ template <int D>
 template <int D>
 [[nodiscard]] bool coarsening_keeps_balance(const MssModel<D>& m, Index parent);
 
-/// Refines every live element once: a uniform refinement. O(model).
+/// Refines every live element once: a uniform refinement. A conforming hexahedral model
+/// (refines_in_one_pass) is refined by the map's batch pass (CMap::subdivide_hexahedra) and its
+/// physics rebuilt once in bulk: the model refine_elements() on every element makes, its new
+/// particles and springs numbered in another order (see refine/src/hierarchy/hex_batch.cpp); any
+/// other model element by element. Throws as refine_element(), the model unchanged, if an element
+/// would pass options.max_level. O(model).
 template <int D>
 RefineReport refine_all(MssModel<D>& m, const RefineOptions& options = {});
+
+/// True if refine_all(m) takes the batch pass: a 3-map whose live elements are all hexahedra of
+/// one level, each a closed volume of 24 darts (no T-junction, no slave node), every edge of that
+/// level carrying a live spring of its own, and no face element. O(elements + edges).
+template <int D>
+[[nodiscard]] bool refines_in_one_pass(const MssModel<D>& m);
 
 }  // namespace sewn::refine

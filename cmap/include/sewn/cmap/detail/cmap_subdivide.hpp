@@ -323,10 +323,33 @@ void CMap<D, A...>::subdivide_hexahedra(Mid&& middle, Fine&& fine) {
       const Mark m = marks_.reserve();
       std::vector<std::uint32_t> cell, parents;
       const auto n = static_cast<std::uint32_t>(beta_.size());
+      std::vector<bool> seen_edge(I == 1 ? n : 0);
       for (std::uint32_t x = 0; x < n; ++x) {
-        if (!is_live_index(x) || marks_.test(x, m)) continue;
+        if (!is_live_index(x)) continue;
         cell.clear();
-        collect_cell<I>(x, m, cell);
+        if constexpr (I == 1) {
+          // an edge of closed volumes is its fan: (y, β2 y) for y along β3∘β2, both ways if open
+          if (seen_edge[x]) continue;
+          std::uint32_t y = x;
+          bool closed = false;
+          for (;;) {
+            cell.push_back(y);
+            cell.push_back(b(y, 2));
+            y = b(b(y, 2), 3);
+            if (y == null || y == x) {
+              closed = y == x;
+              break;
+            }
+          }
+          for (y = closed ? null : b(x, 3); y != null; y = b(b(y, 2), 3)) {
+            cell.push_back(y);
+            cell.push_back(b(y, 2));
+          }
+          for (std::uint32_t z : cell) seen_edge[z] = true;
+        } else {
+          if (marks_.test(x, m)) continue;
+          collect_cell<I>(x, m, cell);
+        }
         std::uint32_t parent = null;
         for (std::uint32_t y : cell)
           if (st.of_dart[y] != null) {
