@@ -122,7 +122,7 @@ struct Wing {
   Wing(const Vec3& n, double le) {
     const double nn = n.squaredNorm();
     n_over = n / nn;
-    u = -le * n_over;
+    u = n * (-le / nn);  // as angle_gradient forms it, so that both give the same ∇θ
     reflect = (le / nn) * (Mat3::Identity() - (2.0 / nn) * n * n.transpose());
   }
   [[nodiscard]] Mat3 d(const Mat3& dn, const Eigen::RowVector3d& dle) const { return -n_over * dle - reflect * dn; }
@@ -136,8 +136,12 @@ struct Wing {
 // n_B = (x2-x3)×(x1-x3): ∂n_B/∂x1 = [x2-x3]×, ∂/∂x2 = -[x1-x3]×, ∂/∂x3 = -[e]×;
 // s = (x_w - x1)·e/|e|²: ∂s/∂x_w = e/|e|², ∂s/∂x2 = ((x_w - x1) - 2 s e)/|e|², ∂s/∂x1 the
 // negated sum. About 1k flops where forward AD with 12-wide duals took ~2.5k and its copies.
-Mat12 dihedral_hessian(const HingePositions& x) {
-  if (!well_shaped(x)) return Mat12::Zero();
+void dihedral_derivatives(const HingePositions& x, Vec12& g, Mat12& H) {
+  if (!well_shaped(x)) {
+    g.setZero();
+    H.setZero();
+    return;
+  }
   const Vec3 x0 = x.col(0), x1 = x.col(1), x2 = x.col(2), x3 = x.col(3);
   const Vec3 e = x2 - x1;
   const double le2 = e.squaredNorm(), le = std::sqrt(le2);
@@ -163,7 +167,10 @@ Mat12 dihedral_hessian(const HingePositions& x) {
   dsB[2] = ((x3 - x1) - 2.0 * sB * e).transpose() / le2;
   dsB[1] = -dsB[3] - dsB[2];
   dsB[0].setZero();
-  Mat12 H;
+  g.segment<3>(0) = A.u;
+  g.segment<3>(3) = A.u * (sA - 1.0) + B.u * (sB - 1.0);
+  g.segment<3>(6) = A.u * (-sA) + B.u * (-sB);
+  g.segment<3>(9) = B.u;
   for (int j = 0; j < 4; ++j) {
     const auto J = static_cast<std::size_t>(j);
     const Mat3 uA_sA = A.u * dsA[J], uB_sB = B.u * dsB[J];
@@ -172,7 +179,14 @@ Mat12 dihedral_hessian(const HingePositions& x) {
     H.block<3, 3>(6, 3 * j) = -sA * dA[J] - uA_sA - sB * dB[J] - uB_sB;
     H.block<3, 3>(9, 3 * j) = dB[J];
   }
-  return 0.5 * (H + H.transpose());
+  H = (0.5 * (H + H.transpose())).eval();
+}
+
+Mat12 dihedral_hessian(const HingePositions& x) {
+  Vec12 g;
+  Mat12 H;
+  dihedral_derivatives(x, g, H);
+  return H;
 }
 
 Mat12 hinge_hessian(const HingePositions& x, const HingeRest& rest, double k_b) {

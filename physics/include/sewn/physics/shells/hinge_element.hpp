@@ -42,6 +42,8 @@ struct HingeRest {
 [[nodiscard]] Vec12 dihedral_gradient(const HingePositions& x);
 /// ∇²θ (12×12, symmetric); zero where ∇θ is undefined.
 [[nodiscard]] Mat12 dihedral_hessian(const HingePositions& x);
+/// ∇θ and ∇²θ together (what dihedral_gradient and dihedral_hessian give), sharing their work.
+void dihedral_derivatives(const HingePositions& x, Vec12& g, Mat12& H);
 /// d wrapped into (-π, π]: the change of an angle from its rest value without a 2π jump.
 [[nodiscard]] double wrap_angle(double d);
 
