@@ -175,6 +175,27 @@ TEST_CASE("hinge bending: angle, gradient and Hessian match finite differences, 
   }
 }
 
+TEST_CASE("hinge bending: the closed-form angle Hessian matches differences of the angle gradient on random hinges") {
+  // Random hinges, wings leaning past the edge's ends included (s_A, s_B outside [0, 1]), at
+  // several scales: ∇²θ against central differences of ∇θ.
+  std::mt19937 rng(181);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 40; ++trial) {
+    CAPTURE(trial);
+    const double scale = std::pow(10.0, u(rng) * 2.0);
+    shells::HingePositions x;
+    x.col(1) = Vector3d(0, 0, 0);
+    x.col(2) = Vector3d(0, 1, 0);
+    x.col(0) = Vector3d(-1.0, 1.5 * u(rng) + 0.5, 0.8 * u(rng));
+    x.col(3) = Vector3d(1.0, 1.5 * u(rng) + 0.5, 0.8 * u(rng));
+    x = scale * (random_rotation(rng) * (x + 0.2 * shells::HingePositions::NullaryExpr([&] { return u(rng); })));
+    const Eigen::MatrixXd H = shells::dihedral_hessian(x);
+    const Eigen::MatrixXd H_fd = fd_jacobian<shells::HingePositions>(
+        [](const shells::HingePositions& y) { return Eigen::VectorXd(shells::dihedral_gradient(y)); }, x, 1e-6 * scale);
+    CHECK(rel_err(H, H_fd) < 1e-6);
+  }
+}
+
 TEST_CASE("PSD projection clamps negative eigenvalues and keeps PSD matrices") {
   std::mt19937 rng(19);
   std::uniform_real_distribution<double> u(-1.0, 1.0);

@@ -163,18 +163,22 @@ elements::Mat<3 * N> patch_hessian(const PatchPositions<N>& x, const PatchRest& 
   // J: row k is ∂d_k/∂x = ℓ_k ∇θ_k; H = Jᵀ S J + Σ_k (S d)_k ℓ_k ∇²θ_k
   Eigen::Matrix<double, 3, 3 * N> J = Eigen::Matrix<double, 3, 3 * N>::Zero();
   elements::Mat<3 * N> H = elements::Mat<3 * N>::Zero();
+  Vec12 gk;
+  Mat12 hk;
   for (int k = 0; k < rest.count; ++k) {
     const auto cols = hinge_columns<N>(rest, k);
-    const HingePositions h = hinge_of<N>(x, cols);
     const double lever = rest.lever[static_cast<std::size_t>(k)];
-    scatter_row<N>(J, k, cols, dihedral_gradient(h) * lever);
-    const Mat12 hk = dihedral_hessian(h) * (Sd[k] * lever);
+    dihedral_derivatives(hinge_of<N>(x, cols), gk, hk);
+    scatter_row<N>(J, k, cols, gk * lever);
+    const double c = Sd[k] * lever;
     for (int a = 0; a < 4; ++a) {
       const int A = cols[static_cast<std::size_t>(a)];
-      for (int b = 0; b < 4; ++b) H.template block<3, 3>(3 * A, 3 * cols[static_cast<std::size_t>(b)]) += hk.block<3, 3>(3 * a, 3 * b);
+      for (int b = 0; b < 4; ++b) H.template block<3, 3>(3 * A, 3 * cols[static_cast<std::size_t>(b)]) += c * hk.block<3, 3>(3 * a, 3 * b);
     }
   }
-  H += J.transpose() * rest.stiffness * J;
+  // coefficient-wise products: Eigen's blocked GEMM costs more than the ~1k flops at this size
+  const Eigen::Matrix<double, 3, 3 * N> SJ = rest.stiffness.lazyProduct(J);
+  H.noalias() += J.transpose().lazyProduct(SJ);
   return 0.5 * (H + H.transpose());
 }
 

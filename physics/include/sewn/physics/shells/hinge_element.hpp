@@ -7,12 +7,12 @@
 // column i is node i.
 // Angle: θ = atan2((n_A × n_B)·ê, n_A·n_B), 0 when flat, in (-π, π]; θ - θ̄ is wrapped into
 // (-π, π] so that a hinge whose rest angle is near ±π does not see a 2π jump.
-// Gradient: the closed form of §3.2. Hessian: 2 k_B w (∇θ∇θᵀ + (θ - θ̄)∇²θ), ∇²θ by
-// forward-mode automatic differentiation of the closed-form ∇θ (Eigen's AutoDiff).
+// Gradient: the closed form of §3.2. Hessian: 2 k_B w (∇θ∇θᵀ + (θ - θ̄)∇²θ), ∇²θ the
+// closed-form gradient differentiated by hand (hinge_element.cpp).
 // Calibration: k_B = D/6, D = E h³/(12(1-ν²)), reproduces ½D∫κ² for cylindrical bending.
 // A hinge with a zero-area face or a zero-length edge has no defined angle gradient: it gives
 // zero gradient and Hessian there (and its energy from atan2's value).
-// Cost: energy ~80 flops, gradient ~120, Hessian ~2.5k (12-wide dual numbers).
+// Cost: energy ~80 flops, gradient ~120, Hessian ~1k.
 
 #include <Eigen/Core>
 
@@ -42,6 +42,8 @@ struct HingeRest {
 [[nodiscard]] Vec12 dihedral_gradient(const HingePositions& x);
 /// ∇²θ (12×12, symmetric); zero where ∇θ is undefined.
 [[nodiscard]] Mat12 dihedral_hessian(const HingePositions& x);
+/// ∇θ and ∇²θ together (what dihedral_gradient and dihedral_hessian give), sharing their work.
+void dihedral_derivatives(const HingePositions& x, Vec12& g, Mat12& H);
 /// d wrapped into (-π, π]: the change of an angle from its rest value without a 2π jump.
 [[nodiscard]] double wrap_angle(double d);
 

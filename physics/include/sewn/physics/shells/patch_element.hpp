@@ -25,8 +25,8 @@
 //
 // Stencil: N = 3 + K nodes, T's corners (counter-clockwise seen along T's normal) then the
 // opposite node of each interior edge in the order of `PatchRest::edge`; DOF order
-// [x0 y0 z0 x1 ...] (3N). Cost: energy ~K·100 flops, gradient ~K·150, Hessian ~K·3k
-// (each edge's angle Hessian by forward-mode AutoDiff) plus (3N)² for the outer products.
+// [x0 y0 z0 x1 ...] (3N). Cost: energy ~K·100 flops, gradient ~K·150, Hessian ~K·1.2k
+// (each edge's closed-form angle Hessian, dihedral_derivatives) plus (3N)² for the outer products.
 
 #include <array>
 #include <cstdint>
