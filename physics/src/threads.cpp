@@ -49,13 +49,16 @@ bool parallel_build() {
 #endif
 }
 
-SerialLibraryRegions::SerialLibraryRegions() {
+SerialLibraryRegions::SerialLibraryRegions(int library_team) {
 #ifdef SEWN_HAVE_OPENMP
-  if (thread_count() != 1) return;
+  // The run asked for as many threads as the library's team: its regions may use them.
+  if (thread_count() >= library_team) return;
   // No active level allowed: every parallel region, whatever its num_threads clause, gets a
   // team of one (the only OpenMP setting a library's explicit clause does not override).
   saved_ = omp_get_max_active_levels();
   omp_set_max_active_levels(0);
+#else
+  (void)library_team;
 #endif
 }
 
