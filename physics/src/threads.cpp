@@ -1,10 +1,12 @@
 #include "sewn/physics/threads.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <string>
 
 #include "sewn/physics/errors.hpp"
+#include "parallel/ranges.hpp"
 
 #ifdef SEWN_HAVE_OPENMP
 #include <omp.h>
@@ -47,6 +49,37 @@ bool parallel_build() {
 #else
   return false;
 #endif
+}
+
+namespace {
+thread_local std::uint64_t split = 0;
+// A site's first back-off after a late region, in regions, and the most it grows to: a late
+// try costs about one time slice of the late thread, so on a machine that stays loaded the
+// tries cost a few percent of the regions' time, and after the load goes a site forks again
+// within 4096 regions (a second or so of steps).
+constexpr int first_backoff = 4, max_backoff = 4096;
+}  // namespace
+
+std::uint64_t split_regions() { return split; }
+
+bool detail::fork_next_region(RegionPacing& pacing) {
+  ++split;
+#ifdef SEWN_HAVE_OPENMP
+  if (pacing.skip == 0) return true;
+  --pacing.skip;
+#else
+  (void)pacing;
+#endif
+  return false;
+}
+
+void detail::region_done(RegionPacing& pacing, double region_s, double ranges_s) {
+  if (region_s <= ranges_s) {
+    pacing.backoff = 0;
+    return;
+  }
+  pacing.backoff = pacing.backoff == 0 ? first_backoff : std::min(2 * pacing.backoff, max_backoff);
+  pacing.skip = pacing.backoff;
 }
 
 SerialLibraryRegions::SerialLibraryRegions(int library_team) {

@@ -243,3 +243,38 @@ TEST_CASE("threads: trajectories repeat bitwise at 2 threads and agree with 1 th
 }
 
 }  // namespace test_threads
+
+namespace test_threads {
+
+TEST_CASE("threads: a small model's steps stay on one thread at 2 threads, the block's split") {
+  using threads_test::Threads;
+  Threads two(2);
+  // 3×3×4 cubes: 80 particles, below every kernel's threshold (forces, Jacobian, product, CG)
+  auto small = std::make_unique<MssModel<3>>(hex_grid(3, 3, 4, {{0.005, 0.005, 0.005}, {}}),
+                                             std::vector<MaterialParams>{{1e6, 0.3, 1000}}, std::vector<std::uint32_t>{});
+  small->nodes().fix(0);
+  auto block = threads_test::block_model();
+  SymplecticEulerOptions so;
+  so.enforce_stable_step = false;
+  ImplicitEulerOptions io;
+  io.solver = solve::Backend::jacobi;
+  for (const bool implicit : {false, true}) {
+    CAPTURE(implicit);
+    SymplecticEuler semi(so);
+    LinearlyImplicitEuler lin(io);
+    const auto step = [&](MssModel<3>& m) {
+      if (implicit)
+        (void)lin.step(m.system(), 2e-5);
+      else
+        (void)semi.step(m.system(), 2e-6);
+    };
+    const std::uint64_t before = split_regions();
+    for (int s = 0; s < 3; ++s) step(*small);
+    CHECK(split_regions() == before);
+    lin.reset();
+    for (int s = 0; s < 3; ++s) step(*block);
+    CHECK(split_regions() > before);
+  }
+}
+
+}  // namespace test_threads

@@ -11,6 +11,8 @@
 // same per-thread split is run one range after the other: results equal those of a parallel
 // build with that count, only not faster.
 
+#include <cstdint>
+
 namespace sewn::physics {
 
 /// Largest thread count accepted.
@@ -28,6 +30,14 @@ void set_thread_count(int threads);
 [[nodiscard]] int parse_thread_count(const char* text, const char* what);
 /// True if this build runs ranges in parallel (OpenMP found at build time).
 [[nodiscard]] bool parallel_build();
+/// How many regions the physics kernels called from this thread have split into more than one
+/// range so far (a kernel below its size threshold splits none): for tests and diagnostics.
+/// A split region forks a team unless its call site is backing off: when a region's team came
+/// late (the join later than running its ranges one after the other would have been: other
+/// work held a core), the site runs its next 4 regions on the calling thread, then tries again,
+/// doubling that count after each late try up to 4096 and forgetting it after an on-time one.
+/// Results do not change (the ranges are the count's), only where they run. O(1).
+[[nodiscard]] std::uint64_t split_regions();
 
 /// The team CHOLMOD's OpenMP regions ask for: its build fixes num_threads(4) (counted with a
 /// GOMP_parallel shim on the frisbee's factorizations), not settable through its API.
