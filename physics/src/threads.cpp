@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstdlib>
 #include <string>
 
@@ -52,34 +53,37 @@ bool parallel_build() {
 }
 
 namespace {
+using clock = std::chrono::steady_clock;
 thread_local std::uint64_t split = 0;
-// A site's first back-off after a late region, in regions, and the most it grows to: a late
-// try costs about one time slice of the late thread, so on a machine that stays loaded the
-// tries cost a few percent of the regions' time, and after the load goes a site forks again
-// within 4096 regions (a second or so of steps).
-constexpr int first_backoff = 4, max_backoff = 4096;
+// Back-off of the calling thread's regions: none forks before next_try while wait_s > 0. A late
+// team is the machine's state, not one kernel's, so one late region holds back every kernel.
+thread_local double wait_s = 0.0;
+thread_local clock::time_point next_try{};
+// A late region loses about a time slice of the late thread (milliseconds, against tens of
+// microseconds of work): waiting 50 times what it lost keeps the tries under 2 % of the time
+// on a machine that stays loaded; doubling after each late try, up to 2 s, and forgetting it
+// after an on-time one, a run forks again within seconds of the load going.
+constexpr double wait_per_lost = 50.0, max_wait_s = 2.0;
 }  // namespace
 
 std::uint64_t split_regions() { return split; }
 
-bool detail::fork_next_region(RegionPacing& pacing) {
+bool detail::fork_next_region() {
   ++split;
 #ifdef SEWN_HAVE_OPENMP
-  if (pacing.skip == 0) return true;
-  --pacing.skip;
+  return wait_s == 0.0 || clock::now() >= next_try;
 #else
-  (void)pacing;
-#endif
   return false;
+#endif
 }
 
-void detail::region_done(RegionPacing& pacing, double region_s, double ranges_s) {
-  if (region_s <= ranges_s) {
-    pacing.backoff = 0;
+void detail::region_done(double region_s, double serial_s) {
+  if (region_s <= serial_s) {
+    wait_s = 0.0;
     return;
   }
-  pacing.backoff = pacing.backoff == 0 ? first_backoff : std::min(2 * pacing.backoff, max_backoff);
-  pacing.skip = pacing.backoff;
+  wait_s = std::min(std::max(2.0 * wait_s, wait_per_lost * (region_s - serial_s)), max_wait_s);
+  next_try = clock::now() + std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(wait_s));
 }
 
 SerialLibraryRegions::SerialLibraryRegions(int library_team) {

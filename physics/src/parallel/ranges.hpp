@@ -4,7 +4,6 @@
 // Without OpenMP the ranges run one after the other, with the same results.
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cstddef>
 
@@ -25,55 +24,51 @@ inline std::size_t range_begin(std::size_t items, int parts, int t) {
          std::min(items % static_cast<std::size_t>(parts), static_cast<std::size_t>(t));
 }
 
-/// One call site's record of its forked regions: how many regions to run unforked before
-/// forking again, and the back-off that follows the next late one (threads.cpp).
-struct RegionPacing {
-  int skip = 0;
-  int backoff = 0;
-};
-
-/// Whether the next region of a call site is to fork, or to run its ranges on the calling
-/// thread while the site backs off after a region whose team came late. Counts the region
+/// Whether the next split region is to fork, or to run its ranges on the calling thread while
+/// this thread backs off after a region whose team came late (threads.cpp). Counts the region
 /// (split_regions()); false without OpenMP.
-bool fork_next_region(RegionPacing& pacing);
-/// Reports a forked region: seconds from the fork to the join, and the sum of its ranges'
-/// own durations (what running them one after the other would have cost).
-void region_done(RegionPacing& pacing, double region_s, double ranges_s);
+bool fork_next_region();
+/// Reports a forked region: seconds from the fork to the join, and an estimate of what running
+/// its ranges one after the other would have cost.
+void region_done(double region_s, double serial_s);
 
 /// Calls body(t) for t in [0, parts), on `parts` threads when OpenMP is built in. body must
 /// not throw (an exception cannot leave an OpenMP region): kernels record failures instead.
 /// The ranges are fixed by `parts` alone, so running them on fewer threads (the runtime's
-/// team, or one while the site backs off on a loaded machine) changes no result.
+/// team, or one while backing off on a loaded machine) changes no result.
 template <class Body>
 void run_parts(int parts, const Body& body) {
   if (parts <= 1) {
     body(0);
     return;
   }
-  // One per call site (each passes a lambda of its own type) and per stepping thread.
-  static thread_local RegionPacing pacing;
-  if (!fork_next_region(pacing)) {
+  if (!fork_next_region()) {
     for (int t = 0; t < parts; ++t) body(t);
     return;
   }
 #ifdef SEWN_HAVE_OPENMP
   using clock = std::chrono::steady_clock;
   const clock::time_point start = clock::now();
-  std::array<double, max_threads> took{};
+  double first_s = 0.0;
 #pragma omp parallel num_threads(parts)
   {
-    // Each range exactly once, whatever number of threads the runtime granted.
+    // Each range exactly once, whatever number of threads the runtime granted; range 0 is the
+    // calling thread's (the static schedule's first iteration goes to thread 0).
 #pragma omp for schedule(static, 1)
     for (int t = 0; t < parts; ++t) {
+      if (t != 0) {
+        body(t);
+        continue;
+      }
       const clock::time_point begin = clock::now();
-      body(t);
-      took[static_cast<std::size_t>(t)] = std::chrono::duration<double>(clock::now() - begin).count();
+      body(0);
+      first_s = std::chrono::duration<double>(clock::now() - begin).count();
     }
   }
-  const double region_s = std::chrono::duration<double>(clock::now() - start).count();
-  double ranges_s = 0.0;
-  for (int t = 0; t < parts; ++t) ranges_s += took[static_cast<std::size_t>(t)];
-  region_done(pacing, region_s, ranges_s);
+  // The ranges are of one size: the calling thread's time, times their count, is what running
+  // them one after the other would cost. Not the sum of every range's time: a worker
+  // preempted midway keeps its clock running, and its late region would look on time.
+  region_done(std::chrono::duration<double>(clock::now() - start).count(), first_s * parts);
 #endif
 }
 

@@ -32,11 +32,11 @@ void set_thread_count(int threads);
 [[nodiscard]] bool parallel_build();
 /// How many regions the physics kernels called from this thread have split into more than one
 /// range so far (a kernel below its size threshold splits none): for tests and diagnostics.
-/// A split region forks a team unless its call site is backing off: when a region's team came
+/// A split region forks a team unless the thread is backing off: when a region's team came
 /// late (the join later than running its ranges one after the other would have been: other
-/// work held a core), the site runs its next 4 regions on the calling thread, then tries again,
-/// doubling that count after each late try up to 4096 and forgetting it after an on-time one.
-/// Results do not change (the ranges are the count's), only where they run. O(1).
+/// work held a core), no region forks for 50 times the time it lost, doubling after each late
+/// try up to 2 s and forgotten after an on-time one. Results do not change (the ranges are the
+/// count's), only where they run. O(1).
 [[nodiscard]] std::uint64_t split_regions();
 
 /// The team CHOLMOD's OpenMP regions ask for: its build fixes num_threads(4) (counted with a
