@@ -53,12 +53,12 @@ bool parallel_build() {
 }
 
 namespace {
-using clock = std::chrono::steady_clock;
+using pacing_clock = std::chrono::steady_clock;
 thread_local std::uint64_t split = 0;
 // Back-off of the calling thread's regions: none forks before next_try while wait_s > 0. A late
 // team is the machine's state, not one kernel's, so one late region holds back every kernel.
 thread_local double wait_s = 0.0;
-thread_local clock::time_point next_try{};
+thread_local pacing_clock::time_point next_try{};
 // A late region loses about a time slice of the late thread (milliseconds, against tens of
 // microseconds of work): waiting 50 times what it lost keeps the tries under 2 % of the time
 // on a machine that stays loaded; doubling after each late try, up to 2 s, and forgetting it
@@ -71,7 +71,7 @@ std::uint64_t split_regions() { return split; }
 bool detail::fork_next_region() {
   ++split;
 #ifdef SEWN_HAVE_OPENMP
-  return wait_s == 0.0 || clock::now() >= next_try;
+  return wait_s == 0.0 || pacing_clock::now() >= next_try;
 #else
   return false;
 #endif
@@ -83,7 +83,7 @@ void detail::region_done(double region_s, double serial_s) {
     return;
   }
   wait_s = std::min(std::max(2.0 * wait_s, wait_per_lost * (region_s - serial_s)), max_wait_s);
-  next_try = clock::now() + std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(wait_s));
+  next_try = pacing_clock::now() + std::chrono::duration_cast<pacing_clock::duration>(std::chrono::duration<double>(wait_s));
 }
 
 SerialLibraryRegions::SerialLibraryRegions(int library_team) {
