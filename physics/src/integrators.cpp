@@ -1,6 +1,7 @@
 #include "sewn/physics/integrators.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -9,6 +10,7 @@
 #include "sewn/physics/errors.hpp"
 #include "format.hpp"
 #include "integrate/require_symmetric.hpp"
+#include "parallel/ranges.hpp"
 
 namespace sewn::physics {
 
@@ -29,11 +31,25 @@ inline std::uint64_t inf_or_nan(double x) {
 // an integer max-reduction vectorises where a floating-point one would need -ffast-math.
 inline std::uint64_t abs_bits(double x) { return std::bit_cast<std::uint64_t>(x) & std::uint64_t{0x7fffffffffffffff}; }
 
-// True if every value of the equally long arrays is finite, in one pass.
+// Values per thread below which the integrators' vector passes stay on one thread (the CG's
+// 1024 nodes: these passes read and write as much per value as CG's vector updates).
+constexpr std::size_t vector_grain = 3 * 1024;
+
+// True if every value of the equally long arrays is finite, in one pass; split in ranges at
+// 2+ threads (an OR of flags: the same answer for any grouping).
 template <class... Spans>
 bool all_finite(std::span<const double> a, Spans... more) {
+  const int parts = detail::parts_for(a.size(), vector_grain);
+  std::array<std::uint64_t, max_threads> bad_of{};
+  detail::run_parts(parts, [&](int t) {
+    std::uint64_t bad = 0;
+    const std::size_t k1 = detail::range_begin(a.size(), parts, t + 1);
+    for (std::size_t k = detail::range_begin(a.size(), parts, t); k < k1; ++k)
+      bad |= (inf_or_nan(a[k]) | ... | inf_or_nan(more[k]));
+    bad_of[static_cast<std::size_t>(t)] = bad;
+  });
   std::uint64_t bad = 0;
-  for (std::size_t k = 0; k < a.size(); ++k) bad |= (inf_or_nan(a[k]) | ... | inf_or_nan(more[k]));
+  for (int t = 0; t < parts; ++t) bad |= bad_of[static_cast<std::size_t>(t)];
   return bad == 0;
 }
 
@@ -126,12 +142,29 @@ StepReport SymplecticEuler::step(System& sys, double h) {
     double* __restrict v = nodes.v().data();
     const double* __restrict f = nodes.f().data();
     const double* __restrict im = (slaves.empty() ? nodes.inverse_mass_dof() : slaves.inverse_mass_dof(nodes)).data();
+    // Elementwise, with an OR and a max as reductions: bitwise equal at any thread count.
+    const int parts = detail::parts_for(n3, vector_grain);
+    std::array<std::uint64_t, max_threads> bad_of{}, speed_of{};
+    detail::run_parts(parts, [&](int t) {
+      double* __restrict xt = x;  // a lambda's captures lose __restrict: the loop would not vectorise
+      double* __restrict vt = v;
+      const double* __restrict ft = f;
+      const double* __restrict imt = im;
+      std::uint64_t bad = 0, speed = 0;
+      const std::size_t k1 = detail::range_begin(n3, parts, t + 1);
+      for (std::size_t k = detail::range_begin(n3, parts, t); k < k1; ++k) {
+        vt[k] += h * imt[k] * ft[k];
+        xt[k] += h * vt[k];
+        bad |= inf_or_nan(vt[k]) | inf_or_nan(xt[k]);
+        speed = std::max(speed, abs_bits(vt[k]));
+      }
+      bad_of[static_cast<std::size_t>(t)] = bad;
+      speed_of[static_cast<std::size_t>(t)] = speed;
+    });
     std::uint64_t bad = 0, speed = 0;
-    for (std::size_t k = 0; k < n3; ++k) {
-      v[k] += h * im[k] * f[k];
-      x[k] += h * v[k];
-      bad |= inf_or_nan(v[k]) | inf_or_nan(x[k]);
-      speed = std::max(speed, abs_bits(v[k]));
+    for (int t = 0; t < parts; ++t) {
+      bad |= bad_of[static_cast<std::size_t>(t)];
+      speed = std::max(speed, speed_of[static_cast<std::size_t>(t)]);
     }
     if (bad == 0) nodes.mark_state_finite();
     finite = bad == 0;

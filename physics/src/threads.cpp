@@ -1,10 +1,13 @@
 #include "sewn/physics/threads.hpp"
 
+#include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstdlib>
 #include <string>
 
 #include "sewn/physics/errors.hpp"
+#include "parallel/ranges.hpp"
 
 #ifdef SEWN_HAVE_OPENMP
 #include <omp.h>
@@ -49,13 +52,50 @@ bool parallel_build() {
 #endif
 }
 
-SerialLibraryRegions::SerialLibraryRegions() {
+namespace {
+using pacing_clock = std::chrono::steady_clock;
+thread_local std::uint64_t split = 0;
+// Back-off of the calling thread's regions: none forks before next_try while wait_s > 0. A late
+// team is the machine's state, not one kernel's, so one late region holds back every kernel.
+thread_local double wait_s = 0.0;
+thread_local pacing_clock::time_point next_try{};
+// A late region loses about a time slice of the late thread (milliseconds, against tens of
+// microseconds of work): waiting 50 times what it lost keeps the tries under 2 % of the time
+// on a machine that stays loaded; doubling after each late try, up to 2 s, and forgetting it
+// after an on-time one, a run forks again within seconds of the load going.
+constexpr double wait_per_lost = 50.0, max_wait_s = 2.0;
+}  // namespace
+
+std::uint64_t split_regions() { return split; }
+
+bool detail::fork_next_region() {
+  ++split;
 #ifdef SEWN_HAVE_OPENMP
-  if (thread_count() != 1) return;
+  return wait_s == 0.0 || pacing_clock::now() >= next_try;
+#else
+  return false;
+#endif
+}
+
+void detail::region_done(double region_s, double serial_s) {
+  if (region_s <= serial_s) {
+    wait_s = 0.0;
+    return;
+  }
+  wait_s = std::min(std::max(2.0 * wait_s, wait_per_lost * (region_s - serial_s)), max_wait_s);
+  next_try = pacing_clock::now() + std::chrono::duration_cast<pacing_clock::duration>(std::chrono::duration<double>(wait_s));
+}
+
+SerialLibraryRegions::SerialLibraryRegions(int library_team) {
+#ifdef SEWN_HAVE_OPENMP
+  // The run asked for as many threads as the library's team: its regions may use them.
+  if (thread_count() >= library_team) return;
   // No active level allowed: every parallel region, whatever its num_threads clause, gets a
   // team of one (the only OpenMP setting a library's explicit clause does not override).
   saved_ = omp_get_max_active_levels();
   omp_set_max_active_levels(0);
+#else
+  (void)library_team;
 #endif
 }
 

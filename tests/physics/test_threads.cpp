@@ -131,26 +131,31 @@ TEST_CASE("threads: the count is set by the API or SEWN_THREADS, and bad values 
   CHECK(thread_count() == 3);  // unchanged by the refused calls
 }
 
-TEST_CASE("threads: at one thread a library's OpenMP region with its own num_threads runs on one thread") {
+TEST_CASE("threads: below the library's team size a library's OpenMP region with its own num_threads runs on one thread") {
   using threads_test::Threads;
-  // CHOLMOD opens its regions with num_threads(4): at thread_count() 1 they must not wake
-  // other threads, whatever the clause asks; outside the guard, or at 2 threads, nothing changes.
-  const int open = library_team_size(4);
-  CHECK(open == (parallel_build() ? 4 : 1));
-  {
-    Threads one(1);
+  // CHOLMOD opens its regions with num_threads(4): at 1 or 2 threads they must not wake more
+  // threads than asked, whatever the clause says; outside the guard, or at 4 threads, nothing changes.
+  const int open = library_team_size(cholmod_team);
+  CHECK(open == (parallel_build() ? cholmod_team : 1));
+  for (const int count : {1, 2, cholmod_team - 1}) {
+    Threads scope(count);
     const SerialLibraryRegions outer;
-    CHECK(library_team_size(4) == 1);
+    CHECK(library_team_size(cholmod_team) == 1);
     {
       const SerialLibraryRegions inner;  // nested: still one, and the outer one restores
-      CHECK(library_team_size(4) == 1);
+      CHECK(library_team_size(cholmod_team) == 1);
     }
-    CHECK(library_team_size(4) == 1);
+    CHECK(library_team_size(cholmod_team) == 1);
   }
-  CHECK(library_team_size(4) == open);
+  CHECK(library_team_size(cholmod_team) == open);
+  {
+    Threads four(cholmod_team);
+    const SerialLibraryRegions guard;
+    CHECK(library_team_size(cholmod_team) == open);
+  }
   Threads two(2);
-  const SerialLibraryRegions guard;
-  CHECK(library_team_size(4) == open);
+  const SerialLibraryRegions wide(2);  // a library whose team the run's count covers
+  CHECK(library_team_size(2) == (parallel_build() ? 2 : 1));
 }
 
 TEST_CASE("threads: the block-sparse product and the springs' Jacobian are bitwise equal at 1, 2 and 3 threads") {
@@ -235,6 +240,41 @@ TEST_CASE("threads: trajectories repeat bitwise at 2 threads and agree with 1 th
       CAPTURE(relative);
       CHECK(relative < 1e-12);  // measured: 2e-16 to 1.2e-15
     }
+}
+
+}  // namespace test_threads
+
+namespace test_threads {
+
+TEST_CASE("threads: a small model's steps stay on one thread at 2 threads, the block's split") {
+  using threads_test::Threads;
+  Threads two(2);
+  // 3×3×4 cubes: 80 particles, below every kernel's threshold (forces, Jacobian, product, CG)
+  auto small = std::make_unique<MssModel<3>>(hex_grid(3, 3, 4, {{0.005, 0.005, 0.005}, {}}),
+                                             std::vector<MaterialParams>{{1e6, 0.3, 1000}}, std::vector<std::uint32_t>{});
+  small->nodes().fix(0);
+  auto block = threads_test::block_model();
+  SymplecticEulerOptions so;
+  so.enforce_stable_step = false;
+  ImplicitEulerOptions io;
+  io.solver = solve::Backend::jacobi;
+  for (const bool implicit : {false, true}) {
+    CAPTURE(implicit);
+    SymplecticEuler semi(so);
+    LinearlyImplicitEuler lin(io);
+    const auto step = [&](MssModel<3>& m) {
+      if (implicit)
+        (void)lin.step(m.system(), 2e-5);
+      else
+        (void)semi.step(m.system(), 2e-6);
+    };
+    const std::uint64_t before = split_regions();
+    for (int s = 0; s < 3; ++s) step(*small);
+    CHECK(split_regions() == before);
+    lin.reset();
+    for (int s = 0; s < 3; ++s) step(*block);
+    CHECK(split_regions() > before);
+  }
 }
 
 }  // namespace test_threads

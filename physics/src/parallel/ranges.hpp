@@ -4,6 +4,7 @@
 // Without OpenMP the ranges run one after the other, with the same results.
 
 #include <algorithm>
+#include <chrono>
 #include <cstddef>
 
 #include "sewn/physics/threads.hpp"
@@ -23,23 +24,51 @@ inline std::size_t range_begin(std::size_t items, int parts, int t) {
          std::min(items % static_cast<std::size_t>(parts), static_cast<std::size_t>(t));
 }
 
+/// Whether the next split region is to fork, or to run its ranges on the calling thread while
+/// this thread backs off after a region whose team came late (threads.cpp). Counts the region
+/// (split_regions()); false without OpenMP.
+bool fork_next_region();
+/// Reports a forked region: seconds from the fork to the join, and an estimate of what running
+/// its ranges one after the other would have cost.
+void region_done(double region_s, double serial_s);
+
 /// Calls body(t) for t in [0, parts), on `parts` threads when OpenMP is built in. body must
 /// not throw (an exception cannot leave an OpenMP region): kernels record failures instead.
+/// The ranges are fixed by `parts` alone, so running them on fewer threads (the runtime's
+/// team, or one while backing off on a loaded machine) changes no result.
 template <class Body>
 void run_parts(int parts, const Body& body) {
   if (parts <= 1) {
     body(0);
     return;
   }
+  if (!fork_next_region()) {
+    for (int t = 0; t < parts; ++t) body(t);
+    return;
+  }
 #ifdef SEWN_HAVE_OPENMP
+  using clock = std::chrono::steady_clock;
+  const clock::time_point start = clock::now();
+  double first_s = 0.0;
 #pragma omp parallel num_threads(parts)
   {
-    // Each range exactly once, whatever number of threads the runtime granted.
+    // Each range exactly once, whatever number of threads the runtime granted; range 0 is the
+    // calling thread's (the static schedule's first iteration goes to thread 0).
 #pragma omp for schedule(static, 1)
-    for (int t = 0; t < parts; ++t) body(t);
+    for (int t = 0; t < parts; ++t) {
+      if (t != 0) {
+        body(t);
+        continue;
+      }
+      const clock::time_point begin = clock::now();
+      body(0);
+      first_s = std::chrono::duration<double>(clock::now() - begin).count();
+    }
   }
-#else
-  for (int t = 0; t < parts; ++t) body(t);
+  // The ranges are of one size: the calling thread's time, times their count, is what running
+  // them one after the other would cost. Not the sum of every range's time: a worker
+  // preempted midway keeps its clock running, and its late region would look on time.
+  region_done(std::chrono::duration<double>(clock::now() - start).count(), first_s * parts);
 #endif
 }
 

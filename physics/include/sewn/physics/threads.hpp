@@ -11,6 +11,8 @@
 // same per-thread split is run one range after the other: results equal those of a parallel
 // build with that count, only not faster.
 
+#include <cstdint>
+
 namespace sewn::physics {
 
 /// Largest thread count accepted.
@@ -28,17 +30,33 @@ void set_thread_count(int threads);
 [[nodiscard]] int parse_thread_count(const char* text, const char* what);
 /// True if this build runs ranges in parallel (OpenMP found at build time).
 [[nodiscard]] bool parallel_build();
+/// How many regions the physics kernels called from this thread have split into more than one
+/// range so far (a kernel below its size threshold splits none): for tests and diagnostics.
+/// A split region forks a team unless the thread is backing off: when a region's team came
+/// late (the join later than running its ranges one after the other would have been: other
+/// work held a core), no region forks for 50 times the time it lost, doubling after each late
+/// try up to 2 s and forgotten after an on-time one. Results do not change (the ranges are the
+/// count's), only where they run. O(1).
+[[nodiscard]] std::uint64_t split_regions();
 
-/// While alive, with thread_count() == 1, the OpenMP regions of the libraries we call run on
-/// the calling thread alone. CHOLMOD's supernodal factorization opens its regions with a fixed
-/// num_threads(4), which neither OMP_NUM_THREADS nor omp_set_num_threads() overrides: a "single
-/// thread" run then woke three more threads for every supernode (35 % of the frisbee's CPU time
-/// went to their wake-ups and spins). Nests (restores the previous setting); not thread-safe,
-/// like the solvers it guards. It sets our OpenMP runtime's setting: with g++ that is the
-/// libgomp CHOLMOD uses; a clang build (libomp) cannot reach CHOLMOD's regions this way. O(1).
+/// The team CHOLMOD's OpenMP regions ask for: its build fixes num_threads(4) (counted with a
+/// GOMP_parallel shim on the frisbee's factorizations), not settable through its API.
+inline constexpr int cholmod_team = 4;
+
+/// While alive, unless thread_count() >= `library_team`, the OpenMP regions of the libraries we
+/// call run on the calling thread alone. CHOLMOD's supernodal factorization opens its regions
+/// with a fixed num_threads(4), which neither OMP_NUM_THREADS nor omp_set_num_threads()
+/// overrides: a "single thread" run then woke three more threads for every supernode (35 % of
+/// the frisbee's CPU time went to their wake-ups and spins), and a 2-thread run put 4 threads
+/// on 2 cores (the frisbee 27x slower beside a busy core). Only a team of one can be forced
+/// from outside, so below 4 threads CHOLMOD runs serially: on 2 vCPUs its team of 4 was slower
+/// than one thread at every size measured (docs/solvers.md, Threads). Nests (restores the
+/// previous setting); not thread-safe, like the solvers it guards. It sets our OpenMP runtime's
+/// setting: with g++ that is the libgomp CHOLMOD uses; a clang build (libomp) cannot reach
+/// CHOLMOD's regions this way. O(1).
 class SerialLibraryRegions {
  public:
-  SerialLibraryRegions();
+  explicit SerialLibraryRegions(int library_team = cholmod_team);
   ~SerialLibraryRegions();
   SerialLibraryRegions(const SerialLibraryRegions&) = delete;
   SerialLibraryRegions& operator=(const SerialLibraryRegions&) = delete;
