@@ -7,7 +7,9 @@
 // cholmod-pcg is 1.6x faster; on the beams at h = 1 ms (12-40 iterations) and on 16³ at
 // h = 0.1 ms (51 iterations, cholmod-pcg 5x slower) block-Jacobi stays; beyond
 // auto_factor_nodes (the N = 16 cantilever, 32³) the factor takes minutes and GBs: block-Jacobi.
+// A new pattern starts the decision over.
 
+#include <cstdint>
 #include <memory>
 
 #include "backends.hpp"
@@ -33,6 +35,9 @@ class AutoSolver final : public LinearSolver {
 
   SolveReport solve(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
                     std::span<const double> mass_scale) override {
+    if (have_pattern_ && A.pattern_version() != pattern_) forget_switch();
+    pattern_ = A.pattern_version();
+    have_pattern_ = true;
     LinearSolver& s = current();
     s.options() = opt_;
     const SolveReport r = s.solve(A, b, x, free_dof, mass_scale);
@@ -54,6 +59,9 @@ class AutoSolver final : public LinearSolver {
     return s;
   }
   void restore(const BlockMatrix& A, const SolverState& s) override {
+    forget_switch();
+    pattern_ = A.pattern_version();
+    have_pattern_ = true;
     switched_ = !s.factored.empty() || s.refresh_due;
     if (switched_) current().restore(A, s);
   }
@@ -67,6 +75,13 @@ class AutoSolver final : public LinearSolver {
     return false;
 #endif
   }
+  // A new pattern (a cut, a refinement) decides afresh, starting from block-Jacobi: the
+  // integrators keep no solver state across a topology change (a checkpoint taken after a cut
+  // resumes with a fresh solver), so a run and its resumed copy decide the same.
+  void forget_switch() {
+    switched_ = false;
+    pcg_.reset();
+  }
   LinearSolver& current() {
 #ifdef SEWN_HAVE_CHOLMOD
     if (switched_) {
@@ -78,7 +93,8 @@ class AutoSolver final : public LinearSolver {
   }
 
   std::unique_ptr<LinearSolver> jacobi_, pcg_;
-  bool switched_ = false;
+  bool switched_ = false, have_pattern_ = false;
+  std::uint64_t pattern_ = 0;
 };
 
 }  // namespace

@@ -34,7 +34,8 @@
 // Backend::automatic (measured: docs/solvers.md) starts with jacobi (default_backend()) at every
 // size and switches for good to cholmod-pcg, where built in, after a solve of more than 120
 // CG iterations on a model of at most 8000 nodes: a model stiff against its mass, small enough
-// for a kept factorization. Its report and backend() name the backend that solved.
+// for a kept factorization; a new pattern starts over from jacobi. Its report and backend()
+// name the backend that solves.
 
 #include <cstdint>
 #include <memory>
