@@ -68,12 +68,7 @@ class AutoSolver final : public LinearSolver {
 
  private:
   [[nodiscard]] static bool can_factor(const BlockMatrix& A) {
-#ifdef SEWN_HAVE_CHOLMOD
-    return static_cast<std::size_t>(A.size()) <= auto_factor_nodes;
-#else
-    (void)A;
-    return false;
-#endif
+    return available(Backend::cholmod_pcg) && static_cast<std::size_t>(A.size()) <= auto_factor_nodes;
   }
   // A new pattern (a cut, a refinement) decides afresh, starting from block-Jacobi: the
   // integrators keep no solver state across a topology change (a checkpoint taken after a cut
