@@ -3,6 +3,7 @@
 // MPI ranks): the filtered systems every backend solves and an independent reference answer.
 
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <random>
 #include <vector>
@@ -117,13 +118,15 @@ inline void random_spd(BlockMatrix& A, Index n, unsigned seed, double diagonal_s
 }
 
 // The SOFA comparison's beam (891 particles), clamped at its base.
-inline std::unique_ptr<MssModel<3>> beam_8x8x10() {
-  const double a = 0.0125;
-  auto m = std::make_unique<MssModel<3>>(hex_grid(8, 8, 10, {{a, a, a}, {}}), std::vector<MaterialParams>{paper_material},
+// nx × ny × nz cubes of side a, the paper's material, the nodes at coordinate 0 on `axis` fixed.
+inline std::unique_ptr<MssModel<3>> clamped_hex_grid(std::uint32_t nx, std::uint32_t ny, std::uint32_t nz, double a, int axis) {
+  auto m = std::make_unique<MssModel<3>>(hex_grid(nx, ny, nz, {{a, a, a}, {}}), std::vector<MaterialParams>{paper_material},
                                          std::vector<std::uint32_t>{});
   for (Index i = 0; i < m->nodes().size(); ++i)
-    if (m->rest_position(i).z() <= 1e-12) m->nodes().fix(i);
+    if (m->rest_position(i)[axis] <= 1e-12) m->nodes().fix(i);
   return m;
 }
+
+inline std::unique_ptr<MssModel<3>> beam_8x8x10() { return clamped_hex_grid(8, 8, 10, 0.0125, 2); }
 
 }  // namespace sewn::physics::test::solve_helpers

@@ -387,6 +387,114 @@ TEST_CASE("issue 17: one CG iteration limit, large enough for the N = 16 cantile
   CHECK(solve::default_max_iterations >= 2000);
 }
 
+// A cantilever of 20x2x2 cubes of 5 cm clamped at x = 0 (the smoke case of bench/solve): at
+// h = 10 ms block-Jacobi CG needs ~136 iterations a step, a stiff model for `auto`.
+std::unique_ptr<MssModel<3>> small_cantilever() { return clamped_hex_grid(20, 2, 2, 0.05, 0); }
+
+TEST_CASE("auto: block-Jacobi CG until a solve proves the model stiff, then cholmod-pcg, the same answer within tolerance") {
+  const bool can_switch = solve::available(solve::Backend::cholmod_pcg);
+  auto run = [](solve::Backend b, double tolerance, std::vector<solve::SolveReport>* reports) {
+    auto mp = small_cantilever();
+    LinearlyImplicitEuler ie;
+    ie.options().solver = b;
+    ie.options().cg_tolerance = tolerance;
+    ie.options().cg_absolute_tolerance = tolerance < 1e-9 ? 0.0 : solve::default_absolute_tolerance;
+    for (int s = 0; s < 20; ++s) {
+      const StepReport r = ie.step(mp->system(), 1e-2);
+      if (reports) reports->push_back(r.solve);
+    }
+    Eigen::VectorXd u(3 * Eigen::Index{mp->nodes().size()});
+    for (Index i = 0; i < mp->nodes().size(); ++i) u.segment<3>(3 * i) = mp->nodes().position(i) - mp->rest_position(i);
+    return u;
+  };
+  std::vector<solve::SolveReport> reports;
+  const Eigen::VectorXd u = run(solve::Backend::automatic, solve::default_tolerance, &reports);
+  // block-Jacobi up to and including the first solve of more than 120 iterations, cholmod-pcg after
+  std::size_t first_stiff = reports.size();
+  for (std::size_t s = 0; s < reports.size() && first_stiff == reports.size(); ++s)
+    if (reports[s].iterations > 120) first_stiff = s;
+  REQUIRE(first_stiff < 5);
+  int jacobi_iterations = 0, auto_iterations = 0;
+  for (std::size_t s = 0; s < reports.size(); ++s) {
+    CAPTURE(s);
+    const bool switched = can_switch && s > first_stiff;
+    CHECK(reports[s].backend == (switched ? solve::Backend::cholmod_pcg : solve::Backend::jacobi));
+    if (s > first_stiff) auto_iterations += reports[s].iterations;
+  }
+  std::vector<solve::SolveReport> jacobi_reports;
+  const Eigen::VectorXd uj = run(solve::Backend::jacobi, solve::default_tolerance, &jacobi_reports);
+  for (std::size_t s = first_stiff + 1; s < jacobi_reports.size(); ++s) jacobi_iterations += jacobi_reports[s].iterations;
+  MESSAGE("20x2x2 cantilever, h = 10 ms, steps after the switch: auto " << auto_iterations << " CG iterations, jacobi "
+                                                                         << jacobi_iterations);
+  if (can_switch) CHECK(auto_iterations * 10 < jacobi_iterations);
+  const Eigen::VectorXd ref = run(solve::Backend::jacobi, 1e-12, nullptr);
+  REQUIRE(ref.norm() > 0);
+  // a relative residual of 1e-6 per step, accumulated over 20 steps
+  CHECK((u - ref).norm() <= 20 * 1e-6 * ref.norm());
+  CHECK((uj - ref).norm() <= 20 * 1e-6 * ref.norm());
+}
+
+TEST_CASE("auto stays block-Jacobi CG on a model its mass keeps well conditioned") {
+  auto mp = beam_8x8x10();
+  LinearlyImplicitEuler ie;
+  ie.options().solver = solve::Backend::automatic;
+  for (int s = 0; s < 20; ++s) {
+    const StepReport r = ie.step(mp->system(), 1e-3);
+    CAPTURE(s);
+    CHECK(r.solve.backend == solve::Backend::jacobi);
+    CHECK(r.solve.iterations <= 120);
+  }
+}
+
+TEST_CASE("auto's choice is in its state: a fresh auto solver given it solves the same, bit for bit; a new pattern decides afresh") {
+  auto mp = small_cantilever();
+  MssModel<3>& m = *mp;
+  assemble(m.system(), 1e-2);
+  BlockMatrix& A = m.system().matrix();
+  Problem p = random_problem(A, &m.nodes(), 0.0, 41);
+  solve::SolverOptions o;
+  o.absolute_tolerance = 0;
+  auto a = solve::make_solver(solve::Backend::automatic, o);
+  std::vector<double> x = p.x0;
+  const auto first = a->solve(A, p.b, x, p.free_dof);
+  CHECK(first.backend == solve::Backend::jacobi);
+  REQUIRE(first.iterations > 120);
+  auto fresh = solve::make_solver(solve::Backend::automatic, o);
+  fresh->restore(A, {});  // the state of one that has not switched: block-Jacobi
+  CHECK(fresh->backend() == solve::Backend::jacobi);
+  if (!solve::available(solve::Backend::cholmod_pcg)) {
+    CHECK(a->backend() == solve::Backend::jacobi);
+    CHECK(a->state().factored.empty());
+    return;
+  }
+  CHECK(a->backend() == solve::Backend::cholmod_pcg);
+  for (int round = 0; round < 2; ++round) {
+    CAPTURE(round);
+    // round 0: switched, nothing factored yet; round 1: cholmod-pcg's kept factor
+    const solve::SolverState state = a->state();
+    CHECK(state.refresh_due == (round == 0));
+    CHECK(state.factored.empty() == (round == 0));
+    auto resumed = solve::make_solver(solve::Backend::automatic, o);
+    resumed->restore(A, state);
+    CHECK(resumed->backend() == solve::Backend::cholmod_pcg);
+    for (Index i = 0; i < A.size(); ++i) A.block(A.diagonal(i)).diagonal().array() *= 1.1;
+    std::vector<double> y1 = p.x0, y2 = p.x0;
+    const auto r1 = a->solve(A, p.b, y1, p.free_dof);
+    const auto r2 = resumed->solve(A, p.b, y2, p.free_dof);
+    CHECK(r1.backend == solve::Backend::cholmod_pcg);
+    CHECK(r1.iterations == r2.iterations);
+    CHECK(r1.factorizations == r2.factorizations);
+    CHECK(r1.relative_residual <= 1e-6);
+    CHECK(y1 == y2);
+  }
+  // a new pattern (a cut) decides afresh from block-Jacobi, as a run resumed after it would
+  BlockMatrix B;
+  random_spd(B, 100, 43);
+  const Problem q = random_problem(B, nullptr, 0.0, 44);
+  std::vector<double> z = q.x0;
+  CHECK(a->solve(B, q.b, z, q.free_dof).backend == solve::Backend::jacobi);
+}
+
 TEST_CASE("cholmod-pcg's and hypre-pcg's state taken up by a fresh solver gives the same iterates, bit for bit") {
   for (auto backend : kept_preconditioner_backends()) {
     CAPTURE(solve::to_string(backend));

@@ -11,6 +11,8 @@
 namespace sewn::physics::solve::detail {
 
 std::unique_ptr<LinearSolver> make_jacobi(SolverOptions o);
+/// Backend::automatic: jacobi, switching to cholmod-pcg on a stiff small model (auto_solver.cpp).
+std::unique_ptr<LinearSolver> make_auto(SolverOptions o);
 std::unique_ptr<LinearSolver> make_sa_pcg(SolverOptions o);
 #ifdef SEWN_HAVE_CHOLMOD
 std::unique_ptr<LinearSolver> make_cholmod(SolverOptions o);

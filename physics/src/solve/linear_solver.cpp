@@ -97,11 +97,12 @@ Backend parse_backend(std::string_view name) {
 Backend default_backend(std::size_t nodes) {
   (void)nodes;
   // Measured (docs/solvers.md: bench/solve and profiles, CPU time per implicit step at equal or
-  // better error): cholmod-pcg (single-precision solves) wins on the N = 8 cantilever at
-  // h = 10 ms (6561 nodes, ~1.4x) and the 1890-tet beam (480 nodes), and loses on the 8x8x10
-  // beam (891 nodes) and on 16^3 at h = 0.1 ms (4913 nodes, 5.6x slower); 32^3 and the N = 16
-  // cantilever cannot hold its factor. What decides is stiffness against mass (block-Jacobi's
-  // iteration count), not the node count, so no size rule follows: jacobi at every size.
+  // better error): which backend wins is decided by stiffness against mass (block-Jacobi's
+  // iteration count), not by the node count: cholmod-pcg (single-precision solves) wins on the
+  // N = 8 cantilever at h = 10 ms (6561 nodes, ~590 iterations a step, ~1.6x) and loses on
+  // the 8x8x10 beam (891 nodes) and on 16^3 at h = 0.1 ms (4913 nodes, 51 iterations, 5.6x
+  // slower). So `auto` starts with jacobi at every size and switches on the iteration count
+  // (auto_solver.cpp).
   return Backend::jacobi;
 }
 
@@ -112,7 +113,8 @@ std::unique_ptr<LinearSolver> make_solver(Backend b, SolverOptions options, std:
     throw InputError("solver absolute_tolerance must be finite and >= 0, got " + std::to_string(options.absolute_tolerance));
   if (options.max_iterations < 1)
     throw InputError("solver max_iterations must be >= 1, got " + std::to_string(options.max_iterations));
-  if (b == Backend::automatic) b = default_backend(nodes);
+  (void)nodes;  // auto decides from the matrices it solves
+  if (b == Backend::automatic) return detail::make_auto(options);
   (void)parse_backend(to_string(b));  // throws if not built in
   switch (b) {
 #ifdef SEWN_HAVE_CHOLMOD
