@@ -80,7 +80,9 @@ class SymplecticEuler {
 };
 
 struct ImplicitEulerOptions {
-  /// The linear solver (solve/linear_solver.hpp); automatic picks by model size.
+  /// The linear solver (solve/linear_solver.hpp); `automatic` starts with
+  /// block-Jacobi CG and moves to a kept-factor PCG when its iterations show a factor pays
+  /// (linear_solver.hpp).
   solve::Backend solver = solve::Backend::automatic;
   double cg_tolerance = solve::default_tolerance;  ///< relative residual ‖S(b - AΔV)‖/‖Sb‖
   /// Absolute floor of the residual as a velocity, m/s (solve::SolverOptions::absolute_tolerance):
