@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include <Eigen/Eigenvalues>
+
 #include "sewn/physics/elements/element_math.hpp"
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/nodes.hpp"
@@ -16,6 +18,17 @@ template <int N>
 Eigen::Matrix<double, N, N> projected(Eigen::Matrix<double, N, N> H) {
   elements::project_psd(H);
   return H;
+}
+
+// The bend-twist stencil's 11×11 with angle DOFs: nearly every one is indefinite on a bent rod
+// (522 of 522 in the sticky hand's first 6 frames), so the eigensolver always runs; its
+// fixed-size instantiation avoids the dynamic one's allocations and loops of unknown length.
+template <>
+Eigen::Matrix<double, 11, 11> projected<11>(Eigen::Matrix<double, 11, 11> H) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 11, 11>> eig(H);
+  const Eigen::Matrix<double, 11, 1> d = eig.eigenvalues();
+  if (d.minCoeff() >= 0.0) return H;
+  return eig.eigenvectors() * d.cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
 }
 
 }  // namespace

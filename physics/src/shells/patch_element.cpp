@@ -190,8 +190,13 @@ elements::Mat<3 * N> patch_hessian_gauss_newton(const PatchPositions<N>& x, cons
     scatter_row<N>(J, k, cols, dihedral_gradient(hinge_of<N>(x, cols)) * rest.lever[static_cast<std::size_t>(k)]);
   }
   // S is symmetric positive definite (patch_rest refuses an ill-conditioned one), so JᵀSJ is PSD.
-  const elements::Mat<3 * N> H = J.transpose() * rest.stiffness * J;
-  return 0.5 * (H + H.transpose());
+  // Coefficient by coefficient over J's 3 rows, one triangle mirrored (exactly symmetric): Eigen's
+  // blocked product for the 18×18 was a third of this function's time.
+  const Eigen::Matrix<double, 3, 3 * N> SJ = rest.stiffness * J;
+  elements::Mat<3 * N> H;
+  for (int j = 0; j < 3 * N; ++j)
+    for (int i = j; i < 3 * N; ++i) H(i, j) = H(j, i) = J(0, i) * SJ(0, j) + J(1, i) * SJ(1, j) + J(2, i) * SJ(2, j);
+  return H;
 }
 
 #define SEWN_PATCH_INSTANTIATE(N)                                                                                       \
