@@ -33,7 +33,7 @@ void set_thread_count(int threads);
 /// How many regions the physics kernels called from this thread have split into more than one
 /// range so far (a kernel below its size threshold splits none): for tests and diagnostics.
 /// A split region forks a team unless the thread is backing off: when a region's team came
-/// late (the join later than running its ranges one after the other would have been: other
+/// late (the join 250 µs or more later than running its ranges one after the other: other
 /// work held a core), no region forks for 50 times the time it lost, doubling after each late
 /// try up to 2 s and forgotten after an on-time one. Results do not change (the ranges are the
 /// count's), only where they run. O(1).
