@@ -163,6 +163,11 @@ int cmd_run(const std::vector<std::string>& args) {
     std::printf("sewn: %s: %llu steps (%.4g s simulated) in %.3g s, %.3g ms/step, %u cut%s; %u frames in %s",
                 scene.name.c_str(), static_cast<unsigned long long>(s.steps), s.simulated, s.wall, s.ms_per_step, s.cuts,
                 s.cuts == 1 ? "" : "s", s.frames, s.out.string().c_str());
+    if (s.newton_iterations > 0)  // what a step costs with integrator `newton`, and the steps' CPU time (no output)
+      std::printf("; %.3g Newton iterations/step, stepping %.3g s CPU", static_cast<double>(s.newton_iterations) / static_cast<double>(s.steps),
+                  s.stepping_cpu);
+    if (s.newton_iterations > 0 && s.linear_iterations > 0)
+      std::printf(", %.3g CG iterations/step", static_cast<double>(s.linear_iterations) / static_cast<double>(s.steps));
     if (s.refined > 0 || s.coarsened > 0)
       std::printf("; %llu elements refined, %llu families coarsened", static_cast<unsigned long long>(s.refined),
                   static_cast<unsigned long long>(s.coarsened));
