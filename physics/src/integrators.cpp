@@ -257,11 +257,15 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
   make_solver(n);
   solve::SolverOptions& so = solver_->options();
   so.tolerance = opt_.cg_tolerance;
-  so.absolute_tolerance = opt_.cg_absolute_tolerance;
   so.max_iterations = opt_.cg_max_iterations;
-  if (!(so.absolute_tolerance >= 0 && std::isfinite(so.absolute_tolerance)))
+  if (!(opt_.cg_absolute_tolerance >= 0 && std::isfinite(opt_.cg_absolute_tolerance)))
     throw InputError("LinearlyImplicitEuler::step: cg_absolute_tolerance must be finite and >= 0, got " +
-                     detail::format_number(so.absolute_tolerance));
+                     detail::format_number(opt_.cg_absolute_tolerance));
+  if (!(opt_.cg_absolute_acceleration >= 0 && std::isfinite(opt_.cg_absolute_acceleration)))
+    throw InputError("LinearlyImplicitEuler::step: cg_absolute_acceleration must be finite and >= 0, got " +
+                     detail::format_number(opt_.cg_absolute_acceleration));
+  // the tighter floor: a velocity error, and a force imbalance that does not grow as h shrinks
+  so.absolute_tolerance = std::min(opt_.cg_absolute_tolerance, opt_.cg_absolute_acceleration * h);
   const bool watch = opt_.health.energy_check_interval > 0;
   if (watch) watchdog_.baseline_if_needed(sys);
 

@@ -67,6 +67,9 @@ inline constexpr int default_max_iterations = 5000;
 inline constexpr double default_tolerance = 1e-6;
 /// The absolute floor of the residual, as a velocity (m/s, see SolverOptions).
 inline constexpr double default_absolute_tolerance = 1e-9;
+/// The implicit integrators' second floor, as an acceleration (m/s²): a step of h stops at a
+/// velocity error of at most this times h (ImplicitEulerOptions::cg_absolute_acceleration).
+inline constexpr double default_absolute_acceleration = 1e-6;
 
 struct SolverOptions {
   /// Iterative backends stop when ‖S(b - Ax)‖ ≤ max(tolerance · ‖Sb‖, floor).
