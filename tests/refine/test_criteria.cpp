@@ -2,6 +2,8 @@
 // adapt(), and refinement of a clamped face (its new particles stay clamped).
 #include <doctest/doctest.h>
 
+#include <cmath>
+#include <random>
 #include <string>
 
 #include "sewn/physics/integrators.hpp"
@@ -94,6 +96,41 @@ TEST_CASE("refine criteria: contact with an obstacle, and any of several") {
   CHECK(adapt(m, any, opt).elements == 2);
   check_all(m);
   CHECK_THROWS_AS(AnyOf<3>({}), InputError);
+}
+
+TEST_CASE("the diagonal strain criterion's squared-length test agrees with strain_percent") {
+  // wants_refinement and allows_coarsening compare squared lengths (no root, no division):
+  // on seeded random deformations of a partly refined bar, they must say what the strain in
+  // percent says, away from the thresholds by more than round-off
+  MssModel<3> m = bar();
+  (void)refine_element(m, 1);
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  int refine = 0, coarsen_ok = 0, compared = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const double a = 0.0005 * (trial + 1);  // up to 2 cm on 1 m and 0.5 m elements
+    for (Index i = 0; i < m.nodes().size(); ++i)
+      m.nodes().set_position(i, m.rest_position(i) + a * Vector3d(unit(rng), unit(rng), unit(rng)));
+    for (const double t : {0.5, 1.2, 3.0}) {
+      const DiagonalStrain<3> c(t);
+      for (Index e = 0; e < m.elements().size(); ++e) {
+        if (!m.elements()[e].alive) continue;
+        const double p = DiagonalStrain<3>::strain_percent(m, e);
+        if (std::abs(p - t) > 1e-9) {
+          CHECK(c.wants_refinement(m, e) == (p > t));
+          refine += p > t;
+        }
+        if (std::abs(p - t / 2) > 1e-9) {
+          CHECK(c.allows_coarsening(m, e) == (p < t / 2));
+          coarsen_ok += p < t / 2;
+        }
+        ++compared;
+      }
+    }
+  }
+  CHECK(refine > compared / 10);  // both answers came up often
+  CHECK(refine < compared * 9 / 10);
+  CHECK(coarsen_ok > compared / 20);
 }
 
 TEST_CASE("adapt refuses a pass past max_elements, the model unchanged") {

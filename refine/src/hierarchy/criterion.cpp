@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <string>
 
 #include "hierarchy/neighbours.hpp"
@@ -30,14 +31,36 @@ double DiagonalStrain<D>::strain_percent(const MssModel<D>& m, Index e) {
   return worst;
 }
 
+namespace {
+
+// True if a diagonal of element e has |l − l₀| > f·l₀ (strictly, or ≥ with `or_equal`), on
+// squared lengths: the criterion pass runs on every element after every step, and this spares
+// its square roots and divisions (f < 1, so l > (1+f)l₀ or l < (1−f)l₀, both sides ≥ 0).
+template <int D>
+bool diagonal_strained(const MssModel<D>& m, Index e, double f, bool or_equal) {
+  const physics::Springs& s = m.springs();
+  const std::span<const double> x = m.nodes().x();
+  for (Index d : m.elements()[e].diagonal) {
+    if (d == physics::invalid_index) continue;
+    const Index i = 3 * s.node_i(d), j = 3 * s.node_j(d);
+    const double dx = x[j] - x[i], dy = x[j + 1] - x[i + 1], dz = x[j + 2] - x[i + 2];
+    const double l2 = dx * dx + dy * dy + dz * dz, l0 = s.rest_length(d);
+    const double hi = (1 + f) * l0 * (1 + f) * l0, lo = (1 - f) * l0 * (1 - f) * l0;
+    if (or_equal ? (l2 >= hi || l2 <= lo) : (l2 > hi || l2 < lo)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 template <int D>
 bool DiagonalStrain<D>::wants_refinement(const MssModel<D>& m, Index e) const {
-  return strain_percent(m, e) > threshold_;
+  return diagonal_strained(m, e, threshold_ / 100, false);
 }
 
 template <int D>
 bool DiagonalStrain<D>::allows_coarsening(const MssModel<D>& m, Index e) const {
-  return strain_percent(m, e) < threshold_ / 2;
+  return !diagonal_strained(m, e, threshold_ / 200, true);
 }
 
 template <int D>
