@@ -61,14 +61,25 @@ def split_name(name, suite):
 
 
 def cpu_model():
+    """The first CPU's model name, with its family/model numbers and clock: a virtual machine's
+    name alone ("Intel(R) Xeon(R) Processor") does not tell one generation from another."""
+    fields = {}
     try:
         with open("/proc/cpuinfo", encoding="utf-8") as f:
             for line in f:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
+                if not line.strip():
+                    break
+                key, _, value = line.partition(":")
+                fields[key.strip()] = value.strip()
     except OSError:
         pass
-    return "unknown CPU"
+    if "model name" not in fields:
+        return "unknown CPU"
+    detail = [f"family {fields[k]}" if k == "cpu family" else f"model {fields[k]}"
+              for k in ("cpu family", "model") if k in fields]
+    if "cpu MHz" in fields:
+        detail.append(f"{float(fields['cpu MHz']):.0f} MHz")
+    return fields["model name"] + (f" ({', '.join(detail)})" if detail else "")
 
 
 def collect(raw, suite):
