@@ -63,13 +63,10 @@ class BatchRefiner {
       map.subdivide_hexahedra([&](NodeRef a, NodeRef b) { return middle(m_, a, b); },
                               [&](auto dim, const FineCell& c) { return fine(dim, c, level); });
     }
-    A::grow_darts(m_);
     report_.particles = m_.nodes().size() - nodes0;
     for (AttrId<0> a : map.template attributes<0>())
       if (map.value(a).node >= nodes0) A::link_vertex(m_, map.value(a).node, map.dart_of(a));
-    for (Index c : report_.children) A::index_darts(m_, c);
     springs_and_masses();
-    for (Index c : report_.children) A::attach_diagonals(m_, c);
     if (m_.options().damping == physics::DampingModel::viscous) m_.springs().set_paper_viscosity(m_.nodes().masses());
   }
 
@@ -123,14 +120,28 @@ class BatchRefiner {
     const Index k = first_ + static_cast<Index>(local[static_cast<std::size_t>(c.piece)]);
     const Element parent = elements[e];  // a copy: make_hex_child adds springs, not elements
     elements[k] = make_hex_child(m_, parent, e, Dart(c.darts[3 * u0 + along]), corner);
+    code_child(c);
     corners_.push_back(corner);
     children_.push_back(k);
     if (c.piece == 7) retire(e);
     return k;
   }
 
+  // The child's darts take the codes of the parent's darts of the same label: the affine map
+  // between the reference cube and the parent's corners sends child corner u to local corner
+  // local(u), as it sends the parent's, so a child dart starts at the same local vertex and lies
+  // on the same local edge (flag included) as the parent dart it is parallel to. This is what
+  // MssModel::index_darts would find by walking the child from its canonical dart.
+  void code_child(const FineCell& c) {
+    A::grow_darts(m_);  // the pass has allocated every new dart before it makes the volumes
+    for (std::size_t l = 0; l < 24; ++l) {
+      const Dart from(c.parent_darts[l]);
+      A::copy_code(m_, from, Dart(c.darts[l]), A::dart_vertex(m_, from));
+    }
+  }
+
   void retire(Index e) {
-    retire_parent(m_, e, first_, 8);  // the diagonals are attached once the children are coded
+    retire_parent(m_, e, first_, 8);  // the children made their own diagonals
     for (Index k = 0; k < 8; ++k) report_.children.push_back(first_ + k);
     ++report_.elements;
   }
