@@ -63,13 +63,10 @@ class BatchRefiner {
       map.subdivide_hexahedra([&](NodeRef a, NodeRef b) { return middle(m_, a, b); },
                               [&](auto dim, const FineCell& c) { return fine(dim, c, level); });
     }
-    A::grow_darts(m_);
     report_.particles = m_.nodes().size() - nodes0;
     for (AttrId<0> a : map.template attributes<0>())
       if (map.value(a).node >= nodes0) A::link_vertex(m_, map.value(a).node, map.dart_of(a));
-    for (Index c : report_.children) A::index_darts(m_, c);
     springs_and_masses();
-    for (Index c : report_.children) A::attach_diagonals(m_, c);
     if (m_.options().damping == physics::DampingModel::viscous) m_.springs().set_paper_viscosity(m_.nodes().masses());
   }
 
@@ -86,9 +83,9 @@ class BatchRefiner {
   template <class Dim>
   auto fine(Dim, const FineCell& c, std::uint32_t level) {
     if constexpr (Dim::value == 1) {
-      if (c.parent == Dart::null_index) return std::optional<SpringRef>(SpringRef{new_spring(), physics::invalid_index, 2 * level});
+      if (c.parent == Dart::null_index) return std::optional<SpringRef>(SpringRef{edge_spring(c, physics::invalid_index), physics::invalid_index, 2 * level});
       const SpringRef p = A::map(m_).template attribute_container<1>().value(c.parent);
-      return std::optional<SpringRef>(SpringRef{c.piece == 0 ? p.spring : new_spring(), p.segment, 2 * p.level});
+      return std::optional<SpringRef>(SpringRef{edge_spring(c, c.piece == 0 ? p.spring : physics::invalid_index), p.segment, 2 * p.level});
     } else if constexpr (Dim::value == 3) {
       return std::optional<ElementRef>(ElementRef{child(c)});
     } else {
@@ -96,7 +93,24 @@ class BatchRefiner {
     }
   }
 
-  Index new_spring() { return m_.springs().add(0, 1, 0.0, 0.0, physics::SpringKind::edge); }
+  // The spring of fine edge c, between the particles at its ends (the vertices are in place when
+  // the pass makes edges) at their rest distance: `kept` (the parent edge's, on the half holding
+  // its recorded dart), else a new one. Its stiffness is summed from the children (code_child).
+  Index edge_spring(const FineCell& c, Index kept) {
+    const Dart d(c.darts.front());  // the dart the attribute will record
+    const Index i = m_.node_of(d), j = m_.node_of(A::map(m_).beta(d, 1));
+    const double rest = (m_.rest_position(j) - m_.rest_position(i)).norm();
+    physics::Springs& springs = m_.springs();
+    Index s = kept;
+    if (s == physics::invalid_index) {
+      s = springs.add(i, j, 0.0, rest, physics::SpringKind::edge);
+    } else {
+      springs.set_endpoints(s, i, j);
+      springs.set_rest_length(s, rest);
+    }
+    edge_springs_.push_back(s);
+    return s;
+  }
 
   // Child v of the reference cube is the child at the parent's corner local(v) (the model's
   // numbering: child k holds the parent's corner k as its local corner k); its corner u, the
@@ -123,41 +137,43 @@ class BatchRefiner {
     const Index k = first_ + static_cast<Index>(local[static_cast<std::size_t>(c.piece)]);
     const Element parent = elements[e];  // a copy: make_hex_child adds springs, not elements
     elements[k] = make_hex_child(m_, parent, e, Dart(c.darts[3 * u0 + along]), corner);
+    code_child(c, elements[k]);
     corners_.push_back(corner);
     children_.push_back(k);
     if (c.piece == 7) retire(e);
     return k;
   }
 
+  // The child's darts take the codes of the parent's darts of the same label: the affine map
+  // between the reference cube and the parent's corners sends child corner u to local corner
+  // local(u), as it sends the parent's, so a child dart starts at the same local vertex and lies
+  // on the same local edge (flag included) as the parent dart it is parallel to. This is what
+  // MssModel::index_darts would find by walking the child from its canonical dart. The dart
+  // flagged for each of the child's 12 edges adds the child's stiffness to that edge's spring
+  // (the child is one level finer than its sides' edges were and its sides are single edges:
+  // the series factor l_e / l_E is 1).
+  void code_child(const FineCell& c, const Element& el) {
+    if (edge_k_.empty()) {  // the first child: every dart and edge spring is made by now
+      A::grow_darts(m_);
+      edge_k_.assign(m_.springs().size(), 0.0);
+    }
+    for (std::size_t l = 0; l < 24; ++l) {
+      const Dart from(c.parent_darts[l]), to(c.darts[l]);
+      A::copy_code(m_, from, to, A::dart_vertex(m_, from));
+      if (const std::uint8_t code = A::dart_code(m_, from); code & 0x80) edge_k_[m_.spring_of(to)] += el.edge_k[code & 0x7f];
+    }
+  }
+
   void retire(Index e) {
-    retire_parent(m_, e, first_, 8);  // the diagonals are attached once the children are coded
+    retire_parent(m_, e, first_, 8);  // the children made their own diagonals
     for (Index k = 0; k < 8; ++k) report_.children.push_back(first_ + k);
     ++report_.elements;
   }
 
-  // Every edge spring: its ends and rest length from the map, its stiffness the sum of the
-  // children's contributions to it (each child is one level finer than its sides' edges were,
-  // and its sides are single edges: the series factor l_e / l_E is 1). Every particle's mass:
-  // ρV/8 from each child it is a corner of.
+  // Every edge spring's stiffness, summed by code_child. Every particle's mass: ρV/8 from each
+  // child it is a corner of.
   void springs_and_masses() {
-    auto& map = A::map(m_);
-    physics::Springs& springs = m_.springs();
-    std::vector<double> k(springs.size(), 0.0);
-    const auto cap = map.dart_capacity();
-    for (std::uint32_t x = 0; x < cap; ++x) {
-      if (!map.is_alive(Dart(x))) continue;
-      const std::uint8_t code = A::dart_code(m_, Dart(x));
-      if (!(code & 0x80)) continue;
-      const Element& el = m_.elements()[m_.element_of(Dart(x))];
-      k[m_.spring_of(Dart(x))] += el.edge_k[code & 0x7f];
-    }
-    for (AttrId<1> a : map.template attributes<1>()) {
-      const Dart d = map.dart_of(a);
-      const Index s = map.value(a).spring, i = m_.node_of(d), j = m_.node_of(map.beta(d, 1));
-      springs.set_endpoints(s, i, j);
-      springs.set_stiffness(s, k[s]);
-      springs.set_rest_length(s, (m_.rest_position(j) - m_.rest_position(i)).norm());
-    }
+    for (Index s : edge_springs_) m_.springs().set_stiffness(s, edge_k_[s]);
     std::vector<double> mass(m_.nodes().size(), 0.0);
     for (std::size_t c = 0; c < children_.size(); ++c) {
       const Element& el = m_.elements()[children_[c]];
@@ -177,6 +193,8 @@ class BatchRefiner {
   Index first_ = 0;
   std::vector<std::array<Index, 8>> corners_;
   std::vector<Index> children_;
+  std::vector<Index> edge_springs_;
+  std::vector<double> edge_k_;  // per spring: the children's edge stiffnesses summed
 };
 
 }  // namespace

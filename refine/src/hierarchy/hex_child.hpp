@@ -1,7 +1,7 @@
 #pragma once
 // A child hexahedron of a 1:8 refinement, as the model builds a hexahedron (MssModel's
 // make_element) at the child's own rest size: Baudet's box stiffness, the Kuhn volume, 4 new
-// diagonal springs (ends and rest lengths set when they are attached). Shared by the
+// diagonal springs between its corners at their rest lengths. Shared by the
 // element-by-element refiner (hex_refine.cpp) and the uniform batch pass (hex_batch.cpp).
 
 #include <array>
@@ -33,7 +33,10 @@ inline physics::Element make_hex_child(physics::MssModel<3>& m, const physics::E
   el.diagonal_k = s.diagonal;
   static constexpr int kuhn[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6}, {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
   for (const auto& t : kuhn) el.measure += physics::tet_volume(r(t[0]), r(t[1]), r(t[2]), r(t[3]));
-  for (std::size_t k = 0; k < 4; ++k) el.diagonal[k] = m.springs().add(0, 1, el.diagonal_k, 0.0, physics::SpringKind::diagonal);
+  for (std::size_t k = 0; k < 4; ++k) {
+    const auto [a, b] = hex_diagonal_ends[k];
+    el.diagonal[k] = m.springs().add(corner[a], corner[b], el.diagonal_k, (r(b) - r(a)).norm(), physics::SpringKind::diagonal);
+  }
   return el;
 }
 

@@ -15,6 +15,9 @@ namespace sewn::refine::detail {
 inline constexpr std::array<std::array<std::uint8_t, 2>, 12> hex_edge_ends = {
     {{0, 1}, {3, 2}, {4, 5}, {7, 6}, {0, 3}, {1, 2}, {4, 7}, {5, 6}, {0, 4}, {1, 5}, {2, 6}, {3, 7}}};
 
+/// The model's hexahedron diagonals, as pairs of VTK corners, in the order of Element::diagonal.
+inline constexpr std::array<std::array<std::uint8_t, 2>, 4> hex_diagonal_ends = {{{0, 6}, {1, 7}, {2, 4}, {3, 5}}};
+
 /// A point of a hexahedron's refinement lattice: each coordinate 0, 1 or 2 (halves of the parent).
 using Lat = std::array<int, 3>;
 /// VTK corner order in lattice coordinates of the parent.

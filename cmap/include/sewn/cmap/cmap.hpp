@@ -422,7 +422,8 @@ class CMap {
   /// (a std::optional: nullopt leaves the cell without), and the parents' I-attributes are
   /// released afterwards. No hooks are called: the caller makes the new cells' values from
   /// their parents' (FineCell names the parent's attribute, still readable during the calls).
-  /// Fine cells are visited with the vertex attributes already in place. O(darts).
+  /// Fine cells are visited with the vertex attributes already in place, edges first, then
+  /// faces, then volumes (a volume's `fine` can read its edges' new attributes). O(darts).
   template <class Mid, class Fine>
   void subdivide_hexahedra(Mid&& middle, Fine&& fine);
 

@@ -299,22 +299,9 @@ void CMap<D, A...>::subdivide_hexahedra(Mid&& middle, Fine&& fine) {
     }
   }
 
-  // 4) the fine edges', faces' and volumes' attributes, from the caller, and the parents' released
-  if constexpr (has_attribute<3>)
-    if (had[3]) {
-      auto& st = store<3>();
-      std::array<std::uint32_t, 24> child{};
-      for (std::uint32_t h = 0; h < hexes; ++h) {
-        const std::uint32_t* pd = hex_darts.data() + 24 * std::size_t{h};
-        const std::uint32_t parent = st.of_dart[pd[0]];
-        for (int v = 0; v < 8; ++v) {
-          for (int l = 0; l < 24; ++l) child[static_cast<std::size_t>(l)] = child_dart(h, pd, v, l);
-          const FineCell cell{parent, v, child, std::span<const std::uint32_t>(pd, 24)};
-          give_fine_attribute<3>(fine(std::integral_constant<int, 3>{}, cell), child);
-        }
-        if (parent != null) st.values.erase(parent);  // no hook: the caller made its successors
-      }
-    }
+  // 4) the fine edges', faces' and volumes' attributes, from the caller, and the parents'
+  // released; edges and faces first, so that the caller making a volume's attribute can read
+  // the attributes of its fine edges and faces
   auto cells_of = [&](auto kk) {
     constexpr int I = decltype(kk)::value;
     if constexpr (I < 3 && has_attribute<I>) {
@@ -371,6 +358,21 @@ void CMap<D, A...>::subdivide_hexahedra(Mid&& middle, Fine&& fine) {
   };
   cells_of(std::integral_constant<int, 1>{});
   cells_of(std::integral_constant<int, 2>{});
+  if constexpr (has_attribute<3>)
+    if (had[3]) {
+      auto& st = store<3>();
+      std::array<std::uint32_t, 24> child{};
+      for (std::uint32_t h = 0; h < hexes; ++h) {
+        const std::uint32_t* pd = hex_darts.data() + 24 * std::size_t{h};
+        const std::uint32_t parent = st.of_dart[pd[0]];
+        for (int v = 0; v < 8; ++v) {
+          for (int l = 0; l < 24; ++l) child[static_cast<std::size_t>(l)] = child_dart(h, pd, v, l);
+          const FineCell cell{parent, v, child, std::span<const std::uint32_t>(pd, 24)};
+          give_fine_attribute<3>(fine(std::integral_constant<int, 3>{}, cell), child);
+        }
+        if (parent != null) st.values.erase(parent);  // no hook: the caller made its successors
+      }
+    }
 }
 
 template <int D, class... A>
