@@ -50,7 +50,7 @@ Index Rods::add_rod(std::span<const Index> nodes, std::span<const double> x, boo
                        ", out of range");
     rest.col(static_cast<Eigen::Index>(k)) = Vec3(x[3 * nodes[k]], x[3 * nodes[k] + 1], x[3 * nodes[k] + 2]);
   }
-  rods_.push_back(Entry{Rod(rest, closed, section, rest_directors), std::vector<Index>(nodes.begin(), nodes.end()), Points(3, 0), {}});
+  rods_.push_back(Entry{Rod(rest, closed, section, rest_directors), std::vector<Index>(nodes.begin(), nodes.end()), Points(3, 0), {}, invalid_index, {}, {}});
   touch_topology();
   return rid;
 }
