@@ -366,6 +366,10 @@ Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum) {
   // the rotational energies where the bodies meet (model.connections), on the rest state
   if (scene.model != "mass-spring")
     b.joints = build_connections(scene, assembly.mesh, assembly.model_of_cell, materials, b.continuum, model);
+  // Rods whose twist no joint turns keep it quasi-static; under Newton it joins the linear system
+  // condensed, so each Newton step is the reduced energy's exact one (docs/rods.md).
+  if (b.continuum.rods && !b.continuum.rods->has_angle_dofs() && scene.integrator == "newton")
+    b.continuum.rods->condense_twist(model.system().angles());
   sum.connection_energies = connection_energies_text(b.joints);
   add_volume_term(scene, assembly.material_names, model);
 

@@ -28,6 +28,7 @@ Index AngleTable::add(const std::string& owner, std::span<const double> values, 
   rate_.resize(value_.size(), 0.0);
   inertia_.insert(inertia_.end(), inertias.begin(), inertias.end());
   fixed_.insert(fixed_.end(), fixed.begin(), fixed.end());
+  condensed_.resize(value_.size(), 0);
   if (lengths.empty())
     length_.resize(value_.size(), 1.0);
   else
@@ -39,6 +40,12 @@ Index AngleTable::add(const std::string& owner, std::span<const double> values, 
 void AngleTable::set_fixed(Index a, bool on) {
   if (a >= size()) throw InputError("AngleTable::set_fixed: angle " + std::to_string(a) + " of " + std::to_string(size()));
   fixed_[a] = on ? 1 : 0;
+}
+
+void AngleTable::set_condensed(Index a, bool on) {
+  if (a >= size()) throw InputError("AngleTable::set_condensed: angle " + std::to_string(a) + " of " + std::to_string(size()));
+  condensed_[a] = on ? 1 : 0;
+  if (on) inertia_[a] = 0.0;  // solved at every evaluation: quasi-static
 }
 
 void AngleTable::set_length(Index a, double metres) {

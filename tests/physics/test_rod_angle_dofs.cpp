@@ -68,6 +68,33 @@ StateView flat_view(const System& sys, const std::vector<double>& q, const std::
           std::span<const double>(q).subspan(n3, na), std::span<const double>(v).subspan(n3, na)};
 }
 
+// Forces and torques, and the energy, at flat state q with zero velocities.
+std::vector<double> forces_at(const System& sys, const std::vector<double>& q) {
+  const std::vector<double> zero(q.size(), 0.0);
+  std::vector<double> f(q.size(), 0.0);
+  sys.add_forces(flat_view(sys, q, zero), f);
+  return f;
+}
+
+double energy_at(const System& sys, const std::vector<double>& q) {
+  const std::vector<double> zero(q.size(), 0.0);
+  double e = 0;
+  for (const auto& t : sys.terms()) e += t->potential_energy(flat_view(sys, q, zero));
+  return e;
+}
+
+// Central differences at q0 along DOF k: the energy's derivative, the forces on either side.
+struct CentralDifference {
+  double energy;
+  std::vector<double> plus, minus;
+};
+CentralDifference central_difference(const System& sys, const std::vector<double>& q0, std::size_t k, double eps) {
+  std::vector<double> qp = q0, qm = q0;
+  qp[k] += eps;
+  qm[k] -= eps;
+  return {(energy_at(sys, qp) - energy_at(sys, qm)) / (2 * eps), forces_at(sys, qp), forces_at(sys, qm)};
+}
+
 // Counts accepted steps.
 class StepCounter final : public ForceTerm {
  public:
@@ -94,17 +121,7 @@ TEST_CASE("rod angle DOFs: torques and forces are minus the gradient, the Jacobi
   const std::vector<double> q0 = flat_state(sys);
   const std::vector<double> zero(q0.size(), 0.0);
   const std::size_t n = 3 * std::size_t{sys.nodes().size()} + sys.angles().size();
-  auto force = [&](const std::vector<double>& q) {
-    std::vector<double> f(q.size(), 0.0);
-    sys.add_forces(flat_view(sys, q, zero), f);
-    return f;
-  };
-  auto energy = [&](const std::vector<double>& q) {
-    double e = 0;
-    for (const auto& t : sys.terms()) e += t->potential_energy(flat_view(sys, q, zero));
-    return e;
-  };
-  const std::vector<double> f0 = force(q0);
+  const std::vector<double> f0 = forces_at(sys, q0);
   BlockMatrix& A = sys.matrix();
   A.set_zero();
   JacobianRequest req;
@@ -115,12 +132,10 @@ TEST_CASE("rod angle DOFs: torques and forces are minus the gradient, the Jacobi
   const double eps = 1e-6;
   double worst_f = 0, worst_j = 0, scale_f = 0, scale_j = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    std::vector<double> qp = q0, qm = q0;
-    qp[k] += eps;
-    qm[k] -= eps;
-    worst_f = std::max(worst_f, std::abs(-(energy(qp) - energy(qm)) / (2 * eps) - f0[k]));
+    const CentralDifference d = central_difference(sys, q0, k, eps);
+    worst_f = std::max(worst_f, std::abs(-d.energy - f0[k]));
     scale_f = std::max(scale_f, std::abs(f0[k]));
-    const std::vector<double> fp = force(qp), fm = force(qm);
+    const std::vector<double>& fp = d.plus, &fm = d.minus;
     for (std::size_t r = 0; r < n; ++r) {
       const double fd = (fp[r] - fm[r]) / (2 * eps);
       worst_j = std::max(worst_j, std::abs(fd - J(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k))));
@@ -353,6 +368,190 @@ TEST_CASE("rod angle DOFs: a hanging rod twisted past pi and back under Newton, 
   CHECK(max_jump < 0.02 * twist);  // ~ twist · 2·(1/600): smooth, no jump
   CHECK(std::abs(sys.angles().values()[driven]) < 1e-12);
   CHECK(sys.potential_energy(EnergyKind::internal) == doctest::Approx(E0).epsilon(1e-6));
+}
+
+// ---- condensed twist (Rods::condense_twist): θ stays quasi-static, and its rows in the Newton
+// system make the position step the exact Newton step of the reduced energy min_θ E. The forces
+// are minus the reduced energy's gradient and the Schur complement of the assembled matrix over
+// the condensed angles is its Hessian (finite differences of the re-solved state); under
+// NewtonEuler the condensed rods follow the quasi-static ones (−H_xx) to the solve's tolerance in
+// fewer iterations; a rod that turns freely (singular θ block) is still solved; the integrator
+// never moves a condensed angle itself.
+
+// Total Newton iterations of `steps` steps of 5 ms.
+int run(System& sys, int steps, double tolerance) {
+  integrate::NewtonEulerOptions opt;
+  opt.velocity_tolerance = tolerance;
+  opt.solver = integrate::LinearSolver::ldlt;
+  opt.max_iterations = 100;
+  integrate::NewtonEuler newton(opt);
+  int iterations = 0;
+  for (int s = 0; s < steps; ++s) iterations += newton.step(sys, 5e-3).iterations;
+  return iterations;
+}
+
+double largest_difference(const System& a, const System& b) {
+  double d = 0;
+  for (Index i = 0; i < a.nodes().size(); ++i) d = std::max(d, (a.nodes().position(i) - b.nodes().position(i)).norm());
+  return d;
+}
+
+// Checks at the system's (perturbed) state that the forces are minus the gradient of the
+// reduced energy over the positions and the integrated angles, and that the Schur complement
+// of the assembled matrix over the condensed angles is its Hessian (central differences, each
+// evaluation solving the condensed angles again).
+void check_reduced_derivatives(System& sys) {
+  std::vector<double> q0 = flat_state(sys);
+  const std::vector<double> zero(q0.size(), 0.0);
+  const std::size_t n3 = 3 * std::size_t{sys.nodes().size()};
+  const std::vector<double> f0 = forces_at(sys, q0);
+  // kept: positions and integrated angles; condensed: the solved ones, whose torques vanish
+  std::vector<Eigen::Index> kept, theta;
+  for (std::size_t k = 0; k < n3; ++k) kept.push_back(static_cast<Eigen::Index>(k));
+  double torque = 0;
+  for (std::size_t a = 0; a < sys.angles().size(); ++a) {
+    const auto id = static_cast<Index>(a);
+    if (sys.angles().fixed(id)) continue;
+    (sys.angles().condensed(id) ? theta : kept).push_back(static_cast<Eigen::Index>(n3 + a));
+    if (sys.angles().condensed(id)) torque = std::max(torque, std::abs(f0[n3 + a]));
+  }
+  BlockMatrix& A = sys.matrix();
+  A.set_zero();
+  JacobianRequest req;
+  req.matrix = &A;
+  req.cx = -1.0;  // A = −∂F/∂q = the Hessian over (x, θ) at the solved θ
+  for (const auto& t : sys.terms()) t->add_jacobians(flat_view(sys, q0, zero), req);
+  const Eigen::MatrixXd K = Eigen::MatrixXd(A.to_sparse());
+  const auto nk = static_cast<Eigen::Index>(kept.size()), nt = static_cast<Eigen::Index>(theta.size());
+  auto pick = [&](const std::vector<Eigen::Index>& rows, const std::vector<Eigen::Index>& cols) {
+    Eigen::MatrixXd M(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(cols.size()));
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      for (std::size_t c = 0; c < cols.size(); ++c) M(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = K(rows[r], cols[c]);
+    return M;
+  };
+  const Eigen::MatrixXd Kkk = pick(kept, kept), Kkt = pick(kept, theta);
+  const Eigen::MatrixXd schur = Kkk - Kkt * pick(theta, theta).ldlt().solve(Kkt.transpose());
+  REQUIRE(nt > 0);
+  const double eps = 1e-6;
+  double worst_f = 0, scale_f = 0, worst_h = 0, scale_h = 0, dropped = 0;
+  for (Eigen::Index c = 0; c < nk; ++c) {
+    const auto k = static_cast<std::size_t>(kept[static_cast<std::size_t>(c)]);
+    const CentralDifference d = central_difference(sys, q0, k, eps);
+    worst_f = std::max(worst_f, std::abs(-d.energy - f0[k]));
+    scale_f = std::max(scale_f, std::abs(f0[k]));
+    const std::vector<double>& fp = d.plus, &fm = d.minus;
+    for (Eigen::Index r = 0; r < nk; ++r) {
+      const auto kr = static_cast<std::size_t>(kept[static_cast<std::size_t>(r)]);
+      const double fd = -(fp[kr] - fm[kr]) / (2 * eps);
+      worst_h = std::max(worst_h, std::abs(fd - schur(r, c)));
+      dropped = std::max(dropped, std::abs(fd - Kkk(r, c)));
+      scale_h = std::max(scale_h, std::abs(fd));
+    }
+  }
+  MESSAGE(nt << " condensed angles: |torque| " << torque << ", |f - fd| " << worst_f << " of " << scale_f << ", |Schur - fd| "
+             << worst_h << " of " << scale_h << " (without the Schur term: " << dropped << ")");
+  CHECK(scale_f > 1e-3);
+  CHECK(torque < 1e-9 * scale_f);
+  CHECK(worst_f < 1e-6 * scale_f);
+  CHECK(worst_h < 1e-5 * scale_h);
+  CHECK(dropped > 1e3 * worst_h);  // the Schur term is really there on this bent, twisted rod, far above the check's error
+}
+
+void perturb_positions(System& sys) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0, 0.01);
+  for (double& x : sys.nodes().x()) x += noise(rng);
+}
+
+TEST_CASE("condensed twist: forces are the reduced gradient, the Schur complement its Hessian") {
+  System sys;
+  Rods& rods = hanging_helix(sys, 7);
+  rods.condense_twist(sys.angles());
+  perturb_positions(sys);
+  check_reduced_derivatives(sys);
+}
+
+TEST_CASE("condensed twist with held angle DOFs: gradient and Hessian over positions and the held angles") {
+  System sys;
+  Rods& rods = hanging_helix(sys, 7);
+  rods.use_angle_dofs(sys.angles(), 1e-6);
+  const std::vector<Rods::RodEdge> held{{0, 3}};
+  rods.condense_twist(sys.angles(), held);
+  CHECK(rods.has_angle_dofs());
+  CHECK_FALSE(sys.angles().condensed(rods.angle_of(0, 3)));
+  CHECK(sys.angles().condensed(rods.angle_of(0, 4)));
+  CHECK(sys.angles().inertias()[rods.angle_of(0, 4)] == 0.0);
+  perturb_positions(sys);
+  sys.angles().values()[rods.angle_of(0, 3)] += 0.4;  // the held angle turned: a torque on it
+  check_reduced_derivatives(sys);
+}
+
+TEST_CASE("condensed twist: Newton follows the quasi-static rods and converges quadratically") {
+  System quasi, condensed, quasi_loose, condensed_loose;
+  (void)hanging_helix(quasi, 9);
+  (void)hanging_helix(quasi_loose, 9);
+  hanging_helix(condensed, 9).condense_twist(condensed.angles());
+  hanging_helix(condensed_loose, 9).condense_twist(condensed_loose.angles());
+  const std::vector<double> angles_before(condensed.angles().values().begin(), condensed.angles().values().end());
+  const int it_quasi = run(quasi, 40, 1e-10);
+  const int it_condensed = run(condensed, 40, 1e-10);
+  const double diff = largest_difference(quasi, condensed);
+  // Quadratic convergence: a tolerance 10⁴ times tighter costs at most a couple of iterations a
+  // step; the linear convergence of −H_xx pays for every factor it gains.
+  const int loose_quasi = run(quasi_loose, 40, 1e-6);
+  const int loose_condensed = run(condensed_loose, 40, 1e-6);
+  MESSAGE("40 steps, Newton iterations at 1e-6 -> 1e-10 m/s: quasi-static " << loose_quasi << " -> " << it_quasi << ", condensed "
+                                                                           << loose_condensed << " -> " << it_condensed
+                                                                           << "; positions differ by " << diff << " m");
+  CHECK(diff < 1e-9);
+  CHECK(it_condensed < it_quasi);
+  CHECK(it_condensed <= loose_condensed + 2 * 40);
+  // The integrator never turns a condensed angle: the rod's own θ is the state.
+  for (std::size_t a = 0; a < angles_before.size(); ++a) CHECK(condensed.angles().values()[a] == angles_before[a]);
+}
+
+TEST_CASE("condensed twist with a held angle follows the rods whose angles are all DOFs") {
+  System dofs, mixed;
+  hanging_helix(dofs, 9).use_angle_dofs(dofs.angles(), 0.0);
+  Rods& rods = hanging_helix(mixed, 9);
+  rods.use_angle_dofs(mixed.angles(), 0.0);
+  const std::vector<Rods::RodEdge> held{{0, 4}};
+  rods.condense_twist(mixed.angles(), held);
+  const int it_dofs = run(dofs, 40, 1e-10);
+  const int it_mixed = run(mixed, 40, 1e-10);
+  const Index a = rods.angle_of(0, 4);
+  const double angle_diff = std::abs(dofs.angles().values()[a] - mixed.angles().values()[a]);
+  MESSAGE("40 steps: Newton iterations all DOFs " << it_dofs << ", condensed but one " << it_mixed << "; positions differ by "
+                                                  << largest_difference(dofs, mixed) << " m, the held angle by " << angle_diff << " rad");
+  CHECK(largest_difference(dofs, mixed) < 1e-9);
+  CHECK(angle_diff < 1e-7);
+  CHECK(std::abs(mixed.angles().values()[a] - rods.rod(0).theta()[4]) == 0.0);
+}
+
+TEST_CASE("condensed twist: a straight rod that turns freely is solved (its first angle held in the system)") {
+  System sys;
+  std::vector<Index> ids;
+  for (int i = 0; i < 6; ++i) ids.push_back(sys.nodes().add(Vec3(0.05 * i, 0, 0), Vec3::Zero(), 0.001));
+  sys.nodes().fix(ids[0]);
+  sys.nodes().fix(ids[1]);
+  Rods& rods = sys.add<Rods>();
+  (void)rods.add_rod(ids, sys.nodes().x(), false, Section::circular(1e7, 0.3, 0.002));
+  sys.add<Gravity>(Vec3(0, 0, -9.81));
+  REQUIRE(rods.rod(0).turns_freely());
+  rods.condense_twist(sys.angles());
+  CHECK(sys.angles().fixed(rods.angle_of(0, 0)));
+  CHECK_FALSE(sys.angles().fixed(rods.angle_of(0, 1)));
+  CHECK_FALSE(rods.has_angle_dofs());
+  const int iterations = run(sys, 10, 1e-10);
+  MESSAGE("straight free rod, 10 steps: " << iterations << " Newton iterations, tip at z = " << sys.nodes().position(ids[5]).z());
+  CHECK(sys.nodes().position(ids[5]).z() < -1e-4);
+  CHECK_THROWS_AS(rods.condense_twist(sys.angles()), InputError);
+  CHECK_THROWS_AS(rods.use_angle_dofs(sys.angles(), 0.0), InputError);
+  System other;
+  Rods& more = other.add<Rods>();
+  (void)more.add_rod(ids, sys.nodes().x(), false, Section::circular(1e7, 0.3, 0.002));
+  const std::vector<Rods::RodEdge> held{{0, 1}};
+  CHECK_THROWS_AS(more.condense_twist(other.angles(), held), InputError);  // held before use_angle_dofs
 }
 
 }  // namespace angle_dofs_test

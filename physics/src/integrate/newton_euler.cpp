@@ -34,7 +34,7 @@ void NewtonEuler::prepare(System& sys, double h) {
   const std::size_t na = angles.size();
   // Angles follow the positions, padded to whole 3×3 blocks (AngleLayout); the padding is fixed.
   const std::size_t total = n3_ + 3 * std::size_t{AngleLayout::blocks_for(angles.size())};
-  for (auto* a : {&xn_, &vn_, &qhat_, &q_, &trial_, &inertia_, &free_, &length_, &g_, &f_, &fv_, &f0_, &vel_, &p_, &rhs_})
+  for (auto* a : {&xn_, &vn_, &qhat_, &q_, &trial_, &inertia_, &free_, &condensed_, &length_, &g_, &f_, &fv_, &f0_, &vel_, &p_, &rhs_})
     a->assign(total, 0.0);
   zeros_.assign(total, 0.0);
   precond_.resize(3 * total);
@@ -65,6 +65,7 @@ void NewtonEuler::prepare(System& sys, double h) {
                         NewtonError::non_finite, {});
     inertia_[k] = angles.inertias()[a];
     free_[k] = angles.fixed(static_cast<Index>(a)) ? 0.0 : 1.0;
+    condensed_[k] = angles.condensed(static_cast<Index>(a)) ? 1.0 : 0.0;
     length_[k] = angles.lengths()[a];
   }
   for (std::size_t k = n3_ + na; k < total; ++k) inertia_[k] = 1.0;
@@ -210,8 +211,8 @@ int NewtonEuler::solve_linear(const BlockMatrix& A, bool need_definite) {
 
 void NewtonEuler::limit_angle_step(double& slope, double& pmax, NewtonReport& rep) {
   const std::size_t n = dof_count();
-  double largest = 0.0;
-  for (std::size_t k = n3_; k < n; ++k) largest = std::max(largest, std::abs(p_[k]));
+  double largest = 0.0;  // a condensed angle is its term's to turn (its own solve limits it)
+  for (std::size_t k = n3_; k < n; ++k) largest = std::max(largest, (1.0 - condensed_[k]) * std::abs(p_[k]));
   if (!(largest > opt_.max_angle_step)) return;
   // Scaling the whole step keeps it a descent direction (gᵀp scales with it) and its shape.
   const double s = opt_.max_angle_step / largest;
@@ -254,6 +255,14 @@ void NewtonEuler::steepest_descent(const BlockMatrix& A, double& slope, double& 
     slope += g_[k] * p_[k];
     pmax = std::max(pmax, std::abs(p_[k]));
   }
+}
+
+void NewtonEuler::drop_condensed(double& slope) {
+  for (std::size_t k = n3_; k < dof_count(); ++k)
+    if (condensed_[k] != 0.0) {
+      slope -= g_[k] * p_[k];
+      p_[k] = 0.0;
+    }
 }
 
 double NewtonEuler::largest_move() const {
@@ -364,6 +373,7 @@ NewtonReport NewtonEuler::step(System& sys, double h) {
       moved = largest_move();
     }
     rep.step_velocity = moved / h;
+    drop_condensed(slope);
     if (pmax == 0.0 || rep.step_velocity < opt_.velocity_tolerance) {
       // The Newton step is within tolerance: take it whole (it is smaller than what the
       // line search could resolve against round-off in Φ).

@@ -196,12 +196,16 @@ double Rod::evaluate(const Points& x, Eigen::VectorXd& g, std::vector<Eigen::Tri
   return E;
 }
 
-int Rod::solve_twist(const Points& x) {
+int Rod::solve_twist(const Points& x, std::span<const unsigned char> held) {
   const int m = num_edges();
+  if (!held.empty() && held.size() != theta_.size())
+    throw InputError("rods::Rod::solve_twist: " + std::to_string(held.size()) + " held flags for " + std::to_string(m) + " edges");
   std::vector<int> free_index(static_cast<std::size_t>(m), -1);
   int nf = 0;
-  for (int j = 0; j < m; ++j)
-    if (!theta_fixed_[static_cast<std::size_t>(j)]) free_index[static_cast<std::size_t>(j)] = nf++;
+  for (int j = 0; j < m; ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    if (!theta_fixed_[k] && (held.empty() || !held[k])) free_index[k] = nf++;
+  }
   if (nf == 0 || num_stencils() == 0) return 0;
   // With no angle held and an energy that turning every angle together leaves unchanged, the
   // θ block is singular along (1, ..., 1): the exact gradient has no component there, but its

@@ -36,8 +36,8 @@ Eigen::Matrix<double, 11, 11> projected<11>(Eigen::Matrix<double, 11, 11> H) {
 Index Rods::add_rod(std::span<const Index> nodes, std::span<const double> x, bool closed, const Section& section,
                     std::span<const Vec3> rest_directors) {
   const Index rid = num_rods();
-  if (angle_dofs_)
-    throw InputError("rods::Rods::add_rod: rod " + std::to_string(rid) + " added after use_angle_dofs (add every rod first)");
+  if (angle_blocks_)
+    throw InputError("rods::Rods::add_rod: rod " + std::to_string(rid) + " added after use_angle_dofs or condense_twist (add every rod first)");
   std::vector<Index> sorted(nodes.begin(), nodes.end());
   std::sort(sorted.begin(), sorted.end());
   if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
@@ -50,14 +50,15 @@ Index Rods::add_rod(std::span<const Index> nodes, std::span<const double> x, boo
                        ", out of range");
     rest.col(static_cast<Eigen::Index>(k)) = Vec3(x[3 * nodes[k]], x[3 * nodes[k] + 1], x[3 * nodes[k] + 2]);
   }
-  rods_.push_back(Entry{Rod(rest, closed, section, rest_directors), std::vector<Index>(nodes.begin(), nodes.end()), Points(3, 0), {}});
+  rods_.push_back(Entry{Rod(rest, closed, section, rest_directors), std::vector<Index>(nodes.begin(), nodes.end()), Points(3, 0), {}, invalid_index, {}, {}});
   touch_topology();
   return rid;
 }
 
 Rod& Rods::rod(Index r) {
   if (r >= num_rods()) throw InputError("rods::Rods::rod: rod " + std::to_string(r) + " of " + std::to_string(num_rods()));
-  rods_[r].solved_at.resize(3, 0);  // θ or clamps may change: solve again
+  rods_[r].solved_at.resize(3, 0);  // θ or clamps may change: solve again, from the θ set here
+  rods_[r].start.clear();
   return rods_[r].rod;
 }
 
@@ -79,11 +80,7 @@ Points Rods::gather(Index r, std::span<const double> x) const {
   return p;
 }
 
-void Rods::use_angle_dofs(AngleTable& angles, double inertia_per_length) {
-  if (angle_dofs_) throw InputError("rods::Rods::use_angle_dofs: called twice");
-  if (!(std::isfinite(inertia_per_length) && inertia_per_length >= 0))
-    throw InputError("rods::Rods::use_angle_dofs: the twist inertia per length must be finite and >= 0, got " +
-                     std::to_string(inertia_per_length));
+void Rods::add_angles(AngleTable& angles, double inertia_per_length) {
   for (Index r = 0; r < num_rods(); ++r) {
     Entry& e = rods_[r];
     const int m = e.rod.num_edges();
@@ -101,13 +98,52 @@ void Rods::use_angle_dofs(AngleTable& angles, double inertia_per_length) {
     }
     e.first_angle = angles.add("rod " + std::to_string(r), value, inertia, fixed, length);
   }
-  angle_dofs_ = true;
-  quasi_static_ = false;
+  angle_blocks_ = true;
   touch_topology();
 }
 
+void Rods::use_angle_dofs(AngleTable& angles, double inertia_per_length) {
+  if (angle_blocks_) throw InputError("rods::Rods::use_angle_dofs: called twice (or after condense_twist)");
+  if (!(std::isfinite(inertia_per_length) && inertia_per_length >= 0))
+    throw InputError("rods::Rods::use_angle_dofs: the twist inertia per length must be finite and >= 0, got " +
+                     std::to_string(inertia_per_length));
+  add_angles(angles, inertia_per_length);
+  angle_dofs_ = true;
+  quasi_static_ = false;
+}
+
+void Rods::condense_twist(AngleTable& angles, std::span<const RodEdge> held) {
+  if (!quasi_static_ && !angle_dofs_) throw InputError("rods::Rods::condense_twist: θ is not quasi-static (set_quasi_static(false))");
+  if (angle_blocks_ && quasi_static_) throw InputError("rods::Rods::condense_twist: called twice");
+  if (!held.empty() && !angle_dofs_)
+    throw InputError("rods::Rods::condense_twist: angles are held as DOFs only after use_angle_dofs");
+  for (Entry& e : rods_) e.held.assign(static_cast<std::size_t>(e.rod.num_edges()), 0);
+  for (const RodEdge& h : held) {
+    if (h.rod >= num_rods() || h.edge < 0 || h.edge >= rods_[h.rod].rod.num_edges())
+      throw InputError("rods::Rods::condense_twist: held rod " + std::to_string(h.rod) + " edge " + std::to_string(h.edge) + " out of range");
+    rods_[h.rod].held[static_cast<std::size_t>(h.edge)] = 1;
+  }
+  if (!angle_blocks_) add_angles(angles, 0.0);
+  for (Index r = 0; r < num_rods(); ++r) {
+    Entry& e = rods_[r];
+    const int m = e.rod.num_edges();
+    bool holds = false;
+    for (int j = 0; j < m; ++j) {
+      const auto k = static_cast<std::size_t>(j);
+      holds = holds || e.rod.theta_fixed(j) || e.held[k];
+      if (!e.held[k]) angles.set_condensed(e.first_angle + static_cast<Index>(j), true);
+    }
+    // A rod whose energy is unchanged when all its angles turn together has a θ block singular
+    // along (1, ..., 1), and H_xθ·1 = 0: holding one angle in the linear system leaves the
+    // Schur complement as it is and makes the matrix definite (its twist solve keeps the mean).
+    if (!holds && e.rod.turns_freely()) angles.set_fixed(e.first_angle, true);
+    e.solved_at.resize(3, 0);
+  }
+  quasi_static_ = true;
+}
+
 Index Rods::angle_of(Index r, int edge) const {
-  if (!angle_dofs_) throw InputError("rods::Rods::angle_of: the rods have no angle DOFs (use_angle_dofs)");
+  if (!angle_blocks_) throw InputError("rods::Rods::angle_of: the rods have no angles in the system (use_angle_dofs, condense_twist)");
   if (r >= num_rods() || edge < 0 || edge >= rods_[r].rod.num_edges())
     throw InputError("rods::Rods::angle_of: rod " + std::to_string(r) + " edge " + std::to_string(edge) + " out of range");
   return rods_[r].first_angle + static_cast<Index>(edge);
@@ -115,19 +151,31 @@ Index Rods::angle_of(Index r, int edge) const {
 
 void Rods::read_angles(Index r, const StateView& s) const {
   if (!angle_dofs_) return;
-  Entry& e = rods_[r];  // θ mirrors the state's angles
+  Entry& e = rods_[r];  // θ mirrors the state's angles (with a condensed twist: the held ones)
   const int m = e.rod.num_edges();
   if (s.angles.size() < std::size_t{e.first_angle} + static_cast<std::size_t>(m))
     throw InputError("rods::Rods: rod " + std::to_string(r) + "'s twist angles are DOFs but the state has " +
                      std::to_string(s.angles.size()) + " angles (only the Newton integrator integrates them)");
-  for (int j = 0; j < m; ++j) e.rod.set_theta(j, s.angles[e.first_angle + static_cast<std::size_t>(j)]);
+  for (int j = 0; j < m; ++j) {
+    const double value = s.angles[e.first_angle + static_cast<std::size_t>(j)];
+    if (quasi_static_ && !e.held[static_cast<std::size_t>(j)]) continue;
+    if (value != e.rod.theta()[static_cast<std::size_t>(j)]) e.solved_at.resize(3, 0);  // a held angle moved: solve again
+    e.rod.set_theta(j, value);
+  }
 }
 
 void Rods::ensure_twist(Index r, const Points& x) const {
   if (!quasi_static_) return;
   Entry& e = rods_[r];  // θ is the term's own (mutable) state
   if (e.solved_at.cols() == x.cols() && e.solved_at == x) return;
-  (void)e.rod.solve_twist(x);
+  // Every solve of a step starts from the step's θ, not from the last solve's: the twist energy
+  // is not convex in θ (bending couples in), and a solve warm-started at a rejected line-search
+  // trial may land in another minimum, and the reduced energy would then depend on the order of
+  // evaluations (a line search must compare values of one function).
+  if (!e.start.empty())
+    for (int j = 0; j < e.rod.num_edges(); ++j)
+      if (e.held.empty() || !e.held[static_cast<std::size_t>(j)]) e.rod.set_theta(j, e.start[static_cast<std::size_t>(j)]);
+  (void)e.rod.solve_twist(x, e.held);
   e.solved_at = x;
 }
 
@@ -136,13 +184,13 @@ void Rods::add_forces(const StateView& s, std::span<double> f) const {
   for (Index r = 0; r < num_rods(); ++r) {
     const Entry& e = rods_[r];
     const Points x = gather(r, s.x);
-    ensure_twist(r, x);
     read_angles(r, s);
+    ensure_twist(r, x);
     (void)e.rod.evaluate(x, g, nullptr);
     for (std::size_t k = 0; k < e.nodes.size(); ++k)
       for (int a = 0; a < 3; ++a) f[3 * e.nodes[k] + static_cast<std::size_t>(a)] -= g[3 * static_cast<Eigen::Index>(k) + a];
     const std::size_t torques = 3 * std::size_t{s.size()} + e.first_angle;  // where θ's torques go
-    if (angle_dofs_ && f.size() >= torques + static_cast<std::size_t>(e.rod.num_edges()))
+    if (angle_blocks_ && f.size() >= torques + static_cast<std::size_t>(e.rod.num_edges()))
       for (int j = 0; j < e.rod.num_edges(); ++j)
         f[torques + static_cast<std::size_t>(j)] -= g[3 * static_cast<Eigen::Index>(e.nodes.size()) + j];
   }
@@ -152,8 +200,8 @@ double Rods::potential_energy(const StateView& s) const {
   double E = 0;
   for (Index r = 0; r < num_rods(); ++r) {
     const Points x = gather(r, s.x);
-    ensure_twist(r, x);
     read_angles(r, s);
+    ensure_twist(r, x);
     E += rods_[r].rod.energy(x);
   }
   return E;
@@ -173,7 +221,7 @@ void Rods::collect_pairs(std::vector<NodePair>& out) const {
     for (int s = 0; s < e.rod.num_stencils(); ++s) {
       const auto v = e.rod.stencil_vertices(s);
       out.push_back({e.nodes[static_cast<std::size_t>(v[0])], e.nodes[static_cast<std::size_t>(v[2])]});
-      if (!angle_dofs_) continue;
+      if (!angle_blocks_) continue;
       std::array<Index, 5> block{};
       std::array<int, 11> comp{};
       stencil_blocks(e, s, block, comp);
@@ -204,7 +252,7 @@ void Rods::bind_pattern(const BlockMatrix& pattern) {
     e.slots.clear();
     auto node = [&](int v) { return e.nodes[static_cast<std::size_t>(v)]; };
     for (int s = 0; s < e.rod.num_stencils(); ++s) {
-      if (angle_dofs_) {
+      if (angle_blocks_) {
         std::array<Index, 5> block{};
         std::array<int, 11> comp{};
         stencil_blocks(e, s, block, comp);
@@ -286,6 +334,7 @@ void Rods::add_jacobians_with_angles(const StateView& s, const JacobianRequest& 
     const Entry& e = rods_[r];
     const Points x = gather(r, s.x);
     read_angles(r, s);
+    ensure_twist(r, x);
     const std::span<const Index> slots(e.slots);
     std::size_t slot = 0;
     for (int st = 0; st < e.rod.num_stencils(); ++st, slot += 25) {
@@ -314,7 +363,7 @@ void Rods::add_jacobians_with_angles(const StateView& s, const JacobianRequest& 
 void Rods::add_jacobians(const StateView& s, const JacobianRequest& req) const {
   if (req.matrix && req.matrix->pattern_version() != bound_pattern_)
     throw InputError("rods::Rods::add_jacobians: the matrix does not carry the pattern this term was bound to");
-  if (angle_dofs_) {
+  if (angle_blocks_) {
     add_jacobians_with_angles(s, req);
     return;
   }
@@ -340,8 +389,8 @@ void Rods::add_stability_rows(const StateView& s, StabilityRows& rows) const {
   for (Index r = 0; r < num_rods(); ++r) {
     const Entry& e = rods_[r];
     const Points x = gather(r, s.x);
-    ensure_twist(r, x);
     read_angles(r, s);
+    ensure_twist(r, x);
     for_each_block(e, x, true, [&](int a, int b, const Eigen::Matrix3d& B, std::size_t) {  // the bound needs PSD blocks
       const Index na = e.nodes[static_cast<std::size_t>(a)], nb = e.nodes[static_cast<std::size_t>(b)];
       if (na == nb)
@@ -355,9 +404,11 @@ void Rods::add_stability_rows(const StateView& s, StabilityRows& rows) const {
 void Rods::step_accepted(const StateView& s) {
   for (Index r = 0; r < num_rods(); ++r) {
     const Points x = gather(r, s.x);
-    ensure_twist(r, x);
     read_angles(r, s);
-    rods_[r].rod.update_frames(x);
+    ensure_twist(r, x);
+    Entry& e = rods_[r];
+    e.rod.update_frames(x);
+    if (quasi_static_) e.start.assign(e.rod.theta().begin(), e.rod.theta().end());
   }
 }
 
@@ -381,6 +432,8 @@ void Rods::restore(std::span<const RodHistory> h) {
   for (std::size_t r = 0; r < h.size(); ++r) {
     Entry& e = rods_[r];
     e.rod.restore(h[r].rod);
+    e.start.clear();  // the rod's θ is the one of the last accepted step
+    if (quasi_static_) e.start = h[r].rod.theta;
     if (h[r].solved_at.empty())
       e.solved_at.resize(3, 0);
     else

@@ -55,12 +55,21 @@ class AngleTable {
   /// after the positions had converged). Throws InputError if a is out of range or metres is
   /// not finite and > 0.
   void set_length(Index a, double metres);
+  /// Marks angle a as condensed: its term solves it inside every evaluation (a rod's
+  /// quasi-static twist, Rods::condense_twist) and reads it from its own state, not from the
+  /// table. The Newton integrator keeps a condensed angle in its linear system only, so the
+  /// position part of each step is the Newton step of the reduced energy min_θ E (the solve
+  /// does the Schur complement H_xx − H_xθ H_θθ⁻¹ H_θx without forming it), and never moves it
+  /// (its value here stays as added). Condensing zeroes its inertia (it is quasi-static).
+  /// Throws InputError if a is out of range.
+  void set_condensed(Index a, bool on);
+  [[nodiscard]] bool condensed(Index a) const { return condensed_[a] != 0; }
   /// Changes whenever angles are added (the Jacobian pattern grows).
   [[nodiscard]] std::uint64_t topology_version() const { return topology_version_; }
 
  private:
   std::vector<double> value_, rate_, inertia_, length_;
-  std::vector<unsigned char> fixed_;
+  std::vector<unsigned char> fixed_, condensed_;
   std::uint64_t topology_version_ = 0;
 };
 

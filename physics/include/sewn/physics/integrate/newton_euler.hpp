@@ -31,6 +31,11 @@
 // energy, gradient or state) throws NewtonError naming what failed, with the node table
 // unchanged (positions and velocities as before the step).
 //
+// Condensed angles (AngleTable::set_condensed, a rod's quasi-static twist): in the linear solve,
+// so the position step is the reduced energy's Newton step, then dropped from p (their term
+// solves them at every trial point; their update still counts in the stopping test, as the
+// distance the next solve will turn them).
+//
 // Angle DOFs: the step works on flat arrays of dof_count() entries with a per-DOF inertia and
 // a per-DOF free flag, all built in prepare(): the 3n positions, then System::angles() (a
 // rod's twist angle per edge, inertia J ≥ 0, free unless fixed), padded to whole blocks
@@ -163,6 +168,9 @@ class NewtonEuler {
   int solve_kept_pcg(const BlockMatrix& A, double tolerance);
   // p_ = -D⁻¹g (D: A's diagonal), always a descent direction; its slope gᵀp and |p|∞.
   void steepest_descent(const BlockMatrix& A, double& slope, double& pmax);
+  // Zeroes p_ on condensed angles (AngleTable::set_condensed: their term solves them at every
+  // evaluation) and takes their part out of the slope gᵀp.
+  void drop_condensed(double& slope);
   // max over the DOFs of length × |p|: how far the step moves any material point.
   [[nodiscard]] double largest_move() const;
   [[nodiscard]] double gradient_norm() const;
@@ -175,7 +183,7 @@ class NewtonEuler {
   std::size_t n3_ = 0;  // position entries; angles follow
   bool damped_ = false;
   double eta_ = 0.0;  // this iteration's relative CG tolerance (forcing_term)
-  AlignedVector<double> xn_, vn_, qhat_, q_, trial_, inertia_, free_, length_, g_, f_, fv_, f0_, vel_, p_, rhs_, precond_, zeros_;
+  AlignedVector<double> xn_, vn_, qhat_, q_, trial_, inertia_, free_, condensed_, length_, g_, f_, fv_, f0_, vel_, p_, rhs_, precond_, zeros_;
   CgWorkspace ws_;
   std::unique_ptr<LdltCache> ldlt_;
 };

@@ -73,8 +73,9 @@ class Rod {
   /// theorem). A rod that turns_freely() with no angle held has a singular θ block along
   /// (1, ..., 1): the solve keeps to the directions orthogonal to it, so the angles' mean stays
   /// where it was (no hold needed). Throws SolveError if it does not converge in 100
-  /// iterations. O(n) per iteration.
-  int solve_twist(const Points& x);
+  /// iterations. `held` (empty, or one flag per edge) holds more angles at their value, beside
+  /// the fixed ones (angles some other term turns: a connection's). O(n) per iteration.
+  int solve_twist(const Points& x, std::span<const unsigned char> held = {});
   /// Whether the energy is unchanged when every θ turns by the same angle: a round section
   /// (EI1 = EI2) and no natural curvature (|κ̄| ≤ 1e-12) at every stencil. O(n).
   [[nodiscard]] bool turns_freely() const;

@@ -24,6 +24,9 @@
 // (connect/) that hold a rod edge's frame need this mode: their θ gradient enters the same
 // Newton system. set_quasi_static(false) alone leaves θ to a caller (Rod::set_theta).
 //
+// Condensed twist (condense_twist): θ quasi-static as above, with θ rows in the Newton system
+// so that its position step is the reduced energy's exact Newton step (see the method).
+//
 // Time-parallel frames are updated in step_accepted(), which integrators call once per accepted
 // step; within a step the frames are frozen (PHYSICS_NOTES §3.4's history state).
 
@@ -64,6 +67,25 @@ class Rods final : public ForceTerm {
   /// added later are refused. Throws InputError if called twice or with a negative or
   /// non-finite inertia. O(edges).
   void use_angle_dofs(AngleTable& angles, double inertia_per_length);
+  /// Keeps θ quasi-static but gives the Newton integrator the exact Jacobian of the reduced
+  /// energy: every edge's θ becomes a condensed angle of `angles` (AngleTable::set_condensed:
+  /// no inertia, in the linear system only) and add_jacobians assembles each stencil's 11×11
+  /// Hessian at the solved θ over (x, θ), so the solve's position step is the Newton step of
+  /// min_θ E (the Schur complement above, without forming it) while the term still solves θ at
+  /// every evaluation: quadratic convergence on bent and twisted rods (a helical spring), where
+  /// −H_xx alone converges linearly. After use_angle_dofs, the edges in `held` stay DOFs (the
+  /// edges a connection turns: their θ is read from the state and held in the twist solve) and
+  /// the others are condensed: min over those θ. A rod with no angle held or fixed that
+  /// turns_freely() gets its first angle fixed in the table (its θ block is singular along
+  /// (1, ..., 1), which H_xθ does not see). Only the Newton integrator accepts the system then.
+  /// Throws InputError if called twice, with `held` before use_angle_dofs or out of range, or
+  /// if θ is the caller's (set_quasi_static(false)). O(edges).
+  struct RodEdge {
+    Index rod = 0;
+    int edge = 0;
+  };
+  void condense_twist(AngleTable& angles, std::span<const RodEdge> held = {});
+  /// θ are System angle DOFs (use_angle_dofs; with a condensed twist, the held ones).
   [[nodiscard]] bool has_angle_dofs() const { return angle_dofs_; }
   /// The System angle that holds θ of rod r's edge j (use_angle_dofs). Throws InputError if out
   /// of range or the rods have no angle DOFs.
@@ -95,7 +117,8 @@ class Rods final : public ForceTerm {
   [[nodiscard]] double energy_scale() const override;
   void collect_pairs(std::vector<NodePair>& out) const override;
   void bind_pattern(const BlockMatrix& pattern) override;
-  /// −H_xx as described above, at the θ of the last solve. O(stencils), a few µs each (AD
+  /// −H_xx as described above, at the θ of the last solve (with angles in the system: the
+  /// stencils' full Hessians over positions and angles). O(stencils), a few µs each (AD
   /// Hessian, 2.4 µs measured, and a 9×9 eigen-decomposition).
   void add_jacobians(const StateView& s, const JacobianRequest& req) const override;
   void add_stability_rows(const StateView& s, StabilityRows& rows) const override;
@@ -112,8 +135,12 @@ class Rods final : public ForceTerm {
     Points solved_at;             // positions of the last θ solve (0 columns: none yet)
     std::vector<Index> slots;     // per stencil 9 block slots (25 with angle DOFs), then per edge 4
     Index first_angle = invalid_index;  // with angle DOFs: θ^j is System angle first_angle + j
+    std::vector<unsigned char> held;    // condensed twist: per edge, θ is a DOF held in the twist solve
+    std::vector<double> start;          // θ every twist solve of the step starts from (empty: the current θ)
   };
   void ensure_twist(Index r, const Points& x) const;
+  // Registers every rod's θ as angles of `angles` (first_angle), with the given inertia per length.
+  void add_angles(AngleTable& angles, double inertia_per_length);
   // With angle DOFs: θ of rod r from the state (InputError if the state has no angles).
   void read_angles(Index r, const StateView& s) const;
   // Block rows of stencil s's 5 DOF groups (3 vertices, 2 edge angles) and the component of
@@ -127,7 +154,8 @@ class Rods final : public ForceTerm {
 
   mutable std::vector<Entry> rods_;
   bool quasi_static_ = true;
-  bool angle_dofs_ = false;
+  bool angle_blocks_ = false;  // θ rows in the Jacobian (use_angle_dofs or condense_twist)
+  bool angle_dofs_ = false;    // use_angle_dofs was called
   bool project_ = true;
   std::uint64_t bound_pattern_ = ~std::uint64_t{0};
 };
