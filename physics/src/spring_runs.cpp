@@ -97,21 +97,18 @@ void join_axes(const Soa& s, double* __restrict out, std::size_t p, std::size_t 
   }
 }
 
-// The force of one spring from the per-axis arrays: the reference arithmetic of the chunk
-// kernel (springs.cpp's spring_scalar, on another layout).
+// The force on node i of one spring (j gets its opposite) from d = xj − xi and u = vj − vi:
+// the reference arithmetic of the chunk kernel (springs.cpp's spring_scalar). False, with no
+// force, for a spring too short to have a direction (a NaN goes on, to be caught downstream).
 template <RunDamping D>
-inline void one_spring(const Soa& s, std::size_t i, std::size_t j, double k, double l, double g, double beta) {
-  const double dx = s.a[X][j] - s.a[X][i], dy = s.a[Y][j] - s.a[Y][i], dz = s.a[Z][j] - s.a[Z][i];
-  const double d2 = dx * dx + dy * dy + dz * dz;
-  if (d2 <= degenerate_ratio_sq * l * l) return;  // NaN goes on, to be caught downstream
+inline bool spring_force(const double (&d)[3], const double (&u)[3], double k, double l, double g, double beta, double (&out)[3]) {
+  const double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+  if (d2 <= degenerate_ratio_sq * l * l) return false;
   const double inv = 1.0 / std::sqrt(d2);
   double c = k * (1.0 - l * inv);
-  double e = 0.0, ux = 0, uy = 0, uz = 0;
+  double e = 0.0;
   if constexpr (D != RunDamping::none) {
-    ux = s.a[VX][j] - s.a[VX][i];
-    uy = s.a[VY][j] - s.a[VY][i];
-    uz = s.a[VZ][j] - s.a[VZ][i];
-    const double w = (ux * dx + uy * dy + uz * dz) * inv * inv;
+    const double w = (u[0] * d[0] + u[1] * d[1] + u[2] * d[2]) * inv * inv;
     if constexpr (D == RunDamping::viscous) {
       c += g * w;
     } else {
@@ -121,13 +118,40 @@ inline void one_spring(const Soa& s, std::size_t i, std::size_t j, double k, dou
       e = bk * cl;
     }
   }
-  const double fx = c * dx + e * ux, fy = c * dy + e * uy, fz = c * dz + e * uz;
-  s.a[FX][i] += fx;
-  s.a[FY][i] += fy;
-  s.a[FZ][i] += fz;
-  s.a[FX][j] -= fx;
-  s.a[FY][j] -= fy;
-  s.a[FZ][j] -= fz;
+  for (int a = 0; a < 3; ++a) out[a] = c * d[a] + e * u[a];
+  return true;
+}
+
+// One spring on the per-axis arrays of s.
+template <RunDamping D>
+inline void one_spring(const Soa& s, std::size_t i, std::size_t j, double k, double l, double g, double beta) {
+  double d[3], u[3] = {0.0, 0.0, 0.0}, f[3];
+  for (int a = 0; a < 3; ++a) d[a] = s.a[X + a][j] - s.a[X + a][i];
+  if constexpr (D != RunDamping::none)
+    for (int a = 0; a < 3; ++a) u[a] = s.a[VX + a][j] - s.a[VX + a][i];
+  if (!spring_force<D>(d, u, k, l, g, beta, f)) return;
+  for (int a = 0; a < 3; ++a) {
+    s.a[FX + a][i] += f[a];
+    s.a[FX + a][j] -= f[a];
+  }
+}
+
+// The rest list's springs, one by one, straight on x, v and f (3n each, node-major).
+template <RunDamping D>
+void rest_springs(const SpringArrays& a, std::span<const Index> rest, const double* x, const double* v, double* out, double beta) {
+  for (const Index r : rest) {
+    if (a.alive[r] == 0) continue;
+    const std::size_t i = 3 * std::size_t{a.ni[r]}, j = 3 * std::size_t{a.nj[r]};
+    double d[3], u[3] = {0.0, 0.0, 0.0}, f[3];
+    for (int c = 0; c < 3; ++c) d[c] = x[j + c] - x[i + c];
+    if constexpr (D != RunDamping::none)
+      for (int c = 0; c < 3; ++c) u[c] = v[j + c] - v[i + c];
+    if (!spring_force<D>(d, u, a.k[r], a.l[r], a.g[r], beta, f)) continue;
+    for (int c = 0; c < 3; ++c) {
+      out[i + c] += f[c];
+      out[j + c] -= f[c];
+    }
+  }
 }
 
 #ifdef SEWN_RUNS_AVX512
@@ -399,6 +423,9 @@ void SpringRuns::rebuild(const SpringArrays& a) {
     reach = std::max<std::size_t>(reach, std::size_t{std::max(chunks_[c].i0, chunks_[c].j0)} + lanes);
     reach_[c / block_chunks] = reach;
   }
+  std::size_t longest = 0;
+  for (const Chunk& c : chunks_) longest = std::max<std::size_t>(longest, c.j0 - c.i0);
+  overhang_ = (longest + 2 * lanes - 1) / lanes * lanes;
   Index floor = invalid_index;
   for (std::size_t b = blocks; b-- > 0;) {
     floor_[b] = floor;
@@ -474,60 +501,105 @@ void SpringRuns::ensure_arrays(Index n, std::size_t arrays) const {
   }
 }
 
+int SpringRuns::plan_ranges(int parts, Index n) const {
+  node_at_.assign(static_cast<std::size_t>(parts) + 1, 0);
+  chunk_at_.assign(static_cast<std::size_t>(parts) + 1, 0);
+  node_at_.back() = n;
+  chunk_at_.back() = chunks_.size();
+  // Balanced by chunks; a range starts at a multiple of 8 nodes (the per-axis arrays are joined
+  // 8 aligned nodes at a time) with the first chunk whose lower node is there.
+  for (int t = 1; t < parts; ++t) {
+    const auto u = static_cast<std::size_t>(t);
+    node_at_[u] = chunks_[range_begin(chunks_.size(), parts, t)].i0 / lanes * lanes;
+    chunk_at_[u] = static_cast<std::size_t>(
+        std::lower_bound(chunks_.begin(), chunks_.end(), node_at_[u], [](const Chunk& c, std::size_t p) { return c.i0 < p; }) -
+        chunks_.begin());
+  }
+  // A range's first `overhang_` nodes also take the forces of the range before's springs that
+  // reach past it: the seams must not reach into a third range.
+  for (int t = 1; t < parts; ++t)
+    if (node_at_[static_cast<std::size_t>(t) + 1] < node_at_[static_cast<std::size_t>(t)] + overhang_) return plan_ranges(1, n);
+  return parts;
+}
+
 void SpringRuns::forces(const SpringArrays& a, RunDamping damping, double beta, std::span<const double> x,
                         std::span<const double> v, std::span<double> f, bool accumulate, Index n) const {
-  const int parts = chunks_.size() >= 2 * thread_grain_chunks ? detail::parts_for(chunks_.size(), thread_grain_chunks) : 1;
-  // Threads past the first accumulate into three arrays of their own.
-  const std::size_t arrays = num_arrays + 3 * static_cast<std::size_t>(parts - 1);
-  ensure_arrays(n, arrays);
+  const int wanted = chunks_.size() >= 2 * thread_grain_chunks ? detail::parts_for(chunks_.size(), thread_grain_chunks) : 1;
+  const int parts = plan_ranges(wanted, n);
+  // Each thread has per-axis arrays of its own: no two threads write the same memory, and
+  // each splits the nodes its springs read (its range and the seam past it).
+  ensure_arrays(n, num_arrays * static_cast<std::size_t>(parts));
   const std::size_t stride = stride_;
-  if (parts > 1) {
-    forces_threads(a, damping, beta, x, v, f, accumulate, n, parts);
-    return;
-  }
-  const Soa s = soa_view(soa_.data(), stride);
+  const auto soa_of = [&](int t) { return soa_view(soa_.data() + static_cast<std::size_t>(t) * num_arrays * stride, stride); };
   const bool damped = damping != RunDamping::none;
-  // Nodes are split into the per-axis arrays just before the first block of chunks that
-  // reads them, and joined into f as soon as no later chunk or rest spring touches them, so
-  // that on a large mesh each node's per-axis values are still in cache when they are used:
-  // the window between the two fronts is about one grid layer.
-  std::size_t split_to = 0, joined_to = 0;
-  const auto split_until = [&](std::size_t end) {
-    end = std::min<std::size_t>((end + lanes - 1) / lanes * lanes, n);
-    if (end <= split_to) return;
-    const std::size_t p = split_to, len = end - p;
-    split_axes(x.data() + 3 * p, s.a[X] + p, s.a[Y] + p, s.a[Z] + p, len);
-    if (damped) split_axes(v.data() + 3 * p, s.a[VX] + p, s.a[VY] + p, s.a[VZ] + p, len);
-    split_to = end;
-  };
-  Index rest_floor = n;
-  for (const Index r : rest_)
-    if (a.alive[r] != 0) rest_floor = std::min({rest_floor, a.ni[r], a.nj[r]});
-  const auto join_until = [&](std::size_t end) {
-    end = std::min<std::size_t>(end, rest_floor);
-    if (end < n) end = end / lanes * lanes;
-    if (end <= joined_to) return;
-    join_axes(s, f.data(), joined_to, end, accumulate);
-    joined_to = end;
-  };
-  const auto run = [&]<RunDamping D>() {
-    for (std::size_t b = 0, c0 = 0; c0 < chunks_.size(); ++b, c0 += block_chunks) {
-      const std::size_t c1 = std::min(c0 + block_chunks, chunks_.size());
+  // Thread t in one pass over its chunks, as one thread over all of them: nodes are split into
+  // the per-axis arrays just before the first block of chunks that reads them, and joined
+  // into f as soon as no later chunk touches them, so that on a large mesh each node's
+  // per-axis values are still in cache when they are used (the window between the two fronts
+  // is about one grid layer). The seam at the start of its range (the range before's springs
+  // add there too) is left to the second phase.
+  const auto pass = [&]<RunDamping D>(int t) {
+    const Soa s = soa_of(t);
+    const auto u = static_cast<std::size_t>(t);
+    const std::size_t first = node_at_[u], last = node_at_[u + 1];
+    std::size_t split_to = first, joined_to = t == 0 ? first : first + overhang_;
+    const auto split_until = [&](std::size_t end) {
+      end = std::min<std::size_t>((end + lanes - 1) / lanes * lanes, n);
+      if (end <= split_to) return;
+      const std::size_t p = split_to, len = end - p;
+      split_axes(x.data() + 3 * p, s.a[X] + p, s.a[Y] + p, s.a[Z] + p, len);
+      if (damped) split_axes(v.data() + 3 * p, s.a[VX] + p, s.a[VY] + p, s.a[VZ] + p, len);
+      split_to = end;
+    };
+    const auto join_until = [&](std::size_t end) {
+      end = std::min(end, last);
+      if (end < n) end = end / lanes * lanes;
+      if (end <= joined_to) return;
+      join_axes(s, f.data(), joined_to, end, accumulate);
+      joined_to = end;
+    };
+    for (std::size_t c0 = chunk_at_[u], c1 = chunk_at_[u + 1]; c0 < c1;) {
+      const std::size_t b = c0 / block_chunks, end = std::min(c1, (b + 1) * block_chunks);
       split_until(reach_[b]);
-      chunk_range<D>(s, chunks_.data(), mask_.data(), k_.data(), l_.data(), g_.data(), c0, c1, beta);
+      chunk_range<D>(s, chunks_.data(), mask_.data(), k_.data(), l_.data(), g_.data(), c0, end, beta);
       join_until(floor_[b]);
+      c0 = end;
     }
-    split_until(n);
-    for (const Index r : rest_)
-      if (a.alive[r] != 0) one_spring<D>(s, a.ni[r], a.nj[r], a.k[r], a.l[r], a.g[r], beta);
+    join_until(last);
   };
+  const auto own_springs = [&](int t) {
+    switch (damping) {
+      case RunDamping::none: pass.template operator()<RunDamping::none>(t); break;
+      case RunDamping::viscous: pass.template operator()<RunDamping::viscous>(t); break;
+      case RunDamping::stiffness_proportional: pass.template operator()<RunDamping::stiffness_proportional>(t); break;
+    }
+  };
+  // The seam of range t: the range before's sums and its own, added in that order (a
+  // different grouping from one thread's, so equal to it to round-off), both back to zero.
+  const auto seam = [&](int t) {
+    if (t == 0) return;
+    const Soa mine = soa_of(t), before = soa_of(t - 1);
+    const std::size_t first = node_at_[static_cast<std::size_t>(t)];
+    for (int axis = 0; axis < 3; ++axis) {
+      double* __restrict p = before.a[FX + axis];
+      double* __restrict q = mine.a[FX + axis];
+      for (std::size_t i = first; i < first + overhang_; ++i) {
+        const double sum = p[i] + q[i];
+        p[i] = q[i] = 0.0;
+        double& o = f[3 * i + static_cast<std::size_t>(axis)];
+        o = accumulate ? o + sum : sum;
+      }
+    }
+  };
+  run_parts(parts, own_springs, seam);
+  // Springs in no chunk, on the calling thread after the join (few: a cut's re-attached ones
+  // until the plan is rebuilt), so that they hold back no thread's join window.
+  if (rest_.empty()) return;
   switch (damping) {
-    case RunDamping::none: run.template operator()<RunDamping::none>(); break;
-    case RunDamping::viscous: run.template operator()<RunDamping::viscous>(); break;
-    case RunDamping::stiffness_proportional: run.template operator()<RunDamping::stiffness_proportional>(); break;
+    case RunDamping::none: rest_springs<RunDamping::none>(a, rest_, x.data(), v.data(), f.data(), beta); break;
+    case RunDamping::viscous: rest_springs<RunDamping::viscous>(a, rest_, x.data(), v.data(), f.data(), beta); break;
+    case RunDamping::stiffness_proportional: rest_springs<RunDamping::stiffness_proportional>(a, rest_, x.data(), v.data(), f.data(), beta); break;
   }
-  // Every spring is done: the nodes not joined yet are final.
-  join_axes(s, f.data(), joined_to, n, accumulate);
 }
 
 bool SpringRuns::stability_rows(RunDamping damping, double beta, std::span<const double> x, Index n, StabilityRows& rows) const {
@@ -550,57 +622,6 @@ bool SpringRuns::stability_rows(RunDamping damping, double beta, std::span<const
   (void)damping, (void)beta, (void)x, (void)n, (void)rows;
   return false;
 #endif
-}
-
-// The threaded force pass: the chunks split into `parts` ranges, each thread accumulating into
-// force arrays of its own (thread 0 into FX FY FZ); the last also takes the rest list. Then the
-// threads' arrays are summed per node in thread order: deterministic for a given count, and
-// equal to the one-thread sums to round-off (a node two ranges touch sums in another order).
-void SpringRuns::forces_threads(const SpringArrays& a, RunDamping damping, double beta, std::span<const double> x,
-                                std::span<const double> v, std::span<double> f, bool accumulate, Index n, int parts) const {
-  const std::size_t stride = stride_;
-  const Soa s = soa_view(soa_.data(), stride);
-  const auto force_array = [&](int t, int axis) {
-    return t == 0 ? s.a[FX + axis] : soa_.data() + (num_arrays + 3 * static_cast<std::size_t>(t - 1) + axis) * stride;
-  };
-  // Node ranges start at multiples of 8: the per-axis arrays are stored 8 aligned at a time.
-  const std::size_t blocks8 = (std::size_t{n} + lanes - 1) / lanes;
-  const auto node = [&](int t) { return std::min<std::size_t>(lanes * range_begin(blocks8, parts, t), n); };
-  const bool damped = damping != RunDamping::none;
-  run_parts(parts, [&](int t) {
-    const std::size_t p = node(t), len = node(t + 1) - p;
-    split_axes(x.data() + 3 * p, s.a[X] + p, s.a[Y] + p, s.a[Z] + p, len);
-    if (damped) split_axes(v.data() + 3 * p, s.a[VX] + p, s.a[VY] + p, s.a[VZ] + p, len);
-  });
-  const auto run = [&]<RunDamping D>(int t) {
-    Soa own = s;
-    for (int axis = 0; axis < 3; ++axis) own.a[FX + axis] = force_array(t, axis);
-    const std::size_t c0 = range_begin(chunks_.size(), parts, t), c1 = range_begin(chunks_.size(), parts, t + 1);
-    chunk_range<D>(own, chunks_.data(), mask_.data(), k_.data(), l_.data(), g_.data(), c0, c1, beta);
-    if (t == parts - 1)
-      for (const Index r : rest_)
-        if (a.alive[r] != 0) one_spring<D>(own, a.ni[r], a.nj[r], a.k[r], a.l[r], a.g[r], beta);
-  };
-  run_parts(parts, [&](int t) {
-    switch (damping) {
-      case RunDamping::none: run.template operator()<RunDamping::none>(t); break;
-      case RunDamping::viscous: run.template operator()<RunDamping::viscous>(t); break;
-      case RunDamping::stiffness_proportional: run.template operator()<RunDamping::stiffness_proportional>(t); break;
-    }
-  });
-  run_parts(parts, [&](int t) {
-    double* out = f.data();
-    for (int axis = 0; axis < 3; ++axis)
-      for (std::size_t p = node(t); p < node(t + 1); ++p) {
-        double sum = 0.0;
-        for (int u = 0; u < parts; ++u) {
-          double* acc = force_array(u, axis);
-          sum += acc[p];
-          acc[p] = 0.0;
-        }
-        out[3 * p + axis] = accumulate ? out[3 * p + axis] + sum : sum;
-      }
-  });
 }
 
 }  // namespace sewn::physics::detail

@@ -221,6 +221,72 @@ TEST_CASE("threads: spring forces at 2 threads equal 1 thread's to round-off, an
   CHECK(forces(1) == one);
 }
 
+TEST_CASE("threads: spring forces set and added at 1 to 4 threads, after a cut, agree to round-off and repeat bitwise") {
+  using threads_test::Threads;
+  // ~2400 chunks: 4 ranges of ~630 nodes at 4 threads, each longer than the ~190-node seam
+  // (a grid layer) where the range before's springs add; the cut leaves springs in the rest list.
+  auto m = threads_test::jiggled_block(5);
+  threads_test::cut_plane(*m);
+  const StateView st = m->nodes().state();
+  const std::size_t n3 = st.x.size();
+  std::vector<double> preset(n3);
+  for (std::size_t k = 0; k < n3; ++k) preset[k] = std::sin(0.37 * static_cast<double>(k));
+  const auto forces = [&](int threads, bool add) {
+    Threads scope(threads);
+    std::vector<double> f = add ? preset : std::vector<double>(n3, 7.0);
+    if (add)
+      m->springs().add_forces(st, f);
+    else
+      m->springs().set_forces(st, f);
+    return f;
+  };
+  const std::vector<double> one = forces(1, false);
+  REQUIRE(m->springs().num_in_runs() > 0);  // the plan, built by the first call, has chunks
+  double scale = 0;
+  for (double f : one) scale = std::max(scale, std::abs(f));
+  REQUIRE(scale > 0);
+  for (const int threads : {1, 2, 3, 4}) {
+    CAPTURE(threads);
+    const std::vector<double> set = forces(threads, false), added = forces(threads, true);
+    CHECK(forces(threads, false) == set);  // bitwise, and the accumulators were left at zero
+    CHECK(threads_test::max_difference(one, set) <= 1e-13 * scale);
+    std::vector<double> expected = preset;
+    for (std::size_t k = 0; k < n3; ++k) expected[k] += one[k];
+    CHECK(threads_test::max_difference(expected, added) <= 1e-13 * (scale + 1));
+  }
+}
+
+TEST_CASE("threads: a slab's forces split only into ranges longer than a seam of a grid layer") {
+  using threads_test::Threads;
+  // 40×40×1 cubes: 3362 particles, ~3400 chunks, the seam (a layer, 1681 nodes, plus the body
+  // diagonal) ~1736 nodes. Balanced by chunks, whose lower node is mostly in the bottom layer:
+  // at 2 threads the ranges start at 0 and ~1300 (the second longer than a seam: split), at 3
+  // at 0, ~730 and ~1460 (the middle one shorter: one range, bitwise as one thread).
+  MssModel<3> m(hex_grid(40, 40, 1, {{0.005, 0.005, 0.005}, {}}), std::vector<MaterialParams>{{1e6, 0.3, 1000}},
+                std::vector<std::uint32_t>{});
+  auto x = m.nodes().x();
+  for (std::size_t k = 0; k < x.size(); ++k) x[k] += 1e-4 * std::sin(1.3 * static_cast<double>(k));
+  const StateView st = m.nodes().state();
+  std::uint64_t regions = 0;
+  const auto forces = [&](int threads) {
+    Threads scope(threads);
+    std::vector<double> f(st.x.size());
+    const std::uint64_t before = split_regions();
+    m.springs().set_forces(st, f);
+    regions = split_regions() - before;
+    return f;
+  };
+  const std::vector<double> one = forces(1);
+  REQUIRE(m.springs().num_in_runs() > 0);
+  double scale = 0;
+  for (double f : one) scale = std::max(scale, std::abs(f));
+  const std::vector<double> two = forces(2);
+  CHECK(regions == 1);
+  CHECK(threads_test::max_difference(one, two) <= 1e-13 * scale);
+  CHECK(forces(3) == one);
+  CHECK(regions == 0);
+}
+
 TEST_CASE("threads: trajectories repeat bitwise at 2 threads and agree with 1 thread to round-off") {
   // 1000 semi-implicit steps; implicit ones cost ~30 CG iterations each, with four meetings
   // of the threads per iteration, which on a loaded machine (CI) take a time slice each: 100

@@ -32,18 +32,44 @@ bool fork_next_region();
 /// its ranges one after the other would have cost.
 void region_done(double region_s, double serial_s);
 
-/// Calls body(t) for t in [0, parts), on `parts` threads when OpenMP is built in. body must
-/// not throw (an exception cannot leave an OpenMP region): kernels record failures instead.
-/// The ranges are fixed by `parts` alone, so running them on fewer threads (the runtime's
-/// team, or one while backing off on a loaded machine) changes no result.
-template <class Body>
-void run_parts(int parts, const Body& body) {
+#ifdef SEWN_HAVE_OPENMP
+// One phase of a forked region: range t of `parts` on the team, each exactly once whatever
+// number of threads the runtime granted; range 0 is the calling thread's (the static
+// schedule's first iteration goes to thread 0), its time added to first_s. The worksharing
+// loop ends at a barrier: a phase starts once every range of the one before is done.
+template <class Phase>
+void run_phase_on_team(int parts, const Phase& phase, double& first_s) {
+  using clock = std::chrono::steady_clock;
+#pragma omp for schedule(static, 1)
+  for (int t = 0; t < parts; ++t) {
+    if (t != 0) {
+      phase(t);
+      continue;
+    }
+    const clock::time_point begin = clock::now();
+    phase(0);
+    first_s += std::chrono::duration<double>(clock::now() - begin).count();
+  }
+}
+#endif
+
+/// Calls phase(t) for t in [0, parts), for each phase in turn, on `parts` threads when OpenMP is
+/// built in: every range of a phase is done before the next phase starts (one fork, a barrier
+/// between phases). Phases must not throw (an exception cannot leave an OpenMP region):
+/// kernels record failures instead. The ranges are fixed by `parts` alone, so running them on
+/// fewer threads (the runtime's team, or one while backing off on a loaded machine: each phase's
+/// ranges one after the other) changes no result.
+template <class... Phases>
+void run_parts(int parts, const Phases&... phases) {
   if (parts <= 1) {
-    body(0);
+    (phases(0), ...);
     return;
   }
+  const auto serially = [parts](const auto& phase) {
+    for (int t = 0; t < parts; ++t) phase(t);
+  };
   if (!fork_next_region()) {
-    for (int t = 0; t < parts; ++t) body(t);
+    (serially(phases), ...);
     return;
   }
 #ifdef SEWN_HAVE_OPENMP
@@ -52,18 +78,7 @@ void run_parts(int parts, const Body& body) {
   double first_s = 0.0;
 #pragma omp parallel num_threads(parts)
   {
-    // Each range exactly once, whatever number of threads the runtime granted; range 0 is the
-    // calling thread's (the static schedule's first iteration goes to thread 0).
-#pragma omp for schedule(static, 1)
-    for (int t = 0; t < parts; ++t) {
-      if (t != 0) {
-        body(t);
-        continue;
-      }
-      const clock::time_point begin = clock::now();
-      body(0);
-      first_s = std::chrono::duration<double>(clock::now() - begin).count();
-    }
+    (run_phase_on_team(parts, phases, first_s), ...);
   }
   // The ranges are of one size: the calling thread's time, times their count, is what running
   // them one after the other would cost. Not the sum of every range's time: a worker

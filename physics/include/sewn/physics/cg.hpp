@@ -40,8 +40,10 @@ struct CgWorkspace {
   AlignedVector<double> pre;                      // the filtered preconditioner, 6 per node
   AlignedVector<double> expanded, ones4;          // a reduced solve's W p, and a filter of ones
   // Several threads: thread t's products into rows past its own range, one array per thread
-  // (4 per node, rows [end of t's range, n) used), added in thread order (deterministic).
+  // (4 per node, rows [end of t's range, spill_end[t]) used, all zero between products), added
+  // in thread order (deterministic).
   std::vector<AlignedVector<double>> spill;
+  std::vector<std::size_t> spill_end;
 };
 
 /// The fast path's packed matrix for other solvers (sa-pcg's multigrid and its CG): copies A's

@@ -85,9 +85,9 @@ class SpringRuns {
   struct Chunk {
     Index i0, j0;  // lane q joins nodes i0 + q and j0 + q
   };
-  // forces() on `parts` threads (spring_runs.cpp).
-  void forces_threads(const SpringArrays& a, RunDamping damping, double beta, std::span<const double> x,
-                      std::span<const double> v, std::span<double> f, bool accumulate, Index n, int parts) const;
+  // Splits the nodes into `parts` ranges for forces() (node_at_, chunk_at_), or into one if a
+  // range would be shorter than a seam; returns the count used.
+  int plan_ranges(int parts, Index n) const;
   // Sizes soa_ for n nodes and `arrays` per-axis arrays, keeping it if it fits.
   void ensure_arrays(Index n, std::size_t arrays) const;
   void ensure_lane_index(Index count);
@@ -105,10 +105,16 @@ class SpringRuns {
   std::vector<Index> rest_;
   std::vector<std::size_t> reach_;  // per block of chunks: nodes below it are read up to it
   std::vector<Index> floor_;        // per block: the lowest node a later block touches
+  // How far past the start of a thread's node range the springs of the ranges before it add
+  // forces: the largest j0 − i0 of a chunk, plus its lanes, rounded up to 8 nodes.
+  std::size_t overhang_ = 0;
+  // forces()'s ranges: thread t owns nodes [node_at_[t], node_at_[t + 1]) and the chunks whose
+  // lower node is among them, chunks [chunk_at_[t], chunk_at_[t + 1]).
+  mutable std::vector<std::size_t> node_at_, chunk_at_;
   std::size_t rest_at_build_ = 0;
   Index chunked_ = 0, live_ = 0;
-  // Per-axis node arrays: x y z, vx vy vz, and the force accumulators fx fy fz, then three more
-  // accumulators per thread past the first; the accumulators are all zero between calls.
+  // Per-axis node arrays: x y z, vx vy vz, and the force accumulators fx fy fz, one such set
+  // per thread of forces(); the accumulators are all zero between calls.
   mutable AlignedVector<double> soa_;
   mutable std::size_t stride_ = 0;
 };
