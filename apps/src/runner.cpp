@@ -89,6 +89,7 @@ physics::ImplicitEulerOptions implicit_options(const Scene& scene) {
   o.solver = scene.solver == "ldlt" ? physics::solve::Backend::automatic : physics::solve::parse_backend(scene.solver);
   o.cg_tolerance = scene.tolerance;
   o.cg_absolute_tolerance = scene.absolute_tolerance;
+  o.cg_absolute_acceleration = scene.absolute_acceleration;
   o.cg_max_iterations = static_cast<int>(scene.max_iterations);
   return o;
 }

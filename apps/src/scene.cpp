@@ -228,6 +228,8 @@ Field build_schema() {
                 field("tolerance", Kind::number).fallback(physics::solve::default_tolerance).above(0).below(1).doc("Relative residual of the iterative solvers (implicit)."),
                 field("absolute_tolerance", Kind::number).unit("m/s").fallback(physics::solve::default_absolute_tolerance).at_least(0).at_most(1)
                     .doc("Floor of the residual as a velocity error on every free axis (implicit): a body at rest stops there instead of chasing round-off. 0: none."),
+                field("absolute_acceleration", Kind::number).unit("m/s²").fallback(physics::solve::default_absolute_acceleration).at_least(0).at_most(1000)
+                    .doc("Floor of the residual as a force error per mass on every free axis (implicit): a step of h stops at the smaller of `absolute_tolerance` and this times h, so the floor tightens with the step instead of stopping small steps early (docs/solvers.md). 0: no floor at all."),
                 field("max_iterations", Kind::integer).fallback(physics::solve::default_max_iterations).at_least(1).at_most(1000000).doc("Iteration limit of the iterative solvers (implicit); reaching it is an error."),
                 field("newton_tolerance", Kind::number).unit("m/s").fallback(1e-6).above(0).doc("Newton stops when the largest update divided by h is below it; a rod twist angle's update counts as the distance it turns the section, the section's radius of gyration times the angle (newton)."),
                 field("newton_forcing", Kind::number).fallback(0.0).at_least(0).below(1)
@@ -631,6 +633,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& file) {
     }
     s.tolerance = in.number("tolerance");
     s.absolute_tolerance = in.number("absolute_tolerance");
+    s.absolute_acceleration = in.number("absolute_acceleration");
     s.max_iterations = static_cast<std::uint32_t>(in.integer("max_iterations"));
     s.newton_tolerance = in.number("newton_tolerance");
     s.newton_iterations = static_cast<std::uint32_t>(in.integer("newton_iterations"));

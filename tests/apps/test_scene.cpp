@@ -185,6 +185,7 @@ TEST_CASE("integrator.solver and the solver defaults: one iteration limit for th
   CHECK(s.max_iterations == static_cast<std::uint32_t>(lib.cg_max_iterations));
   CHECK(s.tolerance == lib.cg_tolerance);
   CHECK(s.absolute_tolerance == lib.cg_absolute_tolerance);
+  CHECK(s.absolute_acceleration == lib.cg_absolute_acceleration);
   for (auto b : sewn::physics::solve::available_backends()) {
     json j = minimal();
     j["integrator"]["solver"] = std::string(sewn::physics::solve::to_string(b));
@@ -195,6 +196,12 @@ TEST_CASE("integrator.solver and the solver defaults: one iteration limit for th
   expect_error(j, "integrator.solver", "cholmod");
   j["integrator"] = json::parse(R"({"absolute_tolerance": -1})");
   expect_error(j, "integrator.absolute_tolerance", ">= 0");
+  j["integrator"] = json::parse(R"({"absolute_acceleration": -1e-6})");
+  expect_error(j, "integrator.absolute_acceleration", ">= 0");
+  j["integrator"] = json::parse(R"({"absolute_acceleration": "fast"})");
+  expect_error(j, "integrator.absolute_acceleration", "number");
+  j["integrator"] = json::parse(R"({"absolute_acceleration": 2e-6})");
+  CHECK(parse_scene(j, "beam.json").absolute_acceleration == 2e-6);
 }
 
 TEST_CASE("integrator.newton_forcing: inexact Newton on cholmod-pcg only, below 1") {

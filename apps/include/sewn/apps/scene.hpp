@@ -146,6 +146,7 @@ struct Scene {
   std::string solver = "auto";
   double tolerance = physics::solve::default_tolerance;
   double absolute_tolerance = physics::solve::default_absolute_tolerance;
+  double absolute_acceleration = physics::solve::default_absolute_acceleration;  // m/s², floor a step of h scales
   std::uint32_t max_iterations = physics::solve::default_max_iterations;
   double newton_tolerance = 1e-6;  // m/s, integrator "newton"
   std::uint32_t newton_iterations = 50;
