@@ -193,6 +193,15 @@ SideJet side_jet(const Side& side, const Eigen::VectorXd& q, int at, int dofs, d
   return dofs <= 9 ? side_jet_n<9>(side, q, at, dofs, sign, coef) : side_jet_n<12>(side, q, at, dofs, sign, coef);
 }
 
+// The first side's frame turned by the constant rotation R fixed at rest (m'_j = Σ_i R(i, j) m_i):
+// the frame the twist is measured from, whose axis m'3 is where n3 sat at rest (the orientation
+// rule, see PointConnection).
+template <class T>
+Frame<T> turned(const Frame<T>& f, const Eigen::Matrix3d& R) {
+  auto column = [&](int j) { return T(R(0, j)) * f.m1 + T(R(1, j)) * f.m2 + T(R(2, j)) * f.m3; };
+  return {column(0), column(1), column(2)};
+}
+
 template <class T>
 struct Core {
   T energy{};
@@ -324,7 +333,15 @@ PointConnection::PointConnection(std::string name, Side m, Side n, PointStiffnes
   if (detail::dot(fm.m3, fn.m3) < 0) sign_n_ = -sign_n_;
   const auto fn2 = build_frame<double>(n_, qn, 0, sign_n_, coef_n_);
   rest_d_ = Vec3(detail::dot(fn2.m3, fm.m1), detail::dot(fn2.m3, fm.m2), detail::dot(fn2.m3, fm.m3));
-  rest_twist_ = signed_angle(transport(fm.m3, fn2.m3, fm.m1), fn2.m1, fn2.m3);
+  // The twist's frame: m's frame turned (the shortest way, in its own coordinates) until its axis
+  // is n̄3, so the transport's singularity m'3 = −n3 is the bend ω = π and no joint starts
+  // nearer to it than a straight one. d̄3 = m̄3·n̄3 ≥ 0 after the flip: that turn is defined.
+  const Vec3 e1 = physics::rods::parallel_transport(Vec3::UnitZ(), rest_d_, Vec3::UnitX());
+  turn_.col(0) = e1;
+  turn_.col(1) = rest_d_.cross(e1);
+  turn_.col(2) = rest_d_;
+  const auto ft = turned(fm, turn_);
+  rest_twist_ = signed_angle(transport(ft.m3, fn2.m3, ft.m1), fn2.m1, fn2.m3);
   accepted_twist_ = rest_twist_;
 }
 
@@ -344,15 +361,16 @@ PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update
     using std::sin;
     using std::sqrt;
     Core<T> c;
-    c.one_plus_c = 1 + value_of(dot(fm.m3, fn.m3));
-    const T raw = signed_angle(transport(fm.m3, fn.m3, fm.m1), fn.m1, fn.m3);
+    const Frame<T> ft = turned(fm, turn_);  // the twist is measured from m's frame turned onto n̄3
+    c.one_plus_c = 1 + value_of(dot(ft.m3, fn.m3));
+    const T raw = signed_angle(transport(ft.m3, fn.m3, ft.m1), fn.m1, fn.m3);
     T delta = raw;
     if (update == TwistUpdate::incremental_i) {
       delta = raw + T(two_pi * std::round((accepted_twist_ - value_of(raw)) / two_pi));
     } else if (update == TwistUpdate::incremental_ii) {
       // Turn m1 by the accepted δ first: what is left to measure is the step's increment (< π).
-      const V3<T> m1t = cos(T(accepted_twist_)) * fm.m1 + sin(T(accepted_twist_)) * fm.m2;
-      delta = T(accepted_twist_) + signed_angle(transport(fm.m3, fn.m3, m1t), fn.m1, fn.m3);
+      const V3<T> m1t = cos(T(accepted_twist_)) * ft.m1 + sin(T(accepted_twist_)) * ft.m2;
+      delta = T(accepted_twist_) + signed_angle(transport(ft.m3, fn.m3, m1t), fn.m1, fn.m3);
     }
     const V3<T> d{dot(fn.m3, fm.m1), dot(fn.m3, fm.m2), dot(fn.m3, fm.m3)};
     const V3<T> db = detail::constant<T>(rest_d_.x(), rest_d_.y(), rest_d_.z());

@@ -212,25 +212,6 @@ TEST_CASE("point connection: gradients near the singular configurations") {
     q[15] += 2 * pi - 0.1;  // increment now 3π − 0.15 ≡ π − 0.15 — the other side: aliased by design
     CHECK(std::abs(c.evaluate(q, u, false).twist - c.rest_twist() - (6.0 + 3 * pi - 0.15)) > 1.0);
   }
-  // Nearly antiparallel axes: a rod nearly perpendicular to the joint axis at rest (allowed:
-  // m̄3·n̄3 > 0), then bent until 1 + m3·n3 = 1e-2; and flagged closer still.
-  RodInTriangle s(pi / 2 - 0.1);
-  PointConnection c("antiparallel", s.tri, s.rod, {2.0, 1.0}, s.q);
-  REQUIRE(c.second_axis_sign() == 1.0);
-  for (double gap : {1e-2, 1e-4}) {
-    const double a = std::acos(gap - 1);  // angle from +x of the rod's axis
-    VectorXd q = s.q;
-    q.segment<3>(12) = Vec3(std::cos(a), 0, std::sin(a));
-    const PointEval e = c.evaluate(q, TwistUpdate::incremental_ii, false);
-    if (gap > antiparallel_margin) {
-      CHECK_FALSE(e.near_antiparallel);
-      check_gradient(c, q, TwistUpdate::incremental_ii);
-      check_gradient(c, q, TwistUpdate::incremental_i);
-      check_hessian(c, q, TwistUpdate::incremental_ii);
-    } else {
-      CHECK(e.near_antiparallel);
-    }
-  }
   // Bending through nearly π is flagged.
   RodInTriangle b;
   PointConnection cb("bend-pi", b.tri, b.rod, {2.0, 1.0}, b.q);
@@ -239,35 +220,85 @@ TEST_CASE("point connection: gradients near the singular configurations") {
   CHECK(cb.evaluate(q, TwistUpdate::incremental_ii, false).bend_near_pi);
 }
 
+TEST_CASE("orientation rule: a joint bent or folded at rest meets the transport's singularity only at a bend of pi") {
+  // Rods leaving the triangle 62° off its axis (the toy ball's spring foot on its platform),
+  // nearly perpendicular to it, and folded back over it (the rule flips that one's axis).
+  for (double tilt : {1.08, pi / 2 - 0.1, pi - 0.3}) {
+    CAPTURE(tilt);
+    RodInTriangle s(tilt);
+    PointConnection c("bent", s.tri, s.rod, {2.0, 3.0}, s.q);
+    CHECK(c.second_axis_sign() == (tilt < pi / 2 ? 1.0 : -1.0));
+    const PointEval e0 = c.evaluate(s.q, TwistUpdate::incremental_ii, true);
+    CHECK(e0.energy < 1e-20);
+    CHECK(e0.gradient.norm() < 1e-9);
+    // Bent on in its plane by ω (away from the triangle's axis, or, folded, towards it).
+    const double away = tilt < pi / 2 ? 1.0 : -1.0;
+    auto bent = [&](double w) {
+      VectorXd q = s.q;
+      q.segment<3>(12) = Vec3(std::cos(tilt + away * w), std::sin(tilt + away * w), 0);
+      return q;
+    };
+    // Where the axes themselves are antiparallel (the transport from the side's own m3 would be
+    // singular there): an ordinary state now, ω short of π by the rest tilt.
+    const double w_old = tilt < pi / 2 ? pi - tilt : tilt;
+    const PointEval e = c.evaluate(bent(w_old), TwistUpdate::incremental_ii, false);
+    CHECK_FALSE(e.singular());
+    CHECK(e.bend_angle == doctest::Approx(w_old).epsilon(1e-12));
+    CHECK(std::isfinite(e.energy));
+    for (TwistUpdate u : {TwistUpdate::incremental_i, TwistUpdate::incremental_ii}) {
+      VectorXd q = bent(w_old);
+      q[15] += 0.4;  // twisted too
+      check_gradient(c, q, u);
+      check_hessian(c, q, u);
+    }
+    // Bent from rest until 1 + cos ω = gap: the guard's flag, and finite differences short of it.
+    for (double gap : {1e-2, 1e-4}) {
+      const VectorXd q = bent(std::acos(gap - 1));
+      const PointEval g = c.evaluate(q, TwistUpdate::incremental_ii, false);
+      if (gap > antiparallel_margin) {
+        CHECK_FALSE(g.near_antiparallel);
+        check_gradient(c, q, TwistUpdate::incremental_ii);
+        check_gradient(c, q, TwistUpdate::incremental_i);
+        check_hessian(c, q, TwistUpdate::incremental_ii);
+      } else {
+        CHECK(g.near_antiparallel);
+      }
+    }
+  }
+}
+
 TEST_CASE("point connection: a rigid motion of the connected pair changes neither energy nor force") {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> ang(-pi, pi);
-  RodInTriangle s(0.2);
-  PointConnection rt("rt", s.tri, s.rod, {2.0, 3.0}, s.q);
-  TwoRods r;
-  PointConnection rr("rr", r.a, r.b, {1.5, 0.7}, r.q);
-  const std::vector<int> rt_blocks{0, 3, 6, 9, 12};
-  for (int trial = 0; trial < 5; ++trial) {
-    const Eigen::Matrix3d R =
-        Eigen::AngleAxisd(ang(rng), Vec3(ang(rng), ang(rng), ang(rng)).normalized()).toRotationMatrix();
-    // At rest, rotated: zero energy, zero force.
-    const VectorXd q_rt = rotated(s.q, R, rt_blocks, {{9, s.rod}});
-    const PointEval e0 = rt.evaluate(q_rt, TwistUpdate::incremental_ii, true);
-    CHECK(e0.energy < 1e-20);
-    CHECK(e0.gradient.norm() < 1e-9);
-    const VectorXd q_rr = rotated(r.q, R, {0, 3, 7, 10}, {{0, r.a}, {7, r.b}});
-    CHECK(rr.evaluate(q_rr, TwistUpdate::incremental_ii, false).energy < 1e-20);
-    // Strained, rotated: the same energy; the forces sum to zero (translation invariance).
-    VectorXd qs = s.q;
-    qs.segment<3>(12) += Vec3(0.05, 0.2, -0.1);
-    qs[15] += 0.7;
-    const PointEval e1 = rt.evaluate(qs, TwistUpdate::incremental_ii, true);
-    const PointEval e2 = rt.evaluate(rotated(qs, R, rt_blocks, {{9, s.rod}}), TwistUpdate::incremental_ii, true);
-    CHECK(e1.energy > 0.1);
-    CHECK(e2.energy == doctest::Approx(e1.energy).epsilon(1e-10));
-    Vec3 net = Vec3::Zero();
-    for (int blk : {0, 3, 6, 9, 12}) net += e2.gradient.segment<3>(blk);
-    CHECK(net.norm() < 1e-10 * e2.gradient.norm());
+  for (double tilt : {0.2, 1.08, pi - 0.3}) {  // nearly straight, bent (turned twist frame), folded (flipped)
+    CAPTURE(tilt);
+    RodInTriangle s(tilt);
+    PointConnection rt("rt", s.tri, s.rod, {2.0, 3.0}, s.q);
+    TwoRods r;
+    PointConnection rr("rr", r.a, r.b, {1.5, 0.7}, r.q);
+    const std::vector<int> rt_blocks{0, 3, 6, 9, 12};
+    for (int trial = 0; trial < 5; ++trial) {
+      const Eigen::Matrix3d R =
+          Eigen::AngleAxisd(ang(rng), Vec3(ang(rng), ang(rng), ang(rng)).normalized()).toRotationMatrix();
+      // At rest, rotated: zero energy, zero force.
+      const VectorXd q_rt = rotated(s.q, R, rt_blocks, {{9, s.rod}});
+      const PointEval e0 = rt.evaluate(q_rt, TwistUpdate::incremental_ii, true);
+      CHECK(e0.energy < 1e-20);
+      CHECK(e0.gradient.norm() < 1e-9);
+      const VectorXd q_rr = rotated(r.q, R, {0, 3, 7, 10}, {{0, r.a}, {7, r.b}});
+      CHECK(rr.evaluate(q_rr, TwistUpdate::incremental_ii, false).energy < 1e-20);
+      // Strained, rotated: the same energy; the forces sum to zero (translation invariance).
+      VectorXd qs = s.q;
+      qs.segment<3>(12) += Vec3(0.05, 0.2, -0.1);
+      qs[15] += 0.7;
+      const PointEval e1 = rt.evaluate(qs, TwistUpdate::incremental_ii, true);
+      const PointEval e2 = rt.evaluate(rotated(qs, R, rt_blocks, {{9, s.rod}}), TwistUpdate::incremental_ii, true);
+      CHECK(e1.energy > 0.1);
+      CHECK(e2.energy == doctest::Approx(e1.energy).epsilon(1e-10));
+      Vec3 net = Vec3::Zero();
+      for (int blk : {0, 3, 6, 9, 12}) net += e2.gradient.segment<3>(blk);
+      CHECK(net.norm() < 1e-10 * e2.gradient.norm());
+    }
   }
 }
 
@@ -377,10 +408,13 @@ TEST_CASE("point connection: accept() keeps a rod side's frame in step with Rod:
     x = step * x;
     const VectorXd q = stencil(x);
     const double raw = c.evaluate(q, TwistUpdate::direct, false).twist_raw;
-    const Vec3 m3(1, 0, 0), m1(0, 0, 1);  // the triangle's frame: axis into the joint, normal
+    // The triangle's frame (axis into the joint, normal) turned onto the rod's rest tangent:
+    // the frame the twist is measured from (the orientation rule).
+    const Vec3 m3(1, 0, 0), m1(0, 0, 1), t0 = (rest.col(1) - rest.col(0)).normalized();
     const Vec3 n3 = (x.col(1) - x.col(0)).normalized();
     const Vec3 n1 = rod.material_directors(x, 0).first;
-    const double expected = physics::rods::signed_angle(physics::rods::parallel_transport(m3, n3, m1), n1, n3);
+    const Vec3 m1t = physics::rods::parallel_transport(m3, t0, m1);
+    const double expected = physics::rods::signed_angle(physics::rods::parallel_transport(t0, n3, m1t), n1, n3);
     worst = std::max(worst, std::abs(std::remainder(raw - expected, 2 * pi)));
     c.accept(q, TwistUpdate::incremental_ii);
     rod.update_frames(x);

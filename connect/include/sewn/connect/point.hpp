@@ -16,7 +16,12 @@
 //                  bisector of the corner's angle); m1 = the triangle's unit normal; m2 = m3×m1.
 // Orientation rule: the first side's axis points into the joint, the second's out of it (a
 // straight rod–rod continuation then has m̄3·n̄3 = 1); the second axis is flipped if still
-// m̄3·n̄3 < 0, so at rest the transport is a hemisphere away from its singularity n3 = −m3.
+// m̄3·n̄3 < 0. The twist is then measured from m's frame turned by a constant rotation (fixed
+// at rest, in m's own coordinates) that carries m̄3 onto n̄3: δ = signed angle from
+// P_{m'3}^{n3}(m'1) to n1 about n3, with m'3 = d1 m1 + d2 m2 + d3 m3 at d = d̄, so
+// 1 + m'3·n3 = 1 + cos ω: the transport's singularity is the bend ω = π from the rest shape,
+// however bent the joint is at rest (a spring's foot at 62° to the platform's normal would
+// otherwise meet it after a bend of 118°). A straight joint's turn is the identity.
 //
 // Stencil DOF order q: the first side's DOFs, then the second's.
 //   rod edge:  x_from (3), x_to (3), θ (1)   — 7; from/to in the rod's own edge direction
@@ -116,7 +121,7 @@ struct PointEval {
   double twist = 0;       ///< δ by the update asked for
   double twist_raw = 0;   ///< the direct δ ∈ (−π, π]
   double bend_angle = 0;  ///< ω ∈ [0, π]
-  bool near_antiparallel = false;  ///< 1 + m3·n3 < antiparallel_margin: transport near its singularity
+  bool near_antiparallel = false;  ///< 1 + m'3·n3 = 1 + cos ω < antiparallel_margin: transport near its singularity
   bool bend_near_pi = false;       ///< ω > π − bend_margin: ∂E_b/∂d ~ ω/sin ω blows up
   Eigen::VectorXd gradient;
   [[nodiscard]] bool singular() const { return near_antiparallel || bend_near_pi; }
@@ -196,6 +201,9 @@ class PointConnection {
   std::vector<Index> nodes_;
   double rest_twist_ = 0, accepted_twist_ = 0;
   Vec3 rest_d_{0, 0, 1};
+  // The constant turn of the first side's frame the twist is measured from (its columns: m'1,
+  // m'2, m'3 = d̄ in m's coordinates; the identity for a straight joint).
+  Eigen::Matrix3d turn_ = Eigen::Matrix3d::Identity();
 };
 
 /// The stencil's position-block nodes for sides (m, n) as PointConnection will order them
