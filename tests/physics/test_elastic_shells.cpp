@@ -5,6 +5,7 @@
 // meshes with either diagonal orientation and on one-row meshes.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -13,6 +14,7 @@
 #include "../../bench/elastic/shell_strip.hpp"
 #include "elastic_helpers.hpp"
 #include "sewn/physics/shells/patch_terms.hpp"
+#include "sewn/physics/shells/shell_terms.hpp"
 
 namespace test_elastic_shells {
 namespace {
@@ -53,6 +55,11 @@ void check_patch(const shells::PatchPositions<N>& X, const std::array<std::uint8
   // bent by up to `amplitude` per coordinate, then rotated and moved rigidly
   const P x = X + amplitude * P::NullaryExpr([&] { return u(rng); });
   sewn::physics::test::check_element<N>(E, G, H, x, 1e-6, 1e-5);
+  // the line search's one-pass energy and gradient give what the two separate calls give
+  sewn::physics::elements::Vec<3 * N> g;
+  const double e = shells::patch_energy_gradient<N>(x, rest, g);
+  CHECK(e == doctest::Approx(E(x)).epsilon(1e-14));
+  CHECK((g - G(x)).cwiseAbs().maxCoeff() <= 1e-14 * G(x).cwiseAbs().maxCoeff());
   const Eigen::Matrix3d R = sewn::physics::test::random_rotation(rng);
   P moved = R * X;
   moved.colwise() += Eigen::Vector3d(u(rng), u(rng), u(rng));
@@ -123,6 +130,46 @@ TEST_CASE("patch bending: every interior patch of an irregular mesh bends a quad
     const double area = 0.5 * std::abs(u.x() * v.y() - u.y() * v.x());
     const double exact = area * plate_density(m, eps * K);
     CHECK(terms.three->element_energy(e, terms.three->gather(sys.state(), e)) == doctest::Approx(exact).epsilon(1e-6));
+  }
+}
+
+TEST_CASE("shell terms: add_forces_and_energy equals potential_energy and add_forces on a bent, stretched mesh") {
+  const auto s = sewn::shell_strip::strip_mesh(sewn::shell_strip::Mesh::jittered, 20);
+  sewn::physics::System sys;
+  const Index n = static_cast<Index>(s.rest.size() / 3);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (Index i = 0; i < n; ++i) {
+    const Eigen::Vector3d X(s.rest[3 * i], s.rest[3 * i + 1], s.rest[3 * i + 2]);
+    sys.nodes().add(X + 0.01 * Eigen::Vector3d(u(rng), u(rng), 3.0 * u(rng)), Eigen::Vector3d::Zero(), 1.0);
+  }
+  const std::vector<shells::PlateMaterial> mat(s.triangles.size(), shells::plate_material(1e6, 0.3, 0.01));
+  const shells::PatchTerms patches = shells::add_patch_bending(sys, s.triangles, s.rest, mat);
+  auto& membranes = sys.add<shells::Membranes>();
+  for (const auto& tri : s.triangles) {
+    shells::TriPositions X;
+    for (int c = 0; c < 3; ++c)
+      for (int r = 0; r < 3; ++r) X(r, c) = s.rest[3 * std::size_t{tri[static_cast<std::size_t>(c)]} + static_cast<std::size_t>(r)];
+    (void)membranes.add(tri, X, 1e6, 0.3, 0.01);
+  }
+  REQUIRE(patches.three != nullptr);
+  REQUIRE(patches.two != nullptr);
+  const sewn::physics::StateView state = sys.state();
+  for (const auto& term : sys.terms()) {
+    std::vector<double> f_two(3 * std::size_t{n}, 0.0), f_one(3 * std::size_t{n}, 0.0);
+    const double e_two = term->potential_energy(state);
+    term->add_forces(state, f_two);
+    const double e_one = term->add_forces_and_energy(state, f_one);
+    CAPTURE(term->name());
+    CHECK(e_two > 0.0);
+    CHECK(e_one == doctest::Approx(e_two).epsilon(1e-13));
+    double largest = 0.0, diff = 0.0;
+    for (std::size_t k = 0; k < f_two.size(); ++k) {
+      largest = std::max(largest, std::abs(f_two[k]));
+      diff = std::max(diff, std::abs(f_one[k] - f_two[k]));
+    }
+    CHECK(largest > 0.0);
+    CHECK(diff <= 1e-13 * largest);
   }
 }
 

@@ -70,6 +70,19 @@ double StencilTerm<N>::potential_energy(const StateView& s) const {
 }
 
 template <int N>
+double StencilTerm<N>::add_forces_and_energy(const StateView& s, std::span<double> f) const {
+  double sum = 0.0;
+  Gradient g;
+  for (Index e = 0; e < size(); ++e) {
+    if (alive_[e] == 0) continue;
+    sum += element_energy_gradient(e, gather(s, e), g);
+    for (int a = 0; a < N; ++a)
+      for (int c = 0; c < 3; ++c) f[3 * std::size_t{nodes_[e][a]} + c] -= g[3 * a + c];
+  }
+  return sum;
+}
+
+template <int N>
 void StencilTerm<N>::collect_pairs(std::vector<NodePair>& out) const {
   for (Index e = 0; e < size(); ++e)
     for (int a = 0; a < N && alive_[e] != 0; ++a)

@@ -75,10 +75,8 @@ void NewtonEuler::prepare(System& sys, double h) {
   // whose forces depend on velocity without a Ψ cannot be minimised: probe each such term with
   // a non-uniform velocity (a uniform one leaves springs' relative velocities zero) and refuse.
   std::fill(f0_.begin(), f0_.end(), 0.0);
-  damped_ = false;
   for (const auto& t : sys.terms()) {
     if (t->dissipative()) {
-      damped_ = true;
       t->add_forces(view(sys, xn_, zeros_), f0_);
     } else if (t->velocity_dependent()) {
       probe_velocity_dependence(sys, *t);
@@ -119,22 +117,26 @@ double NewtonEuler::evaluate(const System& sys, std::span<const double> q, bool 
     phi += free_[k] * inertia_[k] * d * d;
   }
   phi *= 0.5 / (h_ * h_);
-  for (const auto& t : sys.terms()) phi += t->potential_energy(s);
-  if (!want_gradient && !damped_) return phi;
   // f_ = F(q, v) of the terms without dissipation; a dissipative term contributes its
   // elastic part F(q, 0) and its damping at the lagged positions, F(x_n, v) - F(x_n, 0) (the
   // last sum in f0_, from prepare()), and h Ψ(x_n, v) to Φ, whose q-gradient that damping is.
-  std::fill(f_.begin(), f_.end(), 0.0);
+  // Energy and forces of a term come from one pass where it can (add_forces_and_energy).
+  if (want_gradient) std::fill(f_.begin(), f_.end(), 0.0);
+  for (const auto& t : sys.terms()) {
+    if (!want_gradient) {
+      phi += t->potential_energy(s);
+    } else if (!t->dissipative()) {
+      phi += t->add_forces_and_energy(s, f_);
+    } else {
+      phi += t->potential_energy(s);
+      t->add_forces(view(sys, q, zeros_), f_);
+    }
+  }
   const StateView lagged = view(sys, xn_, vel_);
   for (const auto& t : sys.terms()) {
-    if (!t->dissipative()) {
-      if (want_gradient) t->add_forces(s, f_);
-      continue;
-    }
+    if (!t->dissipative()) continue;
     phi += h_ * t->dissipation(lagged);
-    if (!want_gradient) continue;
-    t->add_forces(view(sys, q, zeros_), f_);
-    t->add_forces(lagged, f_);
+    if (want_gradient) t->add_forces(lagged, f_);
   }
   if (want_gradient)
     for (std::size_t k = 0; k < n; ++k)

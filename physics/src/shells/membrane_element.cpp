@@ -16,9 +16,27 @@ namespace {
 using Mat32 = Eigen::Matrix<double, 3, 2>;
 
 // Second Piola-Kirchhoff stress S = 2μE + λ_ps tr(E) I.
-Eigen::Matrix2d membrane_stress(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m) {
-  const Eigen::Matrix2d E = membrane_strain(x, rest);
+Eigen::Matrix2d stress_of(const Eigen::Matrix2d& E, const MembraneMaterial& m) {
   return 2.0 * m.mu * E + m.lambda_ps * E.trace() * Eigen::Matrix2d::Identity();
+}
+
+Eigen::Matrix2d membrane_stress(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m) {
+  return stress_of(membrane_strain(x, rest), m);
+}
+
+double energy_of(const Eigen::Matrix2d& E, const TriRest& rest, const MembraneMaterial& m) {
+  return m.thickness * rest.area * (m.mu * E.squaredNorm() + 0.5 * m.lambda_ps * E.trace() * E.trace());
+}
+
+// ∂W/∂x from F and the stress: the columns of h·Ā F S Dm⁻ᵀ are the forces' negatives on nodes
+// 1 and 2, node 0 takes minus their sum.
+Vec9 gradient_of(const TriPositions& x, const Eigen::Matrix2d& S, const TriRest& rest, const MembraneMaterial& m) {
+  const Mat32 H = m.thickness * rest.area * membrane_deformation(x, rest) * S * rest.Dm_inv.transpose();
+  Vec9 g;
+  g.segment<3>(0) = -H.rowwise().sum();
+  g.segment<3>(3) = H.col(0);
+  g.segment<3>(6) = H.col(1);
+  return g;
 }
 
 }  // namespace
@@ -75,19 +93,17 @@ Mat32 membrane_deformation(const TriPositions& x, const TriRest& rest) {
 }
 
 double membrane_energy(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m) {
-  const Eigen::Matrix2d E = membrane_strain(x, rest);
-  return m.thickness * rest.area * (m.mu * E.squaredNorm() + 0.5 * m.lambda_ps * E.trace() * E.trace());
+  return energy_of(membrane_strain(x, rest), rest, m);
 }
 
 Vec9 membrane_gradient(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m) {
-  const Mat32 F = membrane_deformation(x, rest);
-  const Eigen::Matrix2d S = membrane_stress(x, rest, m);
-  const Mat32 H = m.thickness * rest.area * F * S * rest.Dm_inv.transpose();
-  Vec9 g;
-  g.segment<3>(0) = -H.rowwise().sum();
-  g.segment<3>(3) = H.col(0);
-  g.segment<3>(6) = H.col(1);
-  return g;
+  return gradient_of(x, membrane_stress(x, rest, m), rest, m);
+}
+
+double membrane_energy_gradient(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m, Vec9& g) {
+  const Eigen::Matrix2d E = membrane_strain(x, rest);
+  g = gradient_of(x, stress_of(E, m), rest, m);
+  return energy_of(E, rest, m);
 }
 
 namespace {

@@ -135,9 +135,11 @@ double patch_energy(const PatchPositions<N>& x, const PatchRest& rest) {
   return 0.5 * d.dot(rest.stiffness * d);
 }
 
+namespace {
+
+// Σ_k (S d)_k ℓ_k ∇θ_k: the gradient of ½ dᵀ S d given S d.
 template <int N>
-elements::Vec<3 * N> patch_gradient(const PatchPositions<N>& x, const PatchRest& rest) {
-  const Eigen::Vector3d Sd = rest.stiffness * heights<N>(x, rest);
+elements::Vec<3 * N> gradient_with(const PatchPositions<N>& x, const PatchRest& rest, const Eigen::Vector3d& Sd) {
   elements::Vec<3 * N> g = elements::Vec<3 * N>::Zero();
   for (int k = 0; k < rest.count; ++k) {
     const auto cols = hinge_columns<N>(rest, k);
@@ -145,6 +147,21 @@ elements::Vec<3 * N> patch_gradient(const PatchPositions<N>& x, const PatchRest&
     for (int c = 0; c < 4; ++c) g.template segment<3>(3 * cols[static_cast<std::size_t>(c)]) += gk.segment<3>(3 * c);
   }
   return g;
+}
+
+}  // namespace
+
+template <int N>
+elements::Vec<3 * N> patch_gradient(const PatchPositions<N>& x, const PatchRest& rest) {
+  return gradient_with<N>(x, rest, rest.stiffness * heights<N>(x, rest));
+}
+
+template <int N>
+double patch_energy_gradient(const PatchPositions<N>& x, const PatchRest& rest, elements::Vec<3 * N>& g) {
+  const Eigen::Vector3d d = heights<N>(x, rest);
+  const Eigen::Vector3d Sd = rest.stiffness * d;
+  g = gradient_with<N>(x, rest, Sd);
+  return 0.5 * d.dot(Sd);
 }
 
 namespace {
@@ -204,6 +221,7 @@ elements::Mat<3 * N> patch_hessian_gauss_newton(const PatchPositions<N>& x, cons
                                    const std::array<std::uint8_t, N - 3>&, const PlateMaterial&);                     \
   template double patch_energy<N>(const PatchPositions<N>&, const PatchRest&);                                         \
   template elements::Vec<3 * N> patch_gradient<N>(const PatchPositions<N>&, const PatchRest&);                          \
+  template double patch_energy_gradient<N>(const PatchPositions<N>&, const PatchRest&, elements::Vec<3 * N>&);          \
   template elements::Mat<3 * N> patch_hessian<N>(const PatchPositions<N>&, const PatchRest&);                         \
   template elements::Mat<3 * N> patch_hessian_gauss_newton<N>(const PatchPositions<N>&, const PatchRest&);
 SEWN_PATCH_INSTANTIATE(4)

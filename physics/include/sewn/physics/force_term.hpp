@@ -193,6 +193,15 @@ class ForceTerm {
   [[nodiscard]] virtual double dissipation(const StateView& /*s*/) const { return 0.0; }
   /// Potential energy at state s. Cost: one pass over the elements.
   [[nodiscard]] virtual double potential_energy(const StateView& s) const = 0;
+  /// add_forces(s, f) and potential_energy(s) together, the energy returned: NewtonEuler's line
+  /// search asks for both at each trial point, and a term whose elements compute them from
+  /// shared intermediates (stencil terms: one gather, the strain or bending angles once)
+  /// overrides this to make one pass instead of two. Default: the two calls.
+  virtual double add_forces_and_energy(const StateView& s, std::span<double> f) const {
+    const double e = potential_energy(s);
+    add_forces(s, f);
+    return e;
+  }
   [[nodiscard]] virtual EnergyKind energy_kind() const { return EnergyKind::internal; }
   /// A characteristic energy (springs: Σ ½ k l²) that sets the watchdog's noise floor.
   [[nodiscard]] virtual double energy_scale() const { return 0.0; }

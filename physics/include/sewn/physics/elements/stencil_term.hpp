@@ -52,6 +52,8 @@ class StencilTerm : public ForceTerm {
   /// Element forces are gradients of an energy of the gathered positions.
   [[nodiscard]] bool velocity_dependent() const override { return false; }
   [[nodiscard]] double potential_energy(const StateView& s) const override;
+  /// One gather and one element_energy_gradient per element.
+  double add_forces_and_energy(const StateView& s, std::span<double> f) const override;
   void collect_pairs(std::vector<NodePair>& out) const override;
   void bind_pattern(const BlockMatrix& pattern) override;
   void add_jacobians(const StateView& s, const JacobianRequest& req) const override;
@@ -63,6 +65,13 @@ class StencilTerm : public ForceTerm {
   [[nodiscard]] virtual double element_energy(Index e, const Positions& x) const = 0;
   [[nodiscard]] virtual Gradient element_gradient(Index e, const Positions& x) const = 0;
   [[nodiscard]] virtual Hessian element_hessian(Index e, const Positions& x) const = 0;
+  /// Energy of element e at x, its gradient written to g: the same values as element_energy
+  /// and element_gradient. Default: those two calls; a term whose energy and gradient share
+  /// work (membranes: the strain; patch bending: the dihedral angles) overrides it.
+  [[nodiscard]] virtual double element_energy_gradient(Index e, const Positions& x, Gradient& g) const {
+    g = element_gradient(e, x);
+    return element_energy(e, x);
+  }
   /// A positive-semidefinite stand-in for the Hessian, used where Newton asks for projected
   /// element Hessians (the stability rows keep the eigen-projection of the exact one).
   /// Default: element_hessian with its negative eigenvalues clamped (project_psd, one

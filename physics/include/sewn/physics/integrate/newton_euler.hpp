@@ -181,7 +181,6 @@ class NewtonEuler {
   NewtonEulerOptions opt_;
   double h_ = 0.0;
   std::size_t n3_ = 0;  // position entries; angles follow
-  bool damped_ = false;
   double eta_ = 0.0;  // this iteration's relative CG tolerance (forcing_term)
   AlignedVector<double> xn_, vn_, qhat_, q_, trial_, inertia_, free_, condensed_, length_, g_, f_, fv_, f0_, vel_, p_, rhs_, precond_, zeros_;
   CgWorkspace ws_;

@@ -48,6 +48,8 @@ struct TriRest {
 
 [[nodiscard]] double membrane_energy(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m);
 [[nodiscard]] Vec9 membrane_gradient(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m);
+/// membrane_energy, with membrane_gradient written to g, from one strain evaluation.
+[[nodiscard]] double membrane_energy_gradient(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m, Vec9& g);
 /// Exact Hessian (symmetric, possibly indefinite under compression).
 [[nodiscard]] Mat9 membrane_hessian(const TriPositions& x, const TriRest& rest, const MembraneMaterial& m);
 /// A PSD Hessian for Newton without an eigendecomposition of the 9×9: the exact Hessian with

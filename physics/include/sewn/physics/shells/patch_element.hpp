@@ -71,6 +71,9 @@ template <int N>
 [[nodiscard]] double patch_energy(const PatchPositions<N>& x, const PatchRest& rest);
 template <int N>
 [[nodiscard]] elements::Vec<3 * N> patch_gradient(const PatchPositions<N>& x, const PatchRest& rest);
+/// patch_energy, with patch_gradient written to g, from one evaluation of the dihedral angles.
+template <int N>
+[[nodiscard]] double patch_energy_gradient(const PatchPositions<N>& x, const PatchRest& rest, elements::Vec<3 * N>& g);
 /// Exact Hessian (symmetric, indefinite in general).
 template <int N>
 [[nodiscard]] elements::Mat<3 * N> patch_hessian(const PatchPositions<N>& x, const PatchRest& rest);

@@ -42,6 +42,9 @@ class PatchBending final : public elements::StencilTerm<N> {
   [[nodiscard]] Gradient element_gradient(Index e, const Positions& x) const override {
     return patch_gradient<N>(x, rest_[e]);
   }
+  [[nodiscard]] double element_energy_gradient(Index e, const Positions& x, Gradient& g) const override {
+    return patch_energy_gradient<N>(x, rest_[e], g);
+  }
   [[nodiscard]] Hessian element_hessian(Index e, const Positions& x) const override { return patch_hessian<N>(x, rest_[e]); }
   /// Gauss-Newton, PSD by construction (patch_hessian_gauss_newton).
   [[nodiscard]] Hessian element_hessian_psd(Index e, const Positions& x) const override {

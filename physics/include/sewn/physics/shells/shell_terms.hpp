@@ -34,6 +34,9 @@ class Membranes final : public elements::StencilTerm<3> {
   [[nodiscard]] Gradient element_gradient(Index e, const Positions& x) const override {
     return membrane_gradient(x, rest_[e], mat_[e]);
   }
+  [[nodiscard]] double element_energy_gradient(Index e, const Positions& x, Gradient& g) const override {
+    return membrane_energy_gradient(x, rest_[e], mat_[e], g);
+  }
   [[nodiscard]] Hessian element_hessian(Index e, const Positions& x) const override {
     return membrane_hessian(x, rest_[e], mat_[e]);
   }
