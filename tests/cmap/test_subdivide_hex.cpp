@@ -224,6 +224,8 @@ TEST_CASE("subdivide_hexahedra with edge and volume attributes: every fine cell 
     (void)m.create_attributes<1>([&](Dart) { return 100 * ++next; });
     (void)m.create_attributes<3>([&](Dart) { return 1000 * ++next; });
     const std::uint32_t edges0 = m.num_attributes<1>(), volumes0 = m.num_attributes<3>();
+    std::map<long, Dart> recorded;  // each parent edge's value and the dart its attribute records
+    for (auto a : m.attributes<1>()) recorded[m.value(a)] = m.dart_of(a);
     int halves = 0, inner = 0;
     m.subdivide_hexahedra(mid, [&](auto dim, const sewn::FineCell& c) {
       constexpr int I = decltype(dim)::value;
@@ -253,6 +255,8 @@ TEST_CASE("subdivide_hexahedra with edge and volume attributes: every fine cell 
     std::map<long, int> seen;
     for (auto a : m.attributes<1>()) ++seen[m.value(a)];
     for (const auto& [v, n] : seen) CHECK(n == (v == -1 ? inner : 1));
+    // piece 0 is the half holding the parent's recorded dart (the parent's darts are kept)
+    for (const auto& [v, d] : recorded) CHECK(m.value(m.attribute<1>(d)) == v);
     for (Dart d : m.cells<1>()) CHECK(m.attribute<1>(d));
   }
 }

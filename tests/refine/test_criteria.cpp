@@ -1,10 +1,12 @@
-// The criteria beside the diagonal strain (region, point, contact, any-of), the memory bound of
-// adapt(), and refinement of a clamped face (its new particles stay clamped).
+// The criteria beside the diagonal strain (strain energy, region, point, contact, any-of), the
+// memory bound of adapt(), and refinement of a clamped face (its new particles stay clamped).
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <random>
 #include <string>
+
+#include <Eigen/Geometry>
 
 #include "sewn/physics/integrators.hpp"
 #include "sewn/refine/coarsen.hpp"
@@ -35,6 +37,60 @@ Index live_hexahedra(const MssModel<3>& m) {
 }
 
 
+
+TEST_CASE("refine criteria: the strain energy density is the springs' energy over the volume, zero under rigid motion") {
+  // one hexahedron: its own springs are all the model's, so its energy is the system's internal
+  // potential energy, for any deformation
+  MssModel<3> m(hex_grid(1, 1, 1, {{1, 0.8, 1.2}, {0, 0, 0}}), {material}, {}, no_gravity());
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  for (Index i = 0; i < m.nodes().size(); ++i) m.nodes().set_position(i, m.rest_position(i) + 0.05 * Vector3d(unit(rng), unit(rng), unit(rng)));
+  const double expected = m.system().potential_energy(EnergyKind::internal);
+  REQUIRE(expected > 0);
+  CHECK(StrainEnergy<3>::density(m, 0) * m.elements()[0].measure == doctest::Approx(expected).epsilon(1e-12));
+  // a rigid rotation and translation of the rest shape stores nothing
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(0.7, Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  for (Index i = 0; i < m.nodes().size(); ++i) m.nodes().set_position(i, r * m.rest_position(i) + Vector3d(3, -1, 2));
+  CHECK(StrainEnergy<3>::density(m, 0) < 1e-20 * material.young);
+  CHECK_THROWS_AS(StrainEnergy<3>(0), InputError);
+  CHECK_THROWS_AS(StrainEnergy<3>(std::nan("")), InputError);
+  // a quad (2-map, energy over area x thickness) too
+  MssModel<2> q(quad_grid(1, 1, {{0.1, 0.1, 1}, {}}), {material}, {}, no_gravity());
+  for (Index i = 0; i < q.nodes().size(); ++i) q.nodes().set_position(i, q.rest_position(i) + 0.01 * Vector3d(unit(rng), unit(rng), 0));
+  CHECK(StrainEnergy<2>::density(q, 0) * q.elements()[0].measure == doctest::Approx(q.system().potential_energy(EnergyKind::internal)).epsilon(1e-12));
+}
+
+TEST_CASE("refine criteria: the strain energy refines where the energy density is high, not where it is low") {
+  MssModel<3> m = bar();
+  // the far end stretched by 4 % along the bar: element 3 alone is strained, the others keep
+  // their rest shape
+  for (Index i = 0; i < m.nodes().size(); ++i)
+    if (m.rest_position(i).x() == 4) m.nodes().set_position(i, m.rest_position(i) + Vector3d(0.04, 0, 0));
+  const double high = StrainEnergy<3>::density(m, 3);
+  REQUIRE(high > 0);
+  for (Index e = 0; e < 3; ++e) CHECK(StrainEnergy<3>::density(m, e) == 0);
+  const StrainEnergy<3> c(high / 2);
+  CHECK(c.wants_refinement(m, 3));
+  CHECK_FALSE(c.allows_coarsening(m, 3));
+  for (Index e = 0; e < 3; ++e) {
+    CHECK_FALSE(c.wants_refinement(m, e));
+    CHECK(c.allows_coarsening(m, e));
+  }
+  RefineOptions opt;
+  opt.max_level = 3;
+  std::vector<Index> chosen;
+  CHECK(adapt(m, c, opt, &chosen).elements == 1);
+  CHECK(chosen == std::vector<Index>{3});
+  check_all(m);
+  // the children are stretched as their parent was (positions interpolated multilinearly): the
+  // same density, since a spring's stiffness scales with its size; so they are refined next
+  const Index first = m.elements()[3].first_child;
+  for (Index k = first; k < first + 8; ++k) CHECK(StrainEnergy<3>::density(m, k) == doctest::Approx(high).epsilon(1e-9));
+  chosen.clear();
+  CHECK(adapt(m, c, opt, &chosen).elements == 8);
+  for (Index k : chosen) CHECK(m.elements()[k].parent == 3);
+  check_all(m);
+}
 
 TEST_CASE("refine criteria: a region at rest picks the elements whose rest centroid is in it") {
   MssModel<3> m = bar();

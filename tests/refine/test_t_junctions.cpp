@@ -166,6 +166,39 @@ TEST_CASE("T-junctions: the linearly implicit step solves the reduced system and
   CHECK(worst_off_constraint(m) <= 1e-14);
 }
 
+TEST_CASE("T-junctions: the semi-implicit inverse masses are kept between steps and remade when what they are made of changes") {
+  MssModel<3> m(hex_grid(2, 2, 1, {{0.1, 0.1, 0.1}, {}}), {material}, {}, free_body());
+  refine_3d(m);
+  // what inverse_mass_dof must return, made afresh from lumped_masses (never kept)
+  auto check_fresh = [&] {
+    System& sys = m.system();
+    const std::vector<double> lumped = sys.slaves().lumped_masses(sys.nodes());
+    const auto own = sys.nodes().inverse_mass_dof();
+    std::vector<double> expected(own.size(), 0.0);
+    for (std::size_t a = 0; a < own.size(); ++a) expected[a] = own[a] != 0 && lumped[a / 3] > 0 ? 1 / lumped[a / 3] : 0;
+    const auto got = sys.slaves().inverse_mass_dof(sys.nodes());
+    REQUIRE(got.size() == expected.size());
+    for (std::size_t a = 0; a < got.size(); ++a) CHECK(got[a] == expected[a]);
+  };
+  REQUIRE_FALSE(m.system().slaves().empty());
+  check_fresh();
+  const Index master = m.system().slaves().slaves()[0].master[0];
+  random_state(m, 5);  // the state alone changes nothing
+  check_fresh();
+  m.nodes().set_mass(master, 3 * m.nodes().mass(master));
+  check_fresh();
+  m.nodes().fix(master, axis_y);
+  check_fresh();
+  m.nodes().unfix(master);
+  check_fresh();
+  (void)refine_element(m, 1);  // new particles and a new set of slaves
+  check_fresh();
+  m.system().slaves().set_treatment(SlaveTreatment::paper_projection);
+  CHECK(m.system().slaves().inverse_mass_dof(m.nodes()).data() == m.nodes().inverse_mass_dof().data());
+  m.system().slaves().set_treatment(SlaveTreatment::reduction);
+  check_fresh();
+}
+
 TEST_CASE("T-junctions: nested T-junctions are listed coarse to fine and bad slave lists are refused") {
   MssModel<2> m(quad_grid(3, 3, {{0.1, 0.1, 1}, {}}), {material}, {}, free_body());
   refine_2d(m);

@@ -93,6 +93,7 @@ void SlaveNodes::set(std::vector<SlaveNode> slaves, std::vector<std::vector<std:
     throw InputError("SlaveNodes::set: " + std::to_string(shares.size()) + " share lists for " + std::to_string(slaves.size()) + " slaves");
   slaves_ = std::move(slaves);
   shares_ = std::move(shares);
+  ++revision_;
 }
 
 void SlaveNodes::pass_forces(std::span<double> f) const {
@@ -163,7 +164,10 @@ SlaveExpansion SlaveNodes::expansion(Index nodes) const {
 
 std::span<const double> SlaveNodes::inverse_mass_dof(const NodeTable& nodes) {
   if (treatment_ != SlaveTreatment::reduction) return nodes.inverse_mass_dof();
-  // every step of the semi-implicit integrator comes here: member buffers, no allocation
+  // every step of the semi-implicit integrator comes here: kept while what it is made of stays
+  const MassKey key{&nodes, nodes.topology_version(), nodes.parameter_version(), revision_};
+  if (key == inv_mass_key_) return inv_mass_;
+  inv_mass_key_ = key;
   lump(nodes, lumped_);
   const auto own = nodes.inverse_mass_dof();
   inv_mass_.resize(own.size());
@@ -215,6 +219,7 @@ void SlaveNodes::remap(std::span<const Index> old_to_new) {
   }
   slaves_ = std::move(kept);
   shares_ = std::move(kept_shares);
+  ++revision_;
 }
 
 void SlaveNodes::reduced_block_jacobi(const BlockMatrix& A, std::span<const double> free_dof, std::span<double> inverse) {

@@ -28,6 +28,45 @@ Eigen::Vector3d rest_centroid(const MssModel<D>& m, Index e) {
 }  // namespace
 
 template <int D>
+StrainEnergy<D>::StrainEnergy(double threshold) : threshold_(threshold) {
+  if (!(threshold > 0) || !std::isfinite(threshold))
+    throw physics::InputError("refinement criterion: the strain energy density threshold must be finite and > 0 J/m³ (got " +
+                              std::to_string(threshold) + ")");
+}
+
+template <int D>
+double StrainEnergy<D>::density(const MssModel<D>& m, Index e) {
+  const physics::Element& el = m.elements()[e];
+  const std::vector<Index> nodes = m.element_nodes(e);
+  auto stretch = [&](Index a, Index b) {
+    return (m.nodes().position(b) - m.nodes().position(a)).norm() - (m.rest_position(b) - m.rest_position(a)).norm();
+  };
+  double energy = 0;
+  const auto edges = MssModel<D>::local_edges(el.kind);
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    const double dl = stretch(nodes[edges[i][0]], nodes[edges[i][1]]);
+    energy += el.edge_k[i] * dl * dl / 2;
+  }
+  const physics::Springs& s = m.springs();
+  for (Index d : el.diagonal) {
+    if (d == physics::invalid_index) continue;
+    const double dl = (m.nodes().position(s.node_j(d)) - m.nodes().position(s.node_i(d))).norm() - s.rest_length(d);
+    energy += el.diagonal_k * dl * dl / 2;
+  }
+  return energy / el.measure;
+}
+
+template <int D>
+bool StrainEnergy<D>::wants_refinement(const MssModel<D>& m, Index e) const {
+  return density(m, e) > threshold_;
+}
+
+template <int D>
+bool StrainEnergy<D>::allows_coarsening(const MssModel<D>& m, Index e) const {
+  return density(m, e) < threshold_ / 4;
+}
+
+template <int D>
 InRegion<D>::InRegion(Predicate inside) : inside_(std::move(inside)) {
   if (!inside_) throw physics::InputError("refinement criterion: the region has no predicate");
 }
@@ -111,6 +150,8 @@ bool AnyOf<D>::allows_coarsening(const MssModel<D>& m, Index e) const {
 
 template Eigen::Vector3d element_centroid(const MssModel<2>&, Index);
 template Eigen::Vector3d element_centroid(const MssModel<3>&, Index);
+template class StrainEnergy<2>;
+template class StrainEnergy<3>;
 template class InRegion<2>;
 template class InRegion<3>;
 template class NearPoint<2>;

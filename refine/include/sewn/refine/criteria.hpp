@@ -1,7 +1,7 @@
 #pragma once
-// Refinement criteria beside the 2014 paper's diagonal strain (criterion.hpp): a user region,
-// the distance to a point (a tool tip), contact with rigid obstacles, and a combination of
-// several. Each is a Criterion<D> for adapt() and Adapter, with its own hysteresis for
+// Refinement criteria beside the 2014 paper's diagonal strain (criterion.hpp): the strain
+// energy density, a user region, the distance to a point (a tool tip), contact with rigid
+// obstacles, and a combination of several. Each is a Criterion<D> for adapt() and Adapter, with its own hysteresis for
 // coarsening.
 
 #include <functional>
@@ -18,6 +18,26 @@ namespace sewn::refine {
 /// The mean of the current positions of element e's particles. O(particles of e).
 template <int D>
 [[nodiscard]] Eigen::Vector3d element_centroid(const MssModel<D>& m, Index e);
+
+/// Refines the elements whose strain energy density is above a threshold (J/m³): the energy
+/// ½k(l − l₀)² of the element's own springs, its sides (taken corner to corner, with the
+/// stiffness the element gives each) and its diagonals, over its rest volume (area × thickness
+/// in 2D). Zero under rigid motion; unlike the diagonal strain it weighs the material's
+/// stiffness and sees the sides' stretch too. Allows coarsening below a quarter of the
+/// threshold (half the strain, as the diagonal strain's hysteresis). O(sides of the element).
+template <int D>
+class StrainEnergy : public Criterion<D> {
+ public:
+  /// Throws physics::InputError unless the threshold is finite and > 0.
+  explicit StrainEnergy(double threshold);
+  [[nodiscard]] bool wants_refinement(const MssModel<D>& m, Index e) const override;
+  [[nodiscard]] bool allows_coarsening(const MssModel<D>& m, Index e) const override;
+  /// Element e's strain energy density, J/m³.
+  [[nodiscard]] static double density(const MssModel<D>& m, Index e);
+
+ private:
+  double threshold_;
+};
 
 /// Refines the elements whose rest centroid (the mean of their particles' rest positions)
 /// satisfies a predicate: a zone of interest fixed in the material; allows coarsening outside it.

@@ -35,6 +35,13 @@ struct HexLabels {
   std::array<std::array<std::uint8_t, 24>, 8> fine_point{}, slot{}, outer_label{}, outer_step{};
   std::array<std::uint8_t, 27> darts_at{};  // darts of the 8 children starting at each fine point
   std::array<std::array<std::uint8_t, 2>, 27> one_dart_at{};  // (child, label) of one of them
+  // The fine edges that do not halve a parent edge, each with its darts in the 8 children
+  // (24 v + l): the 6 inside the parent (cell centre to a face centre, 4 children around, 8
+  // darts) and the 24 inside its faces (face centre to an edge midpoint, 2 children on this
+  // side, 4 darts: first the 2 in the parent's face, whose β3 cross it, then the 2 in the
+  // children's shared face).
+  std::array<std::array<std::uint8_t, 8>, 6> inner_edge{};
+  std::array<std::array<std::uint8_t, 4>, 24> face_edge{};
 
   static constexpr int source(int l) { return l / 3; }
   static constexpr int axis(int l) { return l % 3; }
@@ -92,6 +99,39 @@ struct HexLabels {
         }
       }
     }
+    classify_fine_edges();
+  }
+
+  // Each fine dart's edge is named by its doubled midpoint (the sum of its ends' fine lattice
+  // coordinates, 0..4 each): on a parent edge where two coordinates are 0 or 4, in a parent
+  // face where one is, inside the parent where none is.
+  constexpr void classify_fine_edges() {
+    std::array<std::uint8_t, 125> slot_of{}, count{}, in_count{};
+    for (auto& x : slot_of) x = none;
+    int inner = 0, face = 0;
+    for (int v = 0; v < 8; ++v)
+      for (int l = 0; l < 24; ++l) {
+        const int u = source(l), t = target(l);
+        int key = 0, on_boundary = 0;
+        for (int a = 0, w = 1; a < 3; ++a, w *= 5) {
+          const int c = 2 * ((v >> a) & 1) + ((u >> a) & 1) + ((t >> a) & 1);
+          key += w * c;
+          on_boundary += c == 0 || c == 4 ? 1 : 0;
+        }
+        if (on_boundary == 2) continue;  // half of a parent edge: found through the parent's fan
+        const auto k = static_cast<std::size_t>(key);
+        if (slot_of[k] == none) slot_of[k] = static_cast<std::uint8_t>(on_boundary == 0 ? inner++ : face++);
+        const auto code = static_cast<std::uint8_t>(24 * v + l);
+        if (on_boundary == 0) {
+          inner_edge[slot_of[k]][count[k]++] = code;
+        } else {
+          // the darts in the parent's face first (positions 0, 1), those inside it next (2, 3)
+          const bool in_parent_face = outer_label[static_cast<std::size_t>(v)][static_cast<std::size_t>(l)] != none;
+          auto& n = in_parent_face ? count[k] : in_count[k];
+          face_edge[slot_of[k]][(in_parent_face ? 0u : 2u) + n++] = code;
+        }
+      }
+    if (inner != 6 || face != 24) throw "HexLabels: a cube has 6 inner and 24 face edges once halved";  // fails the build
   }
 };
 
@@ -157,37 +197,64 @@ void CMap<D, A...>::subdivide_hexahedra(Mid&& middle, Fine&& fine) {
   if (std::uint64_t{cap} + std::uint64_t{168} * hexes > detail::dead_marker - 1)
     throw CapacityError("cmap: the map cannot hold more than 2^32 - 3 darts");
 
-  // 2) the new vertices' values, before anything changes: an edge midpoint once per edge (all
-  // its darts told through the edge's β2/β3 fan), a face centre once per face (its darts and
-  // those across β3), a cell centre per volume. A face centre is the middle of two opposite
-  // edge midpoints, the cell centre the middle of two opposite face centres, as the insertion
-  // path makes them.
-  std::vector<std::uint32_t> mid_of, centre_of, value_of_cell;
-  std::vector<attribute_type<0>> values;
-  if constexpr (has_attribute<0>) {
-    mid_of.assign(cap, null);
-    centre_of.assign(cap, null);
-    value_of_cell.resize(hexes);
-    auto point = [&](std::uint32_t x) -> const attribute_type<0>& { return store<0>().values.value(store<0>().of_dart[x]); };
+  // which dimensions above 0 carry attributes before the pass (their fine cells get them too)
+  std::array<bool, 4> had{};
+  for_each_dim([&](auto kk) {
+    if constexpr (kk() > 0 && has_attribute<kk()>) had[kk()] = store<kk()>().values.size() > 0;
+  });
+
+  // 2) the parent edges, numbered, each with its darts (walked once through the edge's β2/β3
+  // fan, on the parent map), in pairs (y, β2 y), every y starting where the edge's first
+  // dart does: its midpoint (edge id), and where an edge attribute goes, its halves' darts
+  std::vector<std::uint32_t> edge_of, fan_start, fan;
+  if (has_attribute<0> || had[1]) {
+    edge_of.assign(cap, null);
+    fan.reserve(cap);
     for (std::uint32_t h = 0; h < hexes; ++h) {
       const std::uint32_t* pd = hex_darts.data() + 24 * std::size_t{h};
       for (int l = 0; l < 24; ++l) {
         const std::uint32_t x = pd[l];
-        if (((T.source(l) >> T.axis(l)) & 1) != 0 || mid_of[x] != null) continue;
-        const auto id = static_cast<std::uint32_t>(values.size());
-        values.push_back(middle(point(x), point(b(x, 1))));
+        if (((T.source(l) >> T.axis(l)) & 1) != 0 || edge_of[x] != null) continue;
+        const auto id = static_cast<std::uint32_t>(fan_start.size());
+        fan_start.push_back(static_cast<std::uint32_t>(fan.size()));
+        auto take = [&](std::uint32_t y, std::uint32_t y2) {
+          edge_of[y] = edge_of[y2] = id;
+          fan.push_back(y);
+          fan.push_back(y2);
+        };
         std::uint32_t y = x;
         bool closed = false;
         for (;;) {
-          mid_of[y] = mid_of[b(y, 2)] = id;
+          take(y, b(y, 2));
           y = b(b(y, 2), 3);
           if (y == null || y == x) {
             closed = y == x;
             break;
           }
         }
-        for (y = closed ? null : b(x, 3); y != null; y = b(b(y, 2), 3)) mid_of[y] = mid_of[b(y, 2)] = id;
+        // the other way round an open fan: β3 reverses, so β2 y starts where x does
+        for (y = closed ? null : b(x, 3); y != null; y = b(b(y, 2), 3)) take(b(y, 2), y);
       }
+    }
+    fan_start.push_back(static_cast<std::uint32_t>(fan.size()));
+  }
+
+  // 3) the new vertices' values, before anything changes: an edge midpoint once per edge, a
+  // face centre once per face (its darts and those across β3), a cell centre per volume. A face
+  // centre is the middle of two opposite edge midpoints, the cell centre the middle of two
+  // opposite face centres, as the insertion path makes them. Midpoints come first, numbered as
+  // their edges.
+  std::vector<std::uint32_t> centre_of, value_of_cell;
+  std::vector<attribute_type<0>> values;
+  if constexpr (has_attribute<0>) {
+    centre_of.assign(cap, null);
+    value_of_cell.resize(hexes);
+    auto point = [&](std::uint32_t x) -> const attribute_type<0>& { return store<0>().values.value(store<0>().of_dart[x]); };
+    const auto edges = static_cast<std::uint32_t>(fan_start.size() - 1);
+    values.reserve(edges + 3 * std::size_t{hexes} + hexes);
+    for (std::uint32_t e = 0; e < edges; ++e) {
+      const std::uint32_t x = fan[fan_start[e]];
+      values.push_back(middle(point(x), point(b(x, 1))));
     }
     for (std::uint32_t h = 0; h < hexes; ++h) {
       const std::uint32_t* pd = hex_darts.data() + 24 * std::size_t{h};
@@ -195,7 +262,7 @@ void CMap<D, A...>::subdivide_hexahedra(Mid&& middle, Fine&& fine) {
         const std::uint32_t x = pd[l];
         if (centre_of[x] != null) continue;
         const auto id = static_cast<std::uint32_t>(values.size());
-        values.push_back(middle(values[mid_of[x]], values[mid_of[b(b(x, 1), 1)]]));
+        values.push_back(middle(values[edge_of[x]], values[edge_of[b(b(x, 1), 1)]]));
         for (std::uint32_t y : {x, b(x, 3)})
           for (int n = 0; n < 4 && y != null; ++n, y = b(y, 1)) centre_of[y] = id;
       }
@@ -207,13 +274,7 @@ void CMap<D, A...>::subdivide_hexahedra(Mid&& middle, Fine&& fine) {
     }
   }
 
-  // which dimensions above 0 carry attributes before the pass (their fine cells get them too)
-  std::array<bool, 4> had{};
-  for_each_dim([&](auto kk) {
-    if constexpr (kk() > 0 && has_attribute<kk()>) had[kk()] = store<kk()>().values.size() > 0;
-  });
-
-  // 3) commit: attributes, then 168 new darts per volume (21 per child), every row written once
+  // 4) commit: attributes, then 168 new darts per volume (21 per child), every row written once
   std::vector<std::uint32_t> attr;
   if constexpr (has_attribute<0>) {
     attr.reserve(values.size());
@@ -261,7 +322,7 @@ void CMap<D, A...>::subdivide_hexahedra(Mid&& middle, Fine&& fine) {
         std::array<int, 3> c2{2 * (s & 1), 2 * ((s >> 1) & 1), 2 * ((s >> 2) & 1)};
         vertex[at(c2[0], c2[1], c2[2])] = st.of_dart[x];
         c2[static_cast<std::size_t>(i)] = 1;
-        vertex[at(c2[0], c2[1], c2[2])] = attr[mid_of[x]];
+        vertex[at(c2[0], c2[1], c2[2])] = attr[edge_of[x]];
         for (int a = 0; a < 3; ++a)
           if (a != k) c2[static_cast<std::size_t>(a)] = 1;
         vertex[at(c2[0], c2[1], c2[2])] = attr[centre_of[x]];
@@ -299,44 +360,55 @@ void CMap<D, A...>::subdivide_hexahedra(Mid&& middle, Fine&& fine) {
     }
   }
 
-  // 4) the fine edges', faces' and volumes' attributes, from the caller, and the parents'
+  // 5) the fine edges', faces' and volumes' attributes, from the caller, and the parents'
   // released; edges and faces first, so that the caller making a volume's attribute can read
-  // the attributes of its fine edges and faces
+  // the attributes of its fine edges and faces.
+  // The fine edges without a walk: those inside a parent and inside its faces from the table
+  // (a face's across its β3, given by the hexahedron whose darts there come first), the halves
+  // of each parent edge from its fan (a parent dart and its fine β2, in every volume around).
+  auto fine_edges = [&](auto give) {
+    std::vector<std::uint32_t> cell;
+    for (std::uint32_t h = 0; h < hexes; ++h) {
+      const std::uint32_t* pd = hex_darts.data() + 24 * std::size_t{h};
+      auto at = [&](std::uint8_t code) { return child_dart(h, pd, code / 24, code % 24); };
+      for (const auto& e : T.inner_edge) {
+        cell.clear();
+        for (std::uint8_t code : e) cell.push_back(at(code));
+        give(cell);
+      }
+      for (const auto& e : T.face_edge) {
+        cell.clear();
+        std::uint32_t here = null, there = null;
+        for (std::uint8_t code : e) {
+          cell.push_back(at(code));
+          here = std::min(here, cell.back());
+        }
+        for (std::size_t i = 0; i < 2; ++i)  // across the parent's face: a dart there and its β2
+          if (const std::uint32_t z = b(cell[i], 3); z != null)
+            for (std::uint32_t w : {z, b(z, 2)}) {
+              cell.push_back(w);
+              there = std::min(there, w);
+            }
+        if (here < there) give(cell);  // made once, by the side whose darts come first
+      }
+    }
+    for (std::size_t e = 0; e + 1 < fan_start.size(); ++e)
+      for (std::uint32_t end = 0; end < 2; ++end) {
+        cell.clear();
+        for (std::uint32_t i = fan_start[e] + end; i < fan_start[e + 1]; i += 2) {
+          cell.push_back(fan[i]);
+          cell.push_back(b(fan[i], 2));
+        }
+        give(cell);
+      }
+  };
   auto cells_of = [&](auto kk) {
     constexpr int I = decltype(kk)::value;
     if constexpr (I < 3 && has_attribute<I>) {
       if (!had[I]) return;
       auto& st = store<I>();
-      const Mark m = marks_.reserve();
-      std::vector<std::uint32_t> cell, parents;
-      const auto n = static_cast<std::uint32_t>(beta_.size());
-      std::vector<bool> seen_edge(I == 1 ? n : 0);
-      for (std::uint32_t x = 0; x < n; ++x) {
-        if (!is_live_index(x)) continue;
-        cell.clear();
-        if constexpr (I == 1) {
-          // an edge of closed volumes is its fan: (y, β2 y) for y along β3∘β2, both ways if open
-          if (seen_edge[x]) continue;
-          std::uint32_t y = x;
-          bool closed = false;
-          for (;;) {
-            cell.push_back(y);
-            cell.push_back(b(y, 2));
-            y = b(b(y, 2), 3);
-            if (y == null || y == x) {
-              closed = y == x;
-              break;
-            }
-          }
-          for (y = closed ? null : b(x, 3); y != null; y = b(b(y, 2), 3)) {
-            cell.push_back(y);
-            cell.push_back(b(y, 2));
-          }
-          for (std::uint32_t z : cell) seen_edge[z] = true;
-        } else {
-          if (marks_.test(x, m)) continue;
-          collect_cell<I>(x, m, cell);
-        }
+      std::vector<std::uint32_t> parents;
+      auto give = [&](std::span<const std::uint32_t> cell) {
         std::uint32_t parent = null;
         for (std::uint32_t y : cell)
           if (st.of_dart[y] != null) {
@@ -349,8 +421,20 @@ void CMap<D, A...>::subdivide_hexahedra(Mid&& middle, Fine&& fine) {
           piece = std::find(cell.begin(), cell.end(), st.values.dart(parent)) != cell.end() ? 0 : 1;
         }
         give_fine_attribute<I>(fine(std::integral_constant<int, I>{}, FineCell{parent, piece, cell, {}}), cell);
+      };
+      if constexpr (I == 1) {
+        fine_edges(give);
+      } else {
+        const Mark m = marks_.reserve();
+        std::vector<std::uint32_t> cell;
+        for (std::uint32_t x = 0; x < static_cast<std::uint32_t>(beta_.size()); ++x) {
+          if (!is_live_index(x) || marks_.test(x, m)) continue;
+          cell.clear();
+          collect_cell<I>(x, m, cell);
+          give(cell);
+        }
+        free_mark(m);
       }
-      free_mark(m);
       std::sort(parents.begin(), parents.end());
       parents.erase(std::unique(parents.begin(), parents.end()), parents.end());
       for (std::uint32_t a : parents) st.values.erase(a);  // no hook: the caller made its successors

@@ -67,8 +67,15 @@ class SlaveNodes {
   /// InputError naming the slave for a weight sum ≠ 1, a master listed after its slave, or a
   /// slave listed twice. O(slaves).
   void set(std::vector<SlaveNode> slaves, std::vector<std::vector<std::pair<Index, double>>> shares = {});
-  void clear() { *this = SlaveNodes{}; }
-  void set_treatment(SlaveTreatment t) { treatment_ = t; }
+  void clear() {
+    const std::uint64_t r = revision_;
+    *this = SlaveNodes{};
+    revision_ = r + 1;
+  }
+  void set_treatment(SlaveTreatment t) {
+    treatment_ = t;
+    ++revision_;
+  }
   [[nodiscard]] SlaveTreatment treatment() const { return treatment_; }
   [[nodiscard]] bool empty() const { return slaves_.empty(); }
   [[nodiscard]] std::span<const SlaveNode> slaves() const { return slaves_; }
@@ -78,7 +85,9 @@ class SlaveNodes {
   /// coarse, then f_v = 0; paper: f_v shared out, f_v = 0. O(slaves).
   void pass_forces(std::span<double> f) const;
   /// Inverse masses per axis for the semi-implicit step: reduction: the masters' lumped masses
-  /// m_c + Σ w m_v (fine to coarse), 0 on slaves; paper: the nodes' own. O(n).
+  /// m_c + Σ w m_v (fine to coarse), 0 on slaves; paper: the nodes' own. O(n) when the slaves
+  /// or the nodes' masses, fixed axes or numbering changed since the last call, else O(1)
+  /// (kept: they change with the topology, not with the state).
   [[nodiscard]] std::span<const double> inverse_mass_dof(const NodeTable& nodes);
   /// The reduced system's lumped masses (row sums of WᵀMW): each master's own mass plus Σ w m_v
   /// of its slaves (fine to coarse, so nested slaves reach the particles that move), 0 on
@@ -116,6 +125,15 @@ class SlaveNodes {
   SlaveTreatment treatment_ = SlaveTreatment::reduction;
   void lump(const NodeTable& nodes, std::vector<double>& lumped) const;  // lumped_masses into a buffer
 
+  // What inv_mass_ was made from: the nodes (which table, its versions) and the slaves (revision_,
+  // bumped by every change of the set or the treatment).
+  struct MassKey {
+    const NodeTable* nodes = nullptr;
+    std::uint64_t topology = 0, parameters = 0, slaves = 0;
+    bool operator==(const MassKey&) const = default;
+  };
+  std::uint64_t revision_ = 0;
+  MassKey inv_mass_key_;
   std::vector<double> inv_mass_, lumped_, r_, z_, p_, q_, ap_, free_, blocks_;
   CgWorkspace ws_;  // solve_reduced's packed path
 };
