@@ -5,7 +5,6 @@
 
 #include <array>
 #include <cstdint>
-#include <deque>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,54 +33,74 @@ void label_all_cells(M& m) {
 
 // Neighbours of dart x in the orbit of its i-cell, written out by hand from the definition of
 // cells in a combinatorial map (not shared with the library): for i ≥ 1 every βj (j ≠ i, β0
-// with β1), for i = 0 the compositions β1∘βj, βj∘β0 and βk∘βj (j ≠ k ≥ 2).
+// with β1), for i = 0 the compositions β1∘βj, βj∘β0 and βk∘βj (j ≠ k ≥ 2). A fixed array, not a
+// vector: the randomized tests call this for every dart after every operation, and a heap
+// allocation each time made the allocator most of their cost (most of all under ASan).
 template <class Map>
-std::vector<Dart> orbit_neighbours(const Map& m, Dart x, int i) {
+struct OrbitNeighbours {
+  std::array<Dart, (Map::dimension + 1) * (Map::dimension + 1)> dart{};
+  int size = 0;
+  void push(Dart y) {
+    if (y) dart[static_cast<std::size_t>(size++)] = y;
+  }
+  const Dart* begin() const { return dart.data(); }
+  const Dart* end() const { return dart.data() + size; }
+};
+
+template <class Map>
+OrbitNeighbours<Map> orbit_neighbours(const Map& m, Dart x, int i) {
   constexpr int D = Map::dimension;
-  std::vector<Dart> out;
-  auto push = [&](Dart y) {
-    if (y) out.push_back(y);
-  };
+  OrbitNeighbours<Map> out;
   if (i == 0) {
     for (int j = 2; j <= D; ++j) {
       if (Dart y = m.beta(x, j)) {
-        push(m.beta(y, 1));
+        out.push(m.beta(y, 1));
         for (int k = 2; k <= D; ++k)
-          if (k != j) push(m.beta(y, k));
+          if (k != j) out.push(m.beta(y, k));
       }
-      if (Dart y = m.beta(x, 0)) push(m.beta(y, j));
+      if (Dart y = m.beta(x, 0)) out.push(m.beta(y, j));
     }
   } else {
     for (int j = 0; j <= D; ++j) {
       if (j == i || (i == 1 && j == 0)) continue;
-      push(m.beta(x, j));
+      out.push(m.beta(x, j));
     }
   }
   return out;
 }
 
-// Number of i-cells for i = 0..D by breadth-first search with a plain visited array.
+// Visits the i-cell of `start` (marking its darts in `seen`) and calls f on each of its darts.
+// `stack` is the caller's, reused from cell to cell.
+template <class Map, class F>
+void visit_orbit(const Map& m, Dart start, int i, std::vector<char>& seen, std::vector<Dart>& stack, F&& f) {
+  stack.assign(1, start);
+  seen[start.index()] = 1;
+  while (!stack.empty()) {
+    const Dart x = stack.back();
+    stack.pop_back();
+    f(x);
+    for (Dart y : orbit_neighbours(m, x, i))
+      if (!seen[y.index()]) {
+        seen[y.index()] = 1;
+        stack.push_back(y);
+      }
+  }
+}
+
+// Number of i-cells for i = 0..D by graph search with a plain visited array.
 template <class Map>
 std::array<std::uint32_t, Map::dimension + 1> recount(const Map& m) {
   constexpr int D = Map::dimension;
   std::array<std::uint32_t, D + 1> n{};
   const std::uint32_t cap = m.dart_capacity();
+  std::vector<char> seen;
+  std::vector<Dart> stack;
   for (int i = 0; i <= D; ++i) {
-    std::vector<char> seen(cap, 0);
+    seen.assign(cap, 0);
     for (std::uint32_t s = 0; s < cap; ++s) {
       if (!m.is_alive(Dart(s)) || seen[s]) continue;
       ++n[static_cast<std::size_t>(i)];
-      std::deque<Dart> queue{Dart(s)};
-      seen[s] = 1;
-      while (!queue.empty()) {
-        const Dart x = queue.front();
-        queue.pop_front();
-        for (Dart y : orbit_neighbours(m, x, i))
-          if (!seen[y.index()]) {
-            seen[y.index()] = 1;
-            queue.push_back(y);
-          }
-      }
+      visit_orbit(m, Dart(s), i, seen, stack, [](Dart) {});
     }
   }
   return n;
@@ -93,10 +112,12 @@ template <class Map>
 std::string check_iteration(const Map& m, const std::array<std::uint32_t, Map::dimension + 1>& ref) {
   constexpr int D = Map::dimension;
   std::string problem;
+  std::vector<char> seen;
+  std::vector<Dart> stack;
   auto one = [&](auto k) {
     constexpr int I = decltype(k)::value;
     if (!problem.empty()) return;
-    std::vector<char> seen(m.dart_capacity(), 0);
+    seen.assign(m.dart_capacity(), 0);
     std::uint32_t n = 0;
     for (Dart d : m.template cells<I>()) {
       ++n;
@@ -104,20 +125,11 @@ std::string check_iteration(const Map& m, const std::array<std::uint32_t, Map::d
         problem = "cells<" + std::to_string(I) + ">() yields two darts of one cell";
         return;
       }
-      std::deque<Dart> queue{d};
-      seen[d.index()] = 1;
-      while (!queue.empty()) {
-        const Dart x = queue.front();
-        queue.pop_front();
-        if (x < d) {
-          problem = "cells<" + std::to_string(I) + ">() yields a dart that is not the smallest of its cell";
-          return;
-        }
-        for (Dart y : orbit_neighbours(m, x, I))
-          if (!seen[y.index()]) {
-            seen[y.index()] = 1;
-            queue.push_back(y);
-          }
+      bool smallest = true;
+      visit_orbit(m, d, I, seen, stack, [&](Dart x) { smallest = smallest && !(x < d); });
+      if (!smallest) {
+        problem = "cells<" + std::to_string(I) + ">() yields a dart that is not the smallest of its cell";
+        return;
       }
     }
     if (n != ref[I]) problem = "cells<" + std::to_string(I) + ">() yields " + std::to_string(n) + " cells, not " + std::to_string(ref[I]);
