@@ -23,6 +23,10 @@ Field criterion_schema() {
             "The 2014 paper's: refine when a diagonal spring of the element has 100·|l − l₀|/l₀ above the threshold; "
             "coarsening allowed below half of it.",
             {field("threshold", Kind::number).unit("%").required().above(0).below(100).doc("Strain threshold (the paper: 1.2 for its beam, 2 in 2D).")});
+  c.variant("strain_energy",
+            "Refine when the element's strain energy density (½k(l − l₀)² of its own springs, sides and diagonals, over its rest volume) "
+            "is above the threshold; coarsening allowed below a quarter of it (half the strain).",
+            {field("threshold", Kind::number).unit("J/m³").required().above(0).doc("Energy density threshold (E·ε²/2 for a strain ε of a material of Young's modulus E, roughly).")});
   c.variant("region", "Refine the elements whose rest centroid is in a region (fixed in the material); coarsening allowed outside it.",
             {selector_schema("where", "The region: all, box or sphere.").required()});
   c.variant("point", "Refine the elements whose current centroid is within a radius of a point; coarsening allowed beyond twice the radius.",
@@ -102,7 +106,7 @@ RefinementSpec read_refinement(const nlohmann::json& j, const Field& schema, con
     RefineCriterionSpec c;
     c.type = cj.at("type").get<std::string>();
     Reader cr(cj, cs, c.type);
-    if (c.type == "diagonal_strain") c.threshold = cr.number("threshold");
+    if (c.type == "diagonal_strain" || c.type == "strain_energy") c.threshold = cr.number("threshold");
     if (c.type == "region") c.where = geometric_selector(cj.at("where"), *cs.member("where", "region"), file, path + ".where");
     if (c.type == "point") {
       c.point = cr.vec3("point");
@@ -175,6 +179,7 @@ RefinementRun::RefinementRun(const Scene& scene, physics::MssModel<3>& model) : 
   for (std::size_t i = 0; i < spec.criteria.size(); ++i) {
     const RefineCriterionSpec& c = spec.criteria[i];
     if (c.type == "diagonal_strain") criteria.push_back(std::make_unique<refine::DiagonalStrain<3>>(c.threshold));
+    if (c.type == "strain_energy") criteria.push_back(std::make_unique<refine::StrainEnergy<3>>(c.threshold));
     if (c.type == "region") criteria.push_back(std::make_unique<refine::InRegion<3>>(region_predicate(c.where)));
     if (c.type == "point") criteria.push_back(std::make_unique<refine::NearPoint<3>>(to_eigen(c.point), c.radius));
     if (c.type == "contact") {

@@ -73,16 +73,19 @@ TEST_CASE("scene refinement: defaults, criteria and pre-refined regions") {
   j["refinement"] = json::parse(R"({
     "criteria": [{"type": "diagonal_strain", "threshold": 1.2},
                  {"type": "region", "where": {"type": "sphere", "center": [0, 0, 0], "radius": 0.5}},
-                 {"type": "point", "point": [1, 2, 3], "radius": 0.1}],
+                 {"type": "point", "point": [1, 2, 3], "radius": 0.1},
+                 {"type": "strain_energy", "threshold": 250}],
     "pre_refine": [{"where": {"type": "all"}}]
   })");
   const Scene s = parse_scene(j, "s.json");
   const RefinementSpec& r = s.refinement;
   CHECK(r.enabled);
-  REQUIRE(r.criteria.size() == 3);
+  REQUIRE(r.criteria.size() == 4);
   CHECK(r.criteria[0].threshold == 1.2);
   CHECK(r.criteria[1].where.type == Selector::Type::sphere);
   CHECK(r.criteria[2].radius == 0.1);
+  CHECK(r.criteria[3].type == "strain_energy");
+  CHECK(r.criteria[3].threshold == 250);
   CHECK(r.max_level == 3);
   CHECK(r.pre_refine.at(0).levels == 1);
   CHECK_FALSE(r.coarsen);
@@ -100,6 +103,8 @@ TEST_CASE("scene refinement: bad values name their key") {
   };
   CHECK(with(R"({"criteria": [{"type": "diagonal_strain", "threshold": 0}]})").find("refinement.criteria[0].threshold") == 0);
   CHECK(with(R"({"criteria": [{"type": "diagonal_strain"}]})").find("refinement.criteria[0].threshold") == 0);
+  CHECK(with(R"({"criteria": [{"type": "strain_energy", "threshold": -1}]})").find("refinement.criteria[0].threshold") == 0);
+  CHECK(with(R"({"criteria": [{"type": "strain_energy"}]})").find("refinement.criteria[0].threshold") == 0);
   CHECK(with(R"({"criteria": [{"type": "curvature"}]})").find("refinement.criteria[0].type") == 0);
   CHECK(with(R"({"max_level": 9})").find("refinement.max_level") == 0);
   CHECK(with(R"({"criteria": [{"type": "region", "where": {"type": "tag", "tag": 3}}]})") ==
@@ -160,6 +165,16 @@ TEST_CASE("scene refinement: the Table 1 beam refined adaptively by the run") {
   const RunSummary b = run(bs, o);
   CHECK(b.refined >= s.refined);
   CHECK(b.refined <= 2 + 16);
+
+  // by the strain energy density: the sagging beam's (about E·ε²/2 = 5 J/m³ at 1 % strain)
+  // refines above 1 J/m³ and never above 1e9 J/m³
+  for (const double threshold : {1.0, 1e9}) {
+    json energy = j;
+    energy["refinement"]["criteria"] = json::array({{{"type", "strain_energy"}, {"threshold", threshold}}});
+    const RunSummary e = run(parse_scene(energy, "beam.json"), o);
+    CHECK((e.refined > 2) == (threshold == 1.0));
+    CHECK(e.refined >= 2);
+  }
 
   // without refinement, the same scene keeps its two elements
   json plain = beam_scene();

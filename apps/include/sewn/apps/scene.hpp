@@ -95,11 +95,11 @@ struct ModelGroup {
 };
 
 /// One refinement criterion (docs/refinement.md): `diagonal_strain` (threshold, percent),
-/// `region` (where: box, sphere or all, at rest), `point` (point, radius) or `contact` (with the
-/// scene's obstacles).
+/// `strain_energy` (threshold, J/m³), `region` (where: box, sphere or all, at rest), `point`
+/// (point, radius) or `contact` (with the scene's obstacles).
 struct RefineCriterionSpec {
   std::string type;
-  double threshold = 0;  // diagonal_strain, percent
+  double threshold = 0;  // diagonal_strain, percent; strain_energy, J/m³
   Selector where;        // region
   Vec3 point{};          // point
   double radius = 0;     // point
