@@ -16,16 +16,13 @@
 #include <vector>
 
 #include "sewn/apps/checkpoint.hpp"
+#include "scratch.hpp"
 
 namespace fs = std::filesystem;
 
 namespace checkpoint_test {
 
-fs::path scratch(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("sewn_test_checkpoint_" + std::to_string(::getpid())) / name;
-  fs::create_directories(p.parent_path());
-  return p;
-}
+fs::path scratch(const std::string& name) { return sewn::test::scratch("checkpoint/" + name); }
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);

@@ -26,6 +26,7 @@
 #include "sewn/physics/solids/tets.hpp"
 
 #include "force_check.hpp"
+#include "scratch.hpp"
 
 namespace test_mixed {
 
@@ -85,7 +86,7 @@ std::string reason_of(const std::function<void()>& f) {
 
 // The sewn binary's standard output for `args`, and its exit code.
 int sewn_stdout(const std::string& args, std::string& out) {
-  const auto log = std::filesystem::temp_directory_path() / ("sewn_mixed_" + std::to_string(::getpid()) + ".txt");
+  const auto log = sewn::test::scratch("mixed/stdout.txt");
   const int status = std::system((std::string(SEWN_BINARY) + " " + args + " > " + log.string() + " 2>&1").c_str());
   std::ifstream in(log);
   out.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
@@ -356,7 +357,7 @@ TEST_CASE("sewn run simulates what sewn check reports on a mesh with a face list
   // box_faces.mesh: 144 tetrahedra on 62 points with 116 boundary triangles and 32 edges as
   // cells of their own; `sewn check` reports 144 volumes (above). The run's frames.csv counts
   // the particles and elements it simulated, for the solid and the default mass-spring model.
-  const auto dir = std::filesystem::temp_directory_path() / ("sewn_mixed_run_" + std::to_string(::getpid()));
+  const auto dir = sewn::test::scratch("mixed/run");
   std::filesystem::create_directories(dir);
   const std::string mesh = std::string(SEWN_SOURCE_DIR) + "/tests/apps/data/box_faces.mesh";
   for (const std::string model : {R"({"type": "solid"})", R"({"type": "mass-spring"})"}) {
@@ -425,7 +426,7 @@ RunSummary run_quietly(const nlohmann::json& j, const std::string& name) {
   Scene scene = parse_scene(j, name + ".json");
   scene.write_picture = scene.write_vtu = scene.write_csv = false;
   RunOptions o;
-  o.out = std::filesystem::temp_directory_path() / ("sewn_mixed_" + name + "_" + std::to_string(::getpid()));
+  o.out = sewn::test::scratch("mixed/" + name);
   o.quiet = true;
   const RunSummary sum = run(scene, o);
   std::filesystem::remove_all(o.out);

@@ -19,6 +19,7 @@
 #include "sewn/physics/integrate/newton_euler.hpp"
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
+#include "scratch.hpp"
 
 namespace test_motion_keys {
 
@@ -51,7 +52,7 @@ std::string error_of(const json& j, bool run = false) {
     if (run) {
       sewn::app::RunOptions o;
       o.quiet = true;
-      o.out = std::filesystem::temp_directory_path() / "sewn_test_motion_keys_err";
+      o.out = sewn::test::scratch("motion_keys/err");
       (void)sewn::app::run(s, o);
     }
   } catch (const SceneError& e) {
@@ -214,7 +215,7 @@ TEST_CASE("scene motion: a run drives the end and reports finite energies") {
   j["output"]["frames"] = 2;
   sewn::app::RunOptions o;
   o.quiet = true;
-  o.out = std::filesystem::temp_directory_path() / "sewn_test_motion_keys_run";
+  o.out = sewn::test::scratch("motion_keys/run");
   const sewn::app::RunSummary sum = sewn::app::run(sewn::app::parse_scene(j, "m.json"), o);
   CHECK(sum.steps == 10);
   CHECK(std::isfinite(sum.kinetic_max));

@@ -7,6 +7,7 @@
 
 #include "sewn/apps/runner.hpp"
 #include "sewn/apps/scene.hpp"
+#include "scratch.hpp"
 
 namespace test_obstacle_keys {
 
@@ -80,7 +81,7 @@ TEST_CASE("scene obstacles: the ground stops a falling cube") {
   RunOptions opt;
   opt.quiet = true;
   opt.frames = 2;
-  opt.out = std::filesystem::temp_directory_path() / "sewn_test_obstacle_keys";
+  opt.out = sewn::test::scratch("obstacle_keys/run");
   json free_fall = cube_scene();
   const RunSummary fall = run(parse_scene(free_fall, "fall.json"), opt);
   json grounded = cube_scene();

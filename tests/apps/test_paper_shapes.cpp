@@ -22,6 +22,7 @@
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/write_gmsh.hpp"
 #include "minimal_scene.hpp"
+#include "scratch.hpp"
 
 namespace test_paper_shapes {
 
@@ -200,7 +201,7 @@ TEST_CASE("paper scenes: a few steps each, Newton converged, energy finite, the 
     const auto report = map.validate();
     CHECK_MESSAGE(report.ok(), report.str());
     sewn::app::RunOptions opt;
-    opt.out = std::filesystem::temp_directory_path() / ("sewn_paper_scene_" + std::to_string(::getpid()) + "_" + name);
+    opt.out = sewn::test::scratch("paper_shapes/" + name);
     opt.until = 3 * scene.step;
     opt.frames = 3;
     opt.quiet = true;

@@ -17,6 +17,7 @@
 #include "sewn/physics/solids/volume_term.hpp"
 #include "sewn/refine/cut.hpp"
 #include "sewn/refine/hierarchy.hpp"
+#include "scratch.hpp"
 
 namespace test_refine_keys {
 
@@ -49,7 +50,7 @@ std::string run_refused(const json& j) {
   try {
     RunOptions o;
     o.quiet = true;
-    o.out = std::filesystem::temp_directory_path() / "sewn_refine_keys_refused";
+    o.out = sewn::test::scratch("refine_keys/refused");
     (void)run(parse_scene(j, "bad.json"), o);
   } catch (const SceneError& e) {
     return e.path() + ": " + e.reason();
@@ -144,7 +145,7 @@ TEST_CASE("scene refinement: the Table 1 beam refined adaptively by the run") {
                                     "pre_refine": [{"where": {"type": "all"}}]})");
   RunOptions o;
   o.quiet = true;
-  o.out = std::filesystem::temp_directory_path() / "sewn_refine_keys_beam";
+  o.out = sewn::test::scratch("refine_keys/beam");
   const RunSummary s = run(parse_scene(j, "beam.json"), o);
   // the 2 roots pre-refined, then some of their 16 children as the beam sags: never past level 3
   CHECK(s.refined > 2);
@@ -182,7 +183,7 @@ TEST_CASE("scene refinement: the Table 1 beam refined adaptively by the run") {
 }
 
 TEST_CASE("scene surface meshes: voxelized, refined, and skipped when optional and absent") {
-  const auto dir = std::filesystem::temp_directory_path() / "sewn_refine_keys_surface";
+  const auto dir = sewn::test::scratch("refine_keys/surface");
   std::filesystem::create_directories(dir);
   {
     // a 2 m x 1 m x 1 m box, its faces as quads (outward)
@@ -328,7 +329,7 @@ TEST_CASE("scenes/refine_fig08_cut_path.json: membrane quads refined where the c
   RunOptions o;
   o.quiet = true;
   o.until = 0.4;
-  o.out = std::filesystem::temp_directory_path() / "sewn_refine_keys_fig08";
+  o.out = sewn::test::scratch("refine_keys/fig08");
   const RunSummary run_summary = run(scene, o);
   CHECK(run_summary.cuts == 1);
   CHECK(run_summary.refined > 0);

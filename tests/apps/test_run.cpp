@@ -18,6 +18,7 @@
 #include "sewn/io/errors.hpp"
 #include "sewn/io/geometry.hpp"
 #include "sewn/physics/errors.hpp"
+#include "scratch.hpp"
 
 namespace fs = std::filesystem;
 namespace test_run {
@@ -26,11 +27,7 @@ using namespace sewn::app;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("sewn_test_apps_" + std::to_string(::getpid())) / name;
-  fs::create_directories(p.parent_path());
-  return p;
-}
+fs::path scratch(const std::string& name) { return sewn::test::scratch("run/" + name); }
 
 void write(const fs::path& p, const std::string& text) {
   std::ofstream out(p);

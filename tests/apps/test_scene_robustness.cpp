@@ -12,6 +12,7 @@
 #include "minimal_scene.hpp"
 #include "sewn/apps/scene.hpp"
 #include "sewn/physics/errors.hpp"
+#include "scratch.hpp"
 
 namespace fs = std::filesystem;
 namespace test_scene_robustness {
@@ -35,12 +36,7 @@ void expect_refused(const json& j, const std::string& path, const std::string& r
   }
 }
 
-fs::path scratch_file(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::temp_directory_path() / ("sewn_test_robust_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  std::ofstream(dir / name) << text;
-  return dir / name;
-}
+fs::path scratch_file(const std::string& name, const std::string& text) { return sewn::test::scratch_file("robust/" + name, text); }
 
 void expect_file_refused(const std::string& text, const std::string& path, const std::string& reason) {
   const fs::path f = scratch_file("scene.json", text);

@@ -12,16 +12,13 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "scratch.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path tool_scratch(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("sewn_test_tool_" + std::to_string(::getpid())) / name;
-  fs::create_directories(p.parent_path());
-  return p;
-}
+fs::path tool_scratch(const std::string& name) { return sewn::test::scratch("tool/" + name); }
 
 fs::path tool_write(const std::string& name, const std::string& text) {
   const fs::path p = tool_scratch(name);
