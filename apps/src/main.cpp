@@ -79,8 +79,8 @@ The progress bar is drawn only when standard error is a terminal.
 
 constexpr const char* check_usage = R"(usage: sewn check MESH [--json]
 
-Loads MESH (Gmsh .msh 2.2 or 4.1 ASCII, MEDIT .mesh, legacy VTK .vtk) and reports what
-`sewn run` would simulate: triangles that are faces of volumes and segments that are edges of
+Loads MESH (Gmsh .msh 2.2 or 4.1, ASCII or binary, MEDIT .mesh, legacy VTK .vtk) and reports
+what `sewn run` would simulate: triangles that are faces of volumes and segments that are edges of
 higher-dimensional cells (tetgen's face list, Gmsh's boundary groups) are labels, listed by tag,
 and the rest is the simulated complex (cells per dimension, components: cells sharing a point).
 On that complex it lists every geometric problem (non-finite coordinates, inverted or degenerate

@@ -64,7 +64,7 @@ Field build_schema() {
   });
 
   Field mesh = field("mesh", Kind::object);
-  mesh.doc("One body. Procedural meshes are generated; `file` meshes are read from Gmsh .msh (2.2, 4.1 ASCII), MEDIT .mesh or legacy VTK .vtk files.")
+  mesh.doc("One body. Procedural meshes are generated; `file` meshes are read from Gmsh .msh (2.2, 4.1, ASCII or binary), MEDIT .mesh or legacy VTK .vtk files.")
       .select_by("type");
   Field region = field("region", Kind::object);
   region.doc("A material assignment for the cells whose centroid lies in `where` (later entries win).")

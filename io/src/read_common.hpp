@@ -21,7 +21,9 @@ inline std::string lower(std::string_view s) {
 }
 
 /// Reads `dim` coordinates (missing ones are 0) and rejects non-finite values, naming the node.
-inline Point3 read_point(Cursor& in, int dim, const std::string& node_name) {
+/// Source: a Cursor, or a reader of binary fields with the same real() and fail_semantic().
+template <class Source>
+Point3 read_point(Source& in, int dim, const std::string& node_name) {
   Point3 p{0.0, 0.0, 0.0};
   for (int k = 0; k < dim; ++k) {
     static constexpr const char* axis[3] = {"x", "y", "z"};

@@ -1,9 +1,13 @@
-// Gmsh MSH reader, ASCII versions 2.x and 4.1 (Gmsh reference manual, "MSH file format").
+// Gmsh MSH reader, versions 2.x and 4.1, ASCII and binary (Gmsh reference manual, "MSH file
+// format").
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <charconv>
+#include <cstring>
 #include <map>
+#include <limits>
 #include <optional>
 #include <set>
 #include <unordered_map>
@@ -66,6 +70,66 @@ const char* higher_order_name(std::int64_t t) {
 // tetrahedra and the 2D types number their vertices identically in both.
 constexpr std::array<std::uint32_t, 6> prism_to_vtk{0, 2, 1, 3, 5, 4};
 
+// The values of a section's data: tokens in an ASCII file; in a binary one fixed-width fields
+// in the writer's byte order (a C int of 4 bytes, a size_t of the header's data size, a double
+// of 8), with the section headers and $PhysicalNames still text. The reader's grammar is
+// written once against these calls: the two encodings lay out the same values in the same
+// order, except MSH 2's binary $Elements (read_elements2_binary).
+class MshData {
+ public:
+  explicit MshData(Cursor& in) : in_(in) {}
+
+  void set_binary(int size_bytes, bool swap, bool v4) {
+    binary_ = true;
+    size_bytes_ = size_bytes;
+    swap_ = swap;
+    v4_ = v4;
+  }
+  [[nodiscard]] bool binary() const { return binary_; }
+
+  /// A C int.
+  std::int64_t integer(std::string_view what) { return binary_ ? fixed<std::int32_t>(what) : in_.integer(what); }
+  /// A size_t (node and element tag ranges).
+  std::int64_t size(std::string_view what) {
+    if (!binary_) return in_.integer(what);
+    const std::uint64_t v = size_bytes_ == 4 ? fixed<std::uint32_t>(what) : fixed<std::uint64_t>(what);
+    if (v > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
+      in_.fail_semantic(std::string(what) + " " + std::to_string(v) + " does not fit in 63 bits");
+    return static_cast<std::int64_t>(v);
+  }
+  /// A node or element tag: a size_t in MSH 4.1, an int in MSH 2.
+  std::int64_t tag(std::string_view what) { return v4_ ? size(what) : integer(what); }
+  /// A count (a size_t in binary) no larger than max.
+  std::uint64_t count(std::string_view what, std::uint64_t max = std::numeric_limits<std::uint32_t>::max()) {
+    if (!binary_) return in_.count(what, max);
+    const auto v = static_cast<std::uint64_t>(size(what));
+    if (v > max) in_.fail_semantic(std::string(what) + " " + std::to_string(v) + " is larger than " + std::to_string(max));
+    return v;
+  }
+  double real(std::string_view what) { return binary_ ? fixed<double>(what) : in_.real(what); }
+  /// The end of a record's line in an ASCII file; nothing in a binary one.
+  void end_line(std::string_view after) {
+    if (!binary_) in_.end_line(after);
+  }
+  [[noreturn]] void fail_semantic(const std::string& reason) const { in_.fail_semantic(reason); }
+
+ private:
+  template <class T>
+  T fixed(std::string_view what) {
+    const std::string_view bytes = in_.raw(sizeof(T), what);
+    std::array<unsigned char, sizeof(T)> b{};
+    std::memcpy(b.data(), bytes.data(), sizeof(T));
+    if (swap_) std::reverse(b.begin(), b.end());
+    return std::bit_cast<T>(b);
+  }
+
+  Cursor& in_;
+  bool binary_ = false;
+  bool swap_ = false;
+  bool v4_ = false;
+  int size_bytes_ = 8;
+};
+
 class GmshReader {
  public:
   GmshReader(std::string_view text, const std::string& source) : in_(text, source) {}
@@ -77,6 +141,9 @@ class GmshReader {
       const std::string_view name = in_.token("a section header such as $Nodes");
       if (name.empty() || name[0] != '$') in_.fail_expected("a section header such as $Nodes", name);
       const std::size_t line = in_.line();
+      // MSH 4.1 binary: the data of these sections starts on the line after the header
+      if (data_.binary() && v4_ && (name == "$Entities" || name == "$Nodes" || name == "$Elements"))
+        in_.end_line(std::string(name));
       if (name == "$PhysicalNames") {
         read_physical_names();
         in_.expect("$EndPhysicalNames");
@@ -124,12 +191,24 @@ class GmshReader {
       in_.fail_unsupported("MSH version " + detail::printable(version) +
                            " is not supported (Sewn reads 2.2 and 4.1); re-export with -format msh41 or msh22");
     }
-    const std::int64_t file_type = in_.integer("the MSH file type (0 = ASCII)");
-    if (file_type == 1) in_.fail_unsupported("binary MSH files are not supported; save with Mesh.Binary = 0");
-    if (file_type != 0) in_.fail_expected("the MSH file type 0 (ASCII) or 1 (binary)", std::to_string(file_type));
-    (void)in_.integer("the MSH data size");
+    const std::int64_t file_type = in_.integer("the MSH file type (0 = ASCII, 1 = binary)");
+    if (file_type != 0 && file_type != 1) in_.fail_expected("the MSH file type 0 (ASCII) or 1 (binary)", std::to_string(file_type));
+    const std::int64_t data_size = in_.integer("the MSH data size");
     in_.end_line("the MSH format line");
+    if (file_type == 1) read_byte_order(data_size);
     in_.expect("$EndMeshFormat");
+  }
+
+  // A binary file's header line is followed by the int 1 in the writer's byte order.
+  void read_byte_order(std::int64_t data_size) {
+    if (data_size != 4 && data_size != 8)
+      in_.fail_unsupported("a binary MSH file with data size " + std::to_string(data_size) + " (Sewn reads size_t of 4 or 8 bytes)");
+    const std::string_view one = in_.raw(4, "the binary MSH file's integer 1 (its byte order)");
+    std::int32_t native = 0;
+    std::memcpy(&native, one.data(), 4);
+    if (native != 1 && native != 0x01000000)
+      in_.fail_semantic("the binary MSH file's byte-order check reads " + std::to_string(native) + ", not 1 in either byte order");
+    data_.set_binary(static_cast<int>(data_size), native != 1, v4_);
   }
 
   // Sections Sewn does not use ($NodeData, $Periodic, $Comments, ...) are passed over whole.
@@ -167,25 +246,25 @@ class GmshReader {
   // Physical tags per entity, so that 4.1 element blocks can be tagged.
   void read_entities() {
     std::array<std::uint64_t, 4> n{};
-    for (auto& c : n) c = in_.count("the number of entities of each dimension");
-    in_.end_line("the entity counts");
+    for (auto& c : n) c = data_.count("the number of entities of each dimension");
+    data_.end_line("the entity counts");
     have_entities_ = true;
     for (int dim = 0; dim < 4; ++dim) {
       for (std::uint64_t i = 0; i < n[static_cast<std::size_t>(dim)]; ++i) {
-        const std::int64_t tag = in_.integer("an entity tag");
+        const std::int64_t tag = data_.integer("an entity tag");
         const int reals = dim == 0 ? 3 : 6;  // a point's coordinates or a bounding box
-        for (int k = 0; k < reals; ++k) (void)in_.real("an entity coordinate");
-        const std::uint64_t nphys = in_.count("the number of physical tags of an entity");
+        for (int k = 0; k < reals; ++k) (void)data_.real("an entity coordinate");
+        const std::uint64_t nphys = data_.count("the number of physical tags of an entity");
         std::int32_t phys = 0;
         for (std::uint64_t k = 0; k < nphys; ++k) {
-          const std::int32_t p = detail::to_tag(in_, in_.integer("a physical tag"), "physical tag");
+          const std::int32_t p = detail::to_tag(in_, data_.integer("a physical tag"), "physical tag");
           if (k == 0) phys = p;
         }
         if (dim > 0) {
-          const std::uint64_t nb = in_.count("the number of bounding entities");
-          for (std::uint64_t k = 0; k < nb; ++k) (void)in_.integer("a bounding entity tag");
+          const std::uint64_t nb = data_.count("the number of bounding entities");
+          for (std::uint64_t k = 0; k < nb; ++k) (void)data_.integer("a bounding entity tag");
         }
-        in_.end_line("entity " + std::to_string(tag));
+        data_.end_line("entity " + std::to_string(tag));
         if (!entity_phys_.emplace(std::make_pair(dim, tag), phys).second)
           in_.fail_semantic("entity " + std::to_string(tag) + " of dimension " + std::to_string(dim) + " is declared twice");
       }
@@ -194,54 +273,54 @@ class GmshReader {
 
   void read_nodes2() {
     const std::uint64_t n = in_.count("the number of nodes");
-    in_.end_line("the number of nodes");
+    in_.end_line("the number of nodes");  // text in binary files too
     out_.mesh.points.reserve(detail::reservable(n, in_.remaining(), 8));
     node_index_.reserve(detail::reservable(n, in_.remaining(), 8));
     for (std::uint64_t i = 0; i < n; ++i) {
-      const std::int64_t tag = in_.integer("a node number (node " + std::to_string(i + 1) + " of " + std::to_string(n) + ")");
+      const std::int64_t tag = data_.tag("a node number (node " + std::to_string(i + 1) + " of " + std::to_string(n) + ")");
       const std::string name = "node " + std::to_string(tag);
       if (!node_index_.emplace(tag, out_.mesh.num_points()).second) in_.fail_semantic(name + " is defined twice");
-      out_.mesh.points.push_back(detail::read_point(in_, 3, name));
-      in_.end_line(name + "'s coordinates");
+      out_.mesh.points.push_back(detail::read_point(data_, 3, name));
+      data_.end_line(name + "'s coordinates");
     }
     expect_end("$EndNodes", std::to_string(n) + " nodes");
   }
 
   void read_nodes4() {
-    const std::uint64_t blocks = in_.count("the number of node blocks");
-    const std::uint64_t n = in_.count("the number of nodes");
-    const std::int64_t min_tag = in_.integer("the smallest node tag");
-    const std::int64_t max_tag = in_.integer("the largest node tag");
-    in_.end_line("the $Nodes header");
+    const std::uint64_t blocks = data_.count("the number of node blocks");
+    const std::uint64_t n = data_.count("the number of nodes");
+    const std::int64_t min_tag = data_.size("the smallest node tag");
+    const std::int64_t max_tag = data_.size("the largest node tag");
+    data_.end_line("the $Nodes header");
     out_.mesh.points.reserve(detail::reservable(n, in_.remaining(), 8));
     node_index_.reserve(detail::reservable(n, in_.remaining(), 8));
     std::vector<std::int64_t> tags;
     for (std::uint64_t b = 0; b < blocks; ++b) {
-      const std::int64_t dim = in_.integer("the entity dimension of a node block");
+      const std::int64_t dim = data_.integer("the entity dimension of a node block");
       if (dim < 0 || dim > 3) in_.fail_semantic("node block entity dimension " + std::to_string(dim) + " is not 0..3");
-      (void)in_.integer("the entity tag of a node block");
-      const std::int64_t parametric = in_.integer("the parametric flag of a node block (0 or 1)");
+      (void)data_.integer("the entity tag of a node block");
+      const std::int64_t parametric = data_.integer("the parametric flag of a node block (0 or 1)");
       if (parametric != 0 && parametric != 1) in_.fail_expected("the parametric flag 0 or 1", std::to_string(parametric));
-      const std::uint64_t m = in_.count("the number of nodes in a block");
-      in_.end_line("the node block header");
+      const std::uint64_t m = data_.count("the number of nodes in a block");
+      data_.end_line("the node block header");
       if (out_.mesh.points.size() + m > n)
         in_.fail_semantic("node blocks hold more nodes than the " + std::to_string(n) + " the $Nodes header declares");
       tags.clear();
       tags.reserve(detail::reservable(m, in_.remaining(), 2));
       for (std::uint64_t i = 0; i < m; ++i) {
-        const std::int64_t tag = in_.integer("a node tag");
+        const std::int64_t tag = data_.tag("a node tag");
         if (tag < min_tag || tag > max_tag)
           in_.fail_semantic("node tag " + std::to_string(tag) + " is outside the range " + std::to_string(min_tag) +
                             ".." + std::to_string(max_tag) + " the $Nodes header declares");
-        in_.end_line("node tag " + std::to_string(tag));
+        data_.end_line("node tag " + std::to_string(tag));
         tags.push_back(tag);
       }
       for (const std::int64_t tag : tags) {
         const std::string name = "node " + std::to_string(tag);
         if (!node_index_.emplace(tag, out_.mesh.num_points()).second) in_.fail_semantic(name + " is defined twice");
-        out_.mesh.points.push_back(detail::read_point(in_, 3, name));
-        for (std::int64_t k = 0; k < dim * parametric; ++k) (void)in_.real("a parametric coordinate of " + name);
-        in_.end_line(name + "'s coordinates");
+        out_.mesh.points.push_back(detail::read_point(data_, 3, name));
+        for (std::int64_t k = 0; k < dim * parametric; ++k) (void)data_.real("a parametric coordinate of " + name);
+        data_.end_line(name + "'s coordinates");
       }
     }
     if (out_.mesh.points.size() != n)
@@ -254,9 +333,9 @@ class GmshReader {
   void add_element(std::int64_t id, std::int64_t type, std::int32_t tag, std::int64_t entity, int dim) {
     const std::string name = "element " + std::to_string(id);
     if (type == gmsh_point) {
-      (void)node_of(in_.integer("the node of point " + name), name);
+      (void)node_of(data_.tag("the node of point " + name), name);
       ++out_.skipped_points;
-      in_.end_line(name);
+      data_.end_line(name);
       return;
     }
     const auto gt = linear_type(type);
@@ -264,12 +343,12 @@ class GmshReader {
     std::array<std::uint32_t, 8> v{};
     std::array<std::int64_t, 8> tags{};
     for (std::size_t k = 0; k < static_cast<std::size_t>(gt->nodes); ++k) {
-      tags[k] = in_.integer("node " + std::to_string(k + 1) + " of " + name);
+      tags[k] = data_.tag("node " + std::to_string(k + 1) + " of " + name);
       v[k] = node_of(tags[k], name);
       for (std::size_t l = 0; l < k; ++l)
         if (tags[l] == tags[k]) in_.fail_semantic(name + " uses node " + std::to_string(tags[k]) + " twice");
     }
-    in_.end_line(name + " (a " + std::string(to_string(gt->type)) + " has " + std::to_string(gt->nodes) + " nodes)");
+    data_.end_line(name + " (a " + std::string(to_string(gt->type)) + " has " + std::to_string(gt->nodes) + " nodes)");
     if (gt->type == CellType::prism) {
       const auto g = v;
       for (std::size_t k = 0; k < 6; ++k) v[k] = g[prism_to_vtk[k]];
@@ -298,6 +377,10 @@ class GmshReader {
     in_.end_line("the number of elements");
     out_.file_elements = n;
     reserve_cells(n, 10);
+    if (data_.binary()) {
+      read_elements2_binary(n);
+      return;
+    }
     for (std::uint64_t i = 0; i < n; ++i) {
       const std::int64_t id = in_.integer("an element number (element " + std::to_string(i + 1) + " of " + std::to_string(n) + ")");
       const std::string name = "element " + std::to_string(id);
@@ -315,24 +398,54 @@ class GmshReader {
     }
     expect_end("$EndElements", std::to_string(n) + " elements");
   }
+  // MSH 2 binary: groups of elements of one type and tag count, each group after a header of
+  // three ints (type, elements in the group, tags per element); an element is its number, its
+  // tags, its nodes, all ints.
+  void read_elements2_binary(std::uint64_t n) {
+    std::uint64_t seen = 0;
+    while (seen < n) {
+      const std::int64_t type = data_.integer("the element type of a binary element group");
+      check_type(type, "a binary element group");
+      const std::int64_t m = data_.integer("the number of elements in a binary element group");
+      const std::int64_t ntags = data_.integer("the number of tags of a binary element group");
+      if (m <= 0 || static_cast<std::uint64_t>(m) > n - seen)
+        data_.fail_semantic("a binary element group of " + std::to_string(m) + " elements after " + std::to_string(seen) +
+                            " of the " + std::to_string(n) + " the $Elements header declares");
+      if (ntags < 0 || ntags > 64) data_.fail_semantic("a binary element group with " + std::to_string(ntags) + " tags per element");
+      for (std::int64_t i = 0; i < m; ++i) {
+        const std::int64_t id = data_.integer("an element number");
+        std::int32_t phys = 0;
+        std::int64_t entity = 0;
+        for (std::int64_t k = 0; k < ntags; ++k) {
+          const std::int64_t t = data_.integer("a tag of element " + std::to_string(id));
+          if (k == 0) phys = detail::to_tag(in_, t, "the physical tag of element " + std::to_string(id));
+          if (k == 1) entity = t;
+        }
+        add_element(id, type, phys, entity, type == gmsh_point ? 0 : cell_dimension(linear_type(type)->type));
+      }
+      seen += static_cast<std::uint64_t>(m);
+    }
+    expect_end("$EndElements", std::to_string(n) + " elements");
+  }
+
 
   void read_elements4() {
-    const std::uint64_t blocks = in_.count("the number of element blocks");
-    const std::uint64_t n = in_.count("the number of elements");
-    (void)in_.integer("the smallest element tag");
-    (void)in_.integer("the largest element tag");
-    in_.end_line("the $Elements header");
+    const std::uint64_t blocks = data_.count("the number of element blocks");
+    const std::uint64_t n = data_.count("the number of elements");
+    (void)data_.size("the smallest element tag");
+    (void)data_.size("the largest element tag");
+    data_.end_line("the $Elements header");
     out_.file_elements = n;
     reserve_cells(n, 6);
     std::uint64_t seen = 0;
     for (std::uint64_t b = 0; b < blocks; ++b) {
-      const std::int64_t dim = in_.integer("the entity dimension of an element block");
+      const std::int64_t dim = data_.integer("the entity dimension of an element block");
       if (dim < 0 || dim > 3) in_.fail_semantic("element block entity dimension " + std::to_string(dim) + " is not 0..3");
-      const std::int64_t entity = in_.integer("the entity tag of an element block");
-      const std::int64_t type = in_.integer("the element type of a block");
+      const std::int64_t entity = data_.integer("the entity tag of an element block");
+      const std::int64_t type = data_.integer("the element type of a block");
       check_type(type, "an element block (entity " + std::to_string(entity) + ")");
-      const std::uint64_t m = in_.count("the number of elements in a block");
-      in_.end_line("the element block header");
+      const std::uint64_t m = data_.count("the number of elements in a block");
+      data_.end_line("the element block header");
       const int type_dim = type == gmsh_point ? 0 : cell_dimension(linear_type(type)->type);
       if (type_dim != dim)
         in_.fail_semantic("an element block of entity dimension " + std::to_string(dim) + " holds elements of dimension " +
@@ -350,7 +463,7 @@ class GmshReader {
                           " the $Elements header declares");
       seen += m;
       for (std::uint64_t i = 0; i < m; ++i) {
-        const std::int64_t id = in_.integer("an element tag");
+        const std::int64_t id = data_.tag("an element tag");
         add_element(id, type, phys, entity, type_dim);
       }
     }
@@ -401,6 +514,7 @@ class GmshReader {
   }
 
   Cursor in_;
+  MshData data_{in_};
   MeshFile out_;
   bool v4_ = false;
   bool have_nodes_ = false;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdlib>
 #include <map>
 #include <sstream>
@@ -113,6 +114,26 @@ TEST_CASE("structured meshes: counts from the .geo construction, in MSH 2.2, MSH
     CHECK(count(vtk.mesh, e.type) == e.cells);
     CHECK(canonical(vtk.mesh) == canonical(m41.mesh));
     CHECK_NOTHROW(check_mesh_geometry(vtk.mesh, geo + ".vtk"));
+  }
+}
+
+TEST_CASE("binary MSH 2.2 and 4.1 (gmsh -bin) read as the ASCII files of the same mesh") {
+  for (const std::string geo : {"box_hex", "square_tri", "square_quad", "slab_prism", "box_tet"}) {
+    for (const std::string version : {"msh22", "msh41"}) {
+      CAPTURE(geo);
+      CAPTURE(version);
+      const auto text = load(geo, version), binary = load(geo, version + "b");
+      CHECK(binary.version == text.version);
+      CHECK(binary.mesh.types == text.mesh.types);
+      CHECK(binary.mesh.conn == text.mesh.conn);
+      CHECK(binary.mesh.tags == text.mesh.tags);
+      CHECK(binary.tag_names.size() == text.tag_names.size());
+      REQUIRE(binary.mesh.num_points() == text.mesh.num_points());
+      // the ASCII file prints 16 significant digits, the binary one holds the doubles
+      for (std::size_t p = 0; p < text.mesh.points.size(); ++p)
+        for (std::size_t k = 0; k < 3; ++k)
+          CHECK(std::abs(binary.mesh.points[p][k] - text.mesh.points[p][k]) <= 1e-15 * std::max(1.0, std::abs(text.mesh.points[p][k])));
+    }
   }
 }
 

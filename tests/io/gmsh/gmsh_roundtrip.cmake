@@ -1,5 +1,5 @@
-# CTest driver: meshes each .geo with the real gmsh CLI into MSH 2.2, MSH 4.1, MEDIT and legacy
-# VTK, keeps gmsh's log, then runs the checker on the results.
+# CTest driver: meshes each .geo with the real gmsh CLI into MSH 2.2 and 4.1 (ASCII and binary),
+# MEDIT and legacy VTK, keeps gmsh's log, then runs the checker on the results.
 #   cmake -DGMSH=... -DGEO_DIR=... -DOUT=... -DCHECKER=... -P gmsh_roundtrip.cmake
 # Without gmsh it prints SEWN-SKIP (CTest marks the test skipped), unless SEWN_CI is set: CI
 # installs gmsh, so there its absence is a failure.
@@ -15,12 +15,17 @@ file(MAKE_DIRECTORY "${OUT}")
 file(GLOB geos "${GEO_DIR}/*.geo")
 foreach(geo IN LISTS geos)
   get_filename_component(name "${geo}" NAME_WE)
-  foreach(fmt msh22 msh41 mesh vtk)
+  # msh22b and msh41b: the same MSH versions written binary (gmsh -bin)
+  foreach(fmt msh22 msh41 mesh vtk msh22b msh41b)
     set(ext msh)
     if(fmt STREQUAL "mesh" OR fmt STREQUAL "vtk")
       set(ext ${fmt})
     endif()
-    execute_process(COMMAND "${GMSH}" "${geo}" -3 -format ${fmt} -o "${OUT}/${name}.${fmt}.${ext}"
+    set(args -format ${fmt})
+    if(fmt MATCHES "^(msh..)b$")
+      set(args -format ${CMAKE_MATCH_1} -bin)
+    endif()
+    execute_process(COMMAND "${GMSH}" "${geo}" -3 ${args} -o "${OUT}/${name}.${fmt}.${ext}"
                     RESULT_VARIABLE rc OUTPUT_VARIABLE log ERROR_VARIABLE log)
     file(WRITE "${OUT}/${name}.${fmt}.log" "${log}")
     if(NOT rc EQUAL 0)

@@ -1,5 +1,5 @@
 #pragma once
-// Mesh file readers: Gmsh .msh (ASCII 2.2 and 4.1), MEDIT .mesh (ASCII), legacy VTK .vtk
+// Mesh file readers: Gmsh .msh (2.2 and 4.1, ASCII and binary), MEDIT .mesh (ASCII), legacy VTK .vtk
 // unstructured grids (ASCII and BINARY). Each returns points, cells in VTK vertex order and one
 // integer tag per cell; every problem with the file throws an IoError subclass (errors.hpp)
 // whose message names the file and the line (or the binary offset / element number).
@@ -54,9 +54,9 @@ struct MeshFile {
   std::size_t file_elements = 0;       ///< elements the file declared, skipped ones included
 };
 
-/// Reads a Gmsh ASCII .msh file, version 2.x or 4.1. Throws IoError subclasses (see errors.hpp).
+/// Reads a Gmsh .msh file, version 2.x or 4.1, ASCII or binary (either byte order). Throws IoError subclasses (see errors.hpp).
 MeshFile read_gmsh(const std::filesystem::path& path);
-/// Parses Gmsh MSH text; `source` names it in error messages.
+/// Parses Gmsh MSH text or bytes; `source` names it in error messages.
 MeshFile parse_gmsh(std::string_view text, const std::string& source);
 
 /// Reads a MEDIT ASCII .mesh file (Vertices, Edges, Triangles, Quadrilaterals, Tetrahedra,
