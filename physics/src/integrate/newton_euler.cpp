@@ -233,17 +233,16 @@ double NewtonEuler::term_step_fraction(const System& sys, std::span<const double
 
 void NewtonEuler::predict(const System& sys, NewtonReport& rep) {
   const std::size_t n = dof_count();
-  // from trial_ = (q_n free, q̂ fixed) along p_ = h v_n on the free axes
-  for (std::size_t k = 0; k < n; ++k) {
-    trial_[k] = free_[k] != 0.0 ? xn_[k] : qhat_[k];
-    p_[k] = qhat_[k] - trial_[k];
-  }
-  rep.guess_fraction = term_step_fraction(sys, trial_, p_);
+  // The fraction along the whole state's path q_n → q̂, prescribed axes included, so that a
+  // rigid prescribed motion (which turns no joint) is taken whole; the fixed axes are at q̂
+  // whatever the fraction.
+  for (std::size_t k = 0; k < n; ++k) p_[k] = qhat_[k] - xn_[k];
+  rep.guess_fraction = term_step_fraction(sys, xn_, p_);
   if (rep.guess_fraction == 1.0) {
     std::copy(qhat_.begin(), qhat_.end(), q_.begin());  // q̂ to the bit
     return;
   }
-  for (std::size_t k = 0; k < n; ++k) q_[k] = trial_[k] + rep.guess_fraction * p_[k];
+  for (std::size_t k = 0; k < n; ++k) q_[k] = free_[k] != 0.0 ? xn_[k] + rep.guess_fraction * p_[k] : qhat_[k];
 }
 
 void NewtonEuler::limit_term_step(const System& sys, double& slope, NewtonReport& rep) {

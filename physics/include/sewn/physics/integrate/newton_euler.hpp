@@ -33,7 +33,8 @@
 // unchanged (positions and velocities as before the step).
 //
 // Initial guess: q̂ on the fixed axes (their prescribed motion) and q_n + α h v_n on the free
-// ones, α ≤ 1 the largest fraction the terms allow (ForceTerm::step_fraction): a knocked body's
+// ones, α ≤ 1 the largest fraction of the path q_n → q̂ (every axis) the terms allow
+// (ForceTerm::step_fraction): a knocked body's
 // h·v_n can bend a joint further in one guess than its incremental twist can follow (the toy
 // ball's spring end edge, 1.7 mm long, moved 17 mm). Φ and its minimiser do not depend on it.
 //
