@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 
 #include "sewn/physics/elements/element_math.hpp"
@@ -93,6 +94,29 @@ double PointConnections::potential_energy(const StateView& s) const {
   double E = 0;
   for (const Item& it : items_) E += guarded_energy(it, it.connection.evaluate(it.dofs.gather(s, it.owner()), update_, false));
   return E;
+}
+
+void PointConnections::set_max_trial_turn(double radians) {
+  if (!(radians > 0.0)) throw InputError("point connections: max_trial_turn must be > 0 rad (infinity: no limit), got " + std::to_string(radians));
+  max_trial_turn_ = radians;
+}
+
+double PointConnections::step_fraction(const StateView& s, const StateView& dq) const {
+  if (!std::isfinite(max_trial_turn_)) return 1.0;
+  constexpr int max_halvings = 40;  // 1e-12 of the step: a joint that cannot move at all
+  double alpha = 1.0;
+  for (const Item& it : items_) {
+    const Eigen::VectorXd q = it.dofs.gather(s, it.owner()), d = it.dofs.gather(dq, it.owner());
+    const PointEval from = it.connection.evaluate(q, update_, false);
+    // halving from the fraction the other joints left: only the smallest matters
+    for (int h = 0; h < max_halvings; ++h, alpha *= 0.5) {
+      const PointEval to = it.connection.evaluate(q + alpha * d, update_, false);
+      // the direct twist jumps by 2π where it wraps: a jump, not a turn
+      const double twist = update_ == TwistUpdate::direct ? std::remainder(to.twist - from.twist, 2 * std::numbers::pi) : to.twist - from.twist;
+      if (std::abs(twist) <= max_trial_turn_ && std::abs(to.bend_angle - from.bend_angle) <= max_trial_turn_) break;
+    }
+  }
+  return alpha;
 }
 
 void PointConnections::collect_pairs(std::vector<physics::NodePair>& out) const {

@@ -2,10 +2,13 @@
 // and Jacobian of a rod–shell joint against finite differences (the rod's θ a System angle),
 // the 2019 paper's Fig. 10 release (a rod turned 3.5π inside a held triangle; released, the
 // triangle counter-rotates by the whole 3.5π with the incremental angles; the direct one,
-// whose energy jumps where the angle wraps, fails), the singular-configuration guard, the
+// whose energy jumps where the angle wraps, fails), the singular-configuration guard, the cap
+// on a Newton trial's joint turn (a spin that flings the initial guess past the guard converges
+// to the answer of small trials; a rigid rotation is not capped and costs no force), the
 // stiff option for a rigid joint, and the errors of a rod side whose twist is not a DOF.
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -188,6 +191,86 @@ TEST_CASE("point connections term: singular configurations have infinite energy,
   CHECK(s.sys.angles().values()[s.theta] == before);
 }
 
+// The change dq (a state's layout, velocities zero) turning RodInShell's whole body rigidly by
+// `angle` about x (rod, θ and triangle) and its rod's θ by `twist` more.
+struct Change {
+  std::vector<double> x, theta;
+};
+Change rigid_turn_and_twist(const RodInShell& s, double angle, double twist) {
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(angle, Vec3::UnitX()).toRotationMatrix();
+  Change c{std::vector<double>(s.sys.nodes().x().size()), {twist}};
+  for (Index i = 0; i < s.sys.nodes().size(); ++i) {
+    const Vec3 p = s.sys.nodes().position(i);
+    const Vec3 d = R * p - p;
+    for (int a = 0; a < 3; ++a) c.x[3 * std::size_t{i} + static_cast<std::size_t>(a)] = d[a];
+  }
+  return c;
+}
+
+TEST_CASE("point connections term: a trial's joint turn is capped; a rigid rotation is not, and costs no force") {
+  RodInShell s(TwistUpdate::incremental_ii);
+  const physics::StateView at = s.sys.state();
+  auto fraction = [&](const Change& c) {
+    const std::vector<double> zero(c.x.size(), 0.0), zero_theta(1, 0.0);
+    return s.joint->step_fraction(at, {c.x, zero, at.mass, c.theta, zero_theta});
+  };
+  // The rod's frame is transported along the turn of its tangent, which a turn about x is: the
+  // joint's twist and bend do not move, so 1.5 rad in one trial is allowed.
+  CHECK(fraction(rigid_turn_and_twist(s, 1.5, 0.0)) == 1.0);
+  // 3 rad of twist: halved until 3α ≤ π/4.
+  CHECK(fraction(rigid_turn_and_twist(s, 0.0, 3.0)) == 0.25);
+  CHECK(fraction(rigid_turn_and_twist(s, 1.5, 3.0)) == 0.25);
+  s.joint->set_max_trial_turn(std::numeric_limits<double>::infinity());
+  CHECK(fraction(rigid_turn_and_twist(s, 0.0, 3.0)) == 1.0);
+  CHECK_THROWS_WITH_AS(s.joint->set_max_trial_turn(0.0), doctest::Contains("max_trial_turn"), physics::InputError);
+  // the turned body: the same energy (zero) and no force
+  const Change c = rigid_turn_and_twist(s, 1.5, 0.0);
+  auto x = s.sys.nodes().x();
+  for (std::size_t k = 0; k < x.size(); ++k) x[k] += c.x[k];
+  std::vector<double> f(x.size() + 1, 0.0);
+  s.joint->add_forces(s.sys.state(), f);
+  double largest = 0;
+  for (double v : f) largest = std::max(largest, std::abs(v));
+  CHECK(s.joint->potential_energy(s.sys.state()) < 1e-20);
+  CHECK(largest < 1e-12);
+}
+
+// One step of RodInShell (triangle free) whose rod spins at 3 rad per step, θ free: the initial
+// guess θ_n + 3 rad lies past the jump guard. Returns the state after the step (x, then θ).
+std::vector<double> spun_step(double max_turn, physics::integrate::NewtonReport& rep) {
+  RodInShell s(TwistUpdate::incremental_ii);
+  s.joint->set_max_trial_turn(max_turn);
+  const double h = 0.01;
+  s.sys.angles().rates()[s.theta] = 3.0 / h;
+  physics::integrate::NewtonEulerOptions o;
+  o.solver = physics::integrate::LinearSolver::ldlt;
+  o.velocity_tolerance = 1e-9;
+  o.max_iterations = 200;
+  physics::integrate::NewtonEuler newton(o);
+  rep = newton.step(s.sys, h);
+  std::vector<double> q(s.sys.nodes().x().begin(), s.sys.nodes().x().end());
+  q.push_back(s.sys.angles().values()[s.theta]);
+  CHECK(std::isfinite(s.sys.potential_energy()));
+  return q;
+}
+
+TEST_CASE("point connections term: a joint driven past its guard by the initial guess converges, as by small sub-steps") {
+  physics::integrate::NewtonReport capped, fine, uncapped;
+  // without the cap, the guess's energy is infinite: refused
+  CHECK_THROWS_AS((void)spun_step(std::numeric_limits<double>::infinity(), uncapped), physics::integrate::NewtonError);
+  const std::vector<double> a = spun_step(default_max_trial_turn, capped);
+  const std::vector<double> b = spun_step(0.05, fine);
+  MESSAGE("spun joint: guess fraction " << capped.guess_fraction << " in " << capped.iterations << " iterations ("
+                                        << capped.term_step_limits << " capped); at 0.05 rad per trial " << fine.guess_fraction
+                                        << " in " << fine.iterations << " (" << fine.term_step_limits << "); theta "
+                                        << a.back() << " and " << b.back());
+  CHECK(capped.guess_fraction == 0.25);
+  CHECK(fine.guess_fraction == 1.0 / 64);
+  CHECK(std::abs(a.back()) > 0.1);  // the spin carried the rod on
+  double largest = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) largest = std::max(largest, std::abs(a[k] - b[k]));
+  CHECK(largest < 1e-9);
+}
 
 // A horizontal cantilever of two rods sharing node 5 (rod A: nodes 0..5, clamped at 0, 1 and
 // θ^0; rod B: nodes 5..10), joined at node 5 with stiffness k (none: a free hinge), or one

@@ -224,6 +224,35 @@ void NewtonEuler::limit_angle_step(double& slope, double& pmax, NewtonReport& re
   ++rep.angle_step_limits;
 }
 
+double NewtonEuler::term_step_fraction(const System& sys, std::span<const double> q, std::span<const double> dq) const {
+  const StateView from = view(sys, q, zeros_), change = view(sys, dq, zeros_);
+  double alpha = 1.0;
+  for (const auto& t : sys.terms()) alpha = std::min(alpha, t->step_fraction(from, change));
+  return alpha;
+}
+
+void NewtonEuler::predict(const System& sys, NewtonReport& rep) {
+  const std::size_t n = dof_count();
+  // The fraction along the whole state's path q_n → q̂, prescribed axes included, so that a
+  // rigid prescribed motion (which turns no joint) is taken whole; the fixed axes are at q̂
+  // whatever the fraction.
+  for (std::size_t k = 0; k < n; ++k) p_[k] = qhat_[k] - xn_[k];
+  rep.guess_fraction = term_step_fraction(sys, xn_, p_);
+  if (rep.guess_fraction == 1.0) {
+    std::copy(qhat_.begin(), qhat_.end(), q_.begin());  // q̂ to the bit
+    return;
+  }
+  for (std::size_t k = 0; k < n; ++k) q_[k] = free_[k] != 0.0 ? xn_[k] + rep.guess_fraction * p_[k] : qhat_[k];
+}
+
+void NewtonEuler::limit_term_step(const System& sys, double& slope, NewtonReport& rep) {
+  const double s = term_step_fraction(sys, q_, p_);
+  if (!(s < 1.0)) return;
+  for (std::size_t k = 0; k < dof_count(); ++k) p_[k] *= s;
+  slope *= s;
+  ++rep.term_step_limits;
+}
+
 int NewtonEuler::solve_kept_pcg(const BlockMatrix& A, double tolerance) {
   const std::size_t n = dof_count();
   if (!ldlt_->kept_pcg) {
@@ -306,7 +335,7 @@ NewtonReport NewtonEuler::step(System& sys, double h) {
   prepare(sys, h);
   NewtonReport rep;
   const std::size_t n = dof_count();
-  std::copy(qhat_.begin(), qhat_.end(), q_.begin());
+  predict(sys, rep);
   double phi = evaluate(sys, q_, true);
   const double phi0 = phi;
   auto fail = [&](NewtonError::Reason why, const std::string& what) {
@@ -319,7 +348,7 @@ NewtonReport NewtonEuler::step(System& sys, double h) {
       if (!std::isfinite(a[k])) return static_cast<long long>(k);
     return -1LL;
   };
-  if (!std::isfinite(phi)) fail(NewtonError::non_finite, "the incremental potential is not finite at the predicted state");
+  if (!std::isfinite(phi)) fail(NewtonError::non_finite, "the incremental potential is not finite at the initial guess");
   if (const auto k = first_non_finite(g_); k >= 0)
     fail(NewtonError::non_finite, "the gradient is not finite at " + describe_dof(static_cast<std::size_t>(k)));
 
@@ -384,6 +413,7 @@ NewtonReport NewtonEuler::step(System& sys, double h) {
       converged = true;
       break;
     }
+    limit_term_step(sys, slope, rep);
     // Armijo backtracking; round-off in Φ is allowed for at a few ulps of its terms' size. The
     // first trial evaluates the gradient too (g_ at q_ is not needed again: slope holds what the
     // test uses): α = 1 is accepted nearly always, and its gradient is then already there.

@@ -17,6 +17,11 @@
 // max_twist_increment since the last accepted step (an incremental angle would alias) has
 // infinite energy, so a line search shortens the step instead of crossing it; forces there
 // are still the formula's (finite).
+//
+// That guard is the last line of defence. Before it, step_fraction() keeps every Newton trial
+// (and the initial guess) from changing any joint's twist or bend by more than
+// max_trial_turn() from the iterate it starts at: the incremental twist then follows the
+// motion continuously, and a knocked body's first guess cannot fling a joint past the guard.
 
 #include <array>
 #include <string>
@@ -50,6 +55,9 @@ struct RodEdgeBinding {
 
 /// Largest change of the twist δ within one step before a state counts as singular (rad).
 inline constexpr double max_twist_increment = 2.8;
+/// Default of PointConnections::max_trial_turn() (rad): as NewtonEulerOptions::max_angle_step
+/// for a rod's angles, a fraction of a radian the quadratic model follows.
+inline constexpr double default_max_trial_turn = 0.7853981633974483;
 
 /// The stiff option for a rigid joint: k_t = factor·GJ/l̄, k_b = factor·min(EI1, EI2)/l̄ of a rod
 /// section and edge — `factor` times the stiffness of the rod across one edge (1: the joint
@@ -88,6 +96,10 @@ class PointConnections final : public physics::ForceTerm {
   /// whether it was kept. Throws physics::InputError naming the connection for an id out of
   /// range (nothing changed). O(connections + renames).
   std::vector<bool> follow_nodes(Index num_nodes, const NodeDecision& decide);
+  /// The largest change of any joint's twist or bend one Newton trial may make (rad, > 0;
+  /// infinity: no limit, the jump guard alone). Throws physics::InputError otherwise.
+  void set_max_trial_turn(double radians);
+  [[nodiscard]] double max_trial_turn() const { return max_trial_turn_; }
   [[nodiscard]] const PointConnection& connection(Index c) const { return items_.at(c).connection; }
   /// Values of connection c at state s (energy, angles, flags). O(1).
   [[nodiscard]] PointEval evaluate(Index c, const physics::StateView& s) const;
@@ -98,6 +110,9 @@ class PointConnections final : public physics::ForceTerm {
   [[nodiscard]] bool velocity_dependent() const override { return false; }
   void add_forces(const physics::StateView& s, std::span<double> f) const override;
   [[nodiscard]] double potential_energy(const physics::StateView& s) const override;
+  /// The largest α ≤ 1 (halving from 1) such that no joint's twist or bend at s + α dq differs
+  /// from its value at s by more than max_trial_turn(). O(connections × halvings).
+  [[nodiscard]] double step_fraction(const physics::StateView& s, const physics::StateView& dq) const override;
   void collect_pairs(std::vector<physics::NodePair>& out) const override;
   void bind_pattern(const physics::BlockMatrix& pattern) override;
   void add_jacobians(const physics::StateView& s, const physics::JacobianRequest& req) const override;
@@ -117,6 +132,7 @@ class PointConnections final : public physics::ForceTerm {
   const physics::rods::Rods* rods_;
   TwistUpdate update_;
   std::vector<Item> items_;
+  double max_trial_turn_ = default_max_trial_turn;
   std::uint64_t bound_pattern_ = ~std::uint64_t{0};
 };
 

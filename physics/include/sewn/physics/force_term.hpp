@@ -202,6 +202,12 @@ class ForceTerm {
     add_forces(s, f);
     return e;
   }
+  /// The largest fraction α ∈ (0, 1] of the change dq (laid out as a state: its x the 3n
+  /// position changes, its angles the angle changes; velocities unused) that one Newton trial
+  /// may take from the state s. For terms whose energy holds only for bounded changes within a
+  /// trial (a connection's incremental twist aliases past π): NewtonEuler shortens each step,
+  /// and its initial guess, to the smallest fraction the terms allow. Default 1: no limit.
+  [[nodiscard]] virtual double step_fraction(const StateView& /*s*/, const StateView& /*dq*/) const { return 1.0; }
   [[nodiscard]] virtual EnergyKind energy_kind() const { return EnergyKind::internal; }
   /// A characteristic energy (springs: Σ ½ k l²) that sets the watchdog's noise floor.
   [[nodiscard]] virtual double energy_scale() const { return 0.0; }
