@@ -1,5 +1,6 @@
 #include "sewn/physics/nodes.hpp"
 
+#include <atomic>
 #include <cmath>
 #include <sstream>
 
@@ -21,6 +22,14 @@ void check_mass(double m, const char* where, Index i) {
   if (!(std::isfinite(m) && m > 0))
     throw InputError(std::string(where) + ": mass of node " + std::to_string(i) + " must be finite and > 0, got " +
                      std::to_string(m));
+}
+
+// A version no table of the process has had: a cache keyed by a table's versions cannot take a
+// table copied or assigned over it, whose own counters might have reached the same numbers,
+// for the one it was made from.
+std::uint64_t next_version() {
+  static std::atomic<std::uint64_t> versions{0};
+  return ++versions;
 }
 
 }  // namespace
@@ -55,7 +64,7 @@ Index NodeTable::add(const Vec3& x, const Vec3& v, double mass) {
   fixed_.push_back(no_axes);
   alive_.push_back(1);
   ++alive_count_;
-  ++topology_version_;
+  topology_version_ = next_version();
   return i;
 }
 
@@ -91,8 +100,8 @@ void NodeTable::remove(Index i) {
     f_[3 * i + a] = 0.0;
   }
   refresh_inverse_mass(i);
-  ++topology_version_;
-  ++parameter_version_;
+  topology_version_ = next_version();
+  parameter_version_ = next_version();
 }
 
 Eigen::Vector3d NodeTable::position(Index i) const {
@@ -133,7 +142,7 @@ void NodeTable::set_mass(Index i, double m) {
   check_mass(m, "NodeTable::set_mass", i);
   mass_[i] = m;
   refresh_inverse_mass(i);
-  ++parameter_version_;
+  parameter_version_ = next_version();
 }
 
 void NodeTable::fix(Index i, AxisMask axes) {
@@ -144,7 +153,7 @@ void NodeTable::fix(Index i, AxisMask axes) {
   for (int a = 0; a < 3; ++a)
     if ((axes >> a) & 1u) v_[3 * i + a] = 0.0;
   refresh_inverse_mass(i);
-  ++parameter_version_;
+  parameter_version_ = next_version();
 }
 
 void NodeTable::unfix(Index i, AxisMask axes) {
@@ -154,7 +163,7 @@ void NodeTable::unfix(Index i, AxisMask axes) {
   fixed_[i] = static_cast<AxisMask>(fixed_[i] & ~axes);
   if (was && fixed_[i] == no_axes) --fixed_count_;
   refresh_inverse_mass(i);
-  ++parameter_version_;
+  parameter_version_ = next_version();
 }
 
 std::vector<Index> NodeTable::compact() {
@@ -183,8 +192,8 @@ std::vector<Index> NodeTable::compact() {
   mass_.resize(n);
   fixed_.resize(n);
   alive_.resize(n);
-  ++topology_version_;
-  ++parameter_version_;
+  topology_version_ = next_version();
+  parameter_version_ = next_version();
   return old_to_new;
 }
 

@@ -222,7 +222,11 @@ void Springs::add_jacobians(const StateView& st, const JacobianRequest& req) con
       (req.matrix->pattern_version() != bound_pattern_ || bound_topology_ != topology_version()))
     throw InputError("springs: add_jacobians on a pattern that is not bound to the current springs; call System::refresh()");
   const bool symmetric = jacobian_symmetric(req.options);
-  if (const int parts = detail::parts_for(size(), jacobian_grain); parts > 1) {
+  // A large model takes the two phases even on one thread: the chunked scatter adds each
+  // spring's four blocks where they lie, sweeping a matrix far larger than the cache once per
+  // spring direction (springs come numbered by kind), where the per-node gather writes each row
+  // of blocks once (docs/solvers.md, Threads).
+  if (const int parts = detail::parts_for(size(), jacobian_grain); parts > 1 || size() >= jacobian_gather_min) {
     if (symmetric)
       add_jacobians_threads<true>(st, req, parts);
     else

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "sewn/physics/constraints/slave_nodes.hpp"
 #include "sewn/physics/physics.hpp"
 
 namespace test_nodes {
@@ -41,6 +42,33 @@ TEST_CASE("node table: add, duplicate, masses, fixed axes and the 3n views") {
   CHECK(nodes.fixed(a) == no_axes);
   CHECK(nodes.inverse_mass_dof()[1] == 0.5);
   CHECK(nodes.num_fixed_nodes() == 1);
+}
+
+TEST_CASE("node versions are unique across tables: a kept lumped mass does not survive a table assigned in its place") {
+  // Two tables changed the same way, with different masses: counters of their own would give
+  // them equal versions, and the slaves' kept inverse masses (keyed by the table's address and
+  // versions) would outlive `a = b`.
+  NodeTable a, b;
+  for (Index i = 0; i < 3; ++i) {
+    a.add({static_cast<double>(i), 0, 0}, {0, 0, 0}, 1.0);
+    b.add({static_cast<double>(i), 0, 0}, {0, 0, 0}, 2.0);
+  }
+  CHECK((a.topology_version() != b.topology_version() || a.parameter_version() != b.parameter_version()));
+  SlaveNode mid;  // node 1 halfway between nodes 0 and 2
+  mid.node = 1;
+  mid.master = {0, 2, invalid_index, invalid_index};
+  mid.weight = {0.5, 0.5, 0, 0};
+  mid.masters = 2;
+  SlaveNodes slaves;
+  slaves.set({mid});
+  const double before = slaves.inverse_mass_dof(a)[0];
+  CHECK(before == 1 / 1.5);  // a master's own mass and half the slave's
+  a = b;
+  const double after = slaves.inverse_mass_dof(a)[0];
+  CHECK(after == 1 / 3.0);
+  const NodeTable copy = a;  // a copy shares its versions with its content
+  CHECK(copy.topology_version() == a.topology_version());
+  CHECK(slaves.inverse_mass_dof(copy)[0] == 1 / 3.0);
 }
 
 TEST_CASE("node table refuses bad input, naming the node") {

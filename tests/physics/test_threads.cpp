@@ -78,6 +78,87 @@ void cut_plane(MssModel<3>& m) {
   }
 }
 
+// The block's springs and two more on pairs already joined (ends swapped), in a shuffled order
+// in a System of their own: no thread's range of springs keeps to a region of nodes, so most
+// of the threaded Jacobian's additions go through its stash.
+std::unique_ptr<System> shuffled_springs(unsigned seed) {
+  auto m = jiggled_block(seed);
+  auto sys = std::make_unique<System>();
+  const NodeTable& from = m->nodes();
+  for (Index i = 0; i < from.size(); ++i) {
+    const Index k = sys->nodes().add(from.position(i), from.velocity(i), from.mass(i));
+    if (from.fixed(i) != no_axes) sys->nodes().fix(k, from.fixed(i));
+  }
+  const Springs& block = m->springs();
+  std::vector<Index> order;
+  for (Index s = 0; s < block.size(); ++s)
+    if (block.is_alive(s)) order.push_back(s);
+  order.push_back(order[order.size() / 2]);  // two pairs joined twice
+  order.push_back(order[order.size() / 3]);
+  std::shuffle(order.begin(), order.end(), std::mt19937(seed));
+  auto& springs = sys->add<Springs>(SpringDamping::viscous);
+  std::vector<bool> seen(block.size(), false);
+  for (const Index s : order) {
+    const bool again = seen[s];
+    seen[s] = true;
+    const Index i = again ? block.node_j(s) : block.node_i(s), j = again ? block.node_i(s) : block.node_j(s);
+    springs.add(i, j, block.stiffness(s), block.rest_length(s), SpringKind::edge, block.viscosity(s));
+  }
+  return sys;
+}
+
+// The springs' Jacobian of `sys` at its state, as the solvers ask for it (or exact: the
+// non-symmetric general path), at the current thread count: the assembled matrix values (none
+// when `matrix` is false: a product-only request), ∂F/∂x·v, and A·v.
+struct Assembled {
+  std::vector<double> values, product, matvec;
+};
+Assembled assemble(System& sys, bool exact, bool matrix) {
+  const std::size_t dofs = 3 * std::size_t{sys.nodes().size()};
+  Assembled out;
+  out.product.assign(dofs, 0.0);
+  JacobianRequest req;
+  req.cx = -1e-6;
+  req.cv = -1e-3;
+  req.product_in = sys.nodes().v();
+  req.product_out = out.product;
+  if (exact) req.options = JacobianOptions{false, false};
+  BlockMatrix* A = matrix ? &sys.matrix() : nullptr;
+  if (A != nullptr) {
+    A->set_zero();
+    req.matrix = A;
+  }
+  sys.add_jacobians(req);
+  if (A == nullptr) return out;
+  out.matvec.assign(dofs, 0.0);
+  A->multiply(sys.nodes().v(), out.matvec);
+  for (Index b = 0; b < A->num_blocks(); ++b) out.values.insert(out.values.end(), A->block_data(b), A->block_data(b) + 9);
+  return out;
+}
+
+// Every request of assemble() at 2 and 3 threads against 1 thread's, bitwise.
+void check_jacobians_bitwise(System& sys) {
+  for (const bool exact : {false, true})
+    for (const bool matrix : {true, false}) {
+      CAPTURE(exact);
+      CAPTURE(matrix);
+      Assembled one;
+      {
+        Threads scope(1);
+        one = assemble(sys, exact, matrix);
+      }
+      CHECK(std::any_of(one.product.begin(), one.product.end(), [](double a) { return a != 0.0; }));
+      for (const int threads : {2, 3}) {
+        CAPTURE(threads);
+        Threads scope(threads);
+        const Assembled many = assemble(sys, exact, matrix);
+        CHECK(many.values == one.values);
+        CHECK(many.product == one.product);
+        CHECK(many.matvec == one.matvec);
+      }
+    }
+}
+
 struct Run {
   std::vector<double> x;
   double displacement = 0;  // largest particle displacement from the start
@@ -162,43 +243,43 @@ TEST_CASE("threads: the block-sparse product and the springs' Jacobian are bitwi
   using threads_test::Threads;
   auto m = threads_test::jiggled_block(7);
   System& sys = m->system();
-  const Index n = m->nodes().size();
   REQUIRE(m->springs().num_alive() >= 2 * 4096);  // the springs split at 2 threads
-  REQUIRE(n >= 2 * 1024);
-  // Per thread count: the assembled matrix values, ∂F/∂x·v and A·v, for the solvers' symmetric
-  // Jacobian (the default options) and the exact, non-symmetric one (the general path).
-  std::vector<std::vector<double>> values, products, matvec;
-  for (const bool exact : {false, true})
-  for (int threads : {1, 2, 3}) {
-    Threads scope(threads);
-    BlockMatrix& A = sys.matrix();
-    A.set_zero();
-    std::vector<double> kv(3 * std::size_t{n}, 0.0), av(3 * std::size_t{n}, 0.0);
-    JacobianRequest req;
-    req.matrix = &A;
-    req.cx = -1e-6;
-    req.cv = -1e-3;
-    req.product_in = m->nodes().v();
-    req.product_out = kv;
-    if (exact) req.options = JacobianOptions{false, false};
-    sys.add_jacobians(req);
-    A.multiply(m->nodes().v(), av);
-    std::vector<double> vals;
-    for (Index b = 0; b < A.num_blocks(); ++b) vals.insert(vals.end(), A.block_data(b), A.block_data(b) + 9);
-    values.push_back(vals);
-    products.push_back(kv);
-    matvec.push_back(av);
+  REQUIRE(m->nodes().size() >= 2 * 1024);
+  threads_test::check_jacobians_bitwise(sys);
+  // the exact Jacobian took the other path
+  Threads scope(1);
+  const auto symmetric = threads_test::assemble(sys, false, true), exact = threads_test::assemble(sys, true, true);
+  CHECK(exact.values != symmetric.values);
+  CHECK(std::any_of(symmetric.values.begin(), symmetric.values.end(), [](double a) { return a != 0.0; }));
+}
+
+TEST_CASE("threads: the springs' Jacobian stays bitwise equal with springs in any order, on a repeated pair, on either one-thread path, and after a cut") {
+  SUBCASE("shuffled springs, two pairs joined twice") {
+    auto sys = threads_test::shuffled_springs(11);
+    threads_test::check_jacobians_bitwise(*sys);
   }
-  for (std::size_t t = 1; t < values.size(); ++t) {
-    const std::size_t first = t < 3 ? 0 : 3;  // the same options at 1 thread
-    if (t == first) continue;
-    CAPTURE(t);
-    CHECK(values[t] == values[first]);
-    CHECK(products[t] == products[first]);
-    CHECK(matvec[t] == matvec[first]);
+  SUBCASE("a model small enough for the chunked one-thread path, split in two phases at 2 threads") {
+    MssModel<3> m(hex_grid(11, 11, 10, {{0.005, 0.005, 0.005}, {}}), std::vector<MaterialParams>{{1e6, 0.3, 1000}},
+                  std::vector<std::uint32_t>{});
+    REQUIRE(m.springs().num_alive() >= 2 * 4096);   // split at 2 threads
+    REQUIRE(m.springs().num_alive() < 16384);      // below the two phases' size at one thread
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> jitter(-2e-4, 2e-4);
+    auto x = m.nodes().x();
+    auto v = m.nodes().v();
+    for (std::size_t k = 0; k < x.size(); ++k) {
+      x[k] += jitter(rng);
+      v[k] = 100 * jitter(rng);
+    }
+    threads_test::check_jacobians_bitwise(m.system());
   }
-  CHECK(values[3] != values[0]);  // the exact Jacobian took the other path
-  CHECK(std::any_of(values[0].begin(), values[0].end(), [](double a) { return a != 0.0; }));
+  SUBCASE("the block cut, its springs re-attached to the copies") {
+    auto m = threads_test::jiggled_block(13);
+    threads_test::Threads scope(2);
+    (void)threads_test::assemble(m->system(), false, true);  // a plan for the uncut springs
+    threads_test::cut_plane(*m);
+    threads_test::check_jacobians_bitwise(m->system());
+  }
 }
 
 TEST_CASE("threads: spring forces at 2 threads equal 1 thread's to round-off, and repeat bitwise") {

@@ -126,9 +126,14 @@ class NodeTable {
   /// checking their update). O(1).
   void mark_state_finite() { state_finite_ = true; }
 
-  /// Incremented whenever nodes are added, removed or renumbered (matrix size and pattern).
+  /// Changes whenever nodes are added, removed or renumbered (matrix size and pattern).
+  /// Versions increase and are drawn from one counter for the whole process: no two tables
+  /// reach the same version by changes of their own, so a cache keyed by a table's versions is
+  /// not fooled by another table assigned in its place (a copy shares its versions with its
+  /// content). 0 for a new, empty table.
   [[nodiscard]] std::uint64_t topology_version() const { return topology_version_; }
-  /// Incremented whenever a mass or a fixed flag changes (stable step, preconditioner).
+  /// Changes whenever a mass or a fixed flag changes (stable step, preconditioner); drawn from
+  /// the same counter as topology_version().
   [[nodiscard]] std::uint64_t parameter_version() const { return parameter_version_; }
 
  private:
