@@ -602,6 +602,42 @@ void SpringRuns::forces(const SpringArrays& a, RunDamping damping, double beta, 
   }
 }
 
+bool SpringRuns::potential_energy(const SpringArrays& a, std::span<const double> x, Index n, double& energy) const {
+#ifdef SEWN_RUNS_AVX512
+  ensure_arrays(n, num_arrays);
+  const Soa s = soa_view(soa_.data(), stride_);
+  split_axes(x.data(), s.a[X], s.a[Y], s.a[Z], n);
+  const double* __restrict px = s.a[X];
+  const double* __restrict py = s.a[Y];
+  const double* __restrict pz = s.a[Z];
+  // One partial sum per lane; lanes outside a chunk's mask (padding, removed springs) add nothing.
+  __m512d sum = _mm512_setzero_pd();
+  const __m512d half = _mm512_set1_pd(0.5);
+  for (std::size_t c = 0; c < chunks_.size(); ++c) {
+    const std::size_t i = chunks_[c].i0, j = chunks_[c].j0;
+    const auto diff = [&](const double* p) { return _mm512_sub_pd(_mm512_loadu_pd(p + j), _mm512_loadu_pd(p + i)); };
+    const __m512d dx = diff(px), dy = diff(py), dz = diff(pz);
+    const __m512d d = _mm512_sqrt_pd(_mm512_fmadd_pd(dz, dz, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dx, dx))));
+    const __m512d t = _mm512_sub_pd(d, _mm512_load_pd(l_.data() + 8 * c));
+    const __m512d e = _mm512_mul_pd(_mm512_mul_pd(half, _mm512_load_pd(k_.data() + 8 * c)), _mm512_mul_pd(t, t));
+    sum = _mm512_mask_add_pd(sum, mask_[c], sum, e);
+  }
+  double total = _mm512_reduce_add_pd(sum);
+  for (const Index r : rest_) {
+    if (a.alive[r] == 0) continue;
+    const std::size_t i = 3 * std::size_t{a.ni[r]}, j = 3 * std::size_t{a.nj[r]};
+    const double dx = x[j] - x[i], dy = x[j + 1] - x[i + 1], dz = x[j + 2] - x[i + 2];
+    const double t = std::sqrt(dx * dx + dy * dy + dz * dz) - a.l[r];
+    total += 0.5 * a.k[r] * t * t;
+  }
+  energy = total;
+  return true;
+#else
+  (void)a, (void)x, (void)n, (void)energy;
+  return false;
+#endif
+}
+
 bool SpringRuns::stability_rows(RunDamping damping, double beta, std::span<const double> x, Index n, StabilityRows& rows) const {
 #ifdef SEWN_RUNS_AVX512
   if (rows.folds()) return false;

@@ -31,10 +31,35 @@ int parse_thread_count(const char* text, const char* what) {
   return static_cast<int>(v);
 }
 
+namespace {
+// SEWN_THREADS as first read: its count, or the error to throw at every call. Read once because
+// getenv scans the whole environment, and kernels ask for the count several times a step: on a
+// one-hexahedron model that was a large share of a sub-microsecond step.
+struct EnvCount {
+  int count = 1;
+  std::string error;
+};
+const EnvCount& env_count() {
+  static const EnvCount once = [] {
+    EnvCount e;
+    const char* env = std::getenv("SEWN_THREADS");  // NOLINT(concurrency-mt-unsafe): read once, read-only
+    if (env == nullptr) return e;
+    try {
+      e.count = parse_thread_count(env, "SEWN_THREADS");
+    } catch (const InputError& x) {
+      e.error = x.what();
+    }
+    return e;
+  }();
+  return once;
+}
+}  // namespace
+
 int thread_count() {
   if (chosen > 0) return chosen;
-  const char* env = std::getenv("SEWN_THREADS");  // NOLINT(concurrency-mt-unsafe): read-only use
-  return env == nullptr ? 1 : parse_thread_count(env, "SEWN_THREADS");
+  const EnvCount& e = env_count();
+  if (!e.error.empty()) throw InputError(e.error);
+  return e.count;
 }
 
 void set_thread_count(int threads) {

@@ -311,6 +311,7 @@ std::vector<Index> orphan_holders(const MssModel<D>& m, std::span<const Facet> f
 // one is no quad or hexahedron (nothing else refines).
 template <int D>
 std::vector<Index> to_refine(const MssModel<D>& m, std::span<const Facet> facets) {
+  if (!m.ever_refined()) return {};  // no T-junction, no level jump: the common cut ends here
   std::vector<Index> out = orphan_holders(m, facets);
   for (const Facet& f : facets)
     if (Index c = invalid_index; level_jump(m, f, c)) out.push_back(c);

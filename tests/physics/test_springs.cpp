@@ -40,6 +40,18 @@ Eigen::VectorXd reference_forces(const System& sys, const Springs& sp) {
   return f;
 }
 
+// Σ ½ k (|xj − xi| − l)² over the live springs, one by one.
+double reference_energy(const System& sys, const Springs& sp) {
+  const NodeTable& nd = sys.nodes();
+  double e = 0;
+  for (Index s = 0; s < sp.size(); ++s) {
+    if (!sp.is_alive(s)) continue;
+    const double t = (nd.position(sp.node_j(s)) - nd.position(sp.node_i(s))).norm() - sp.rest_length(s);
+    e += 0.5 * sp.stiffness(s) * t * t;
+  }
+  return e;
+}
+
 // n nodes at random in the unit cube with random velocities, and m springs between random
 // distinct nodes with rest lengths 0.5..1.5 × current (so both stretched and compressed).
 Springs& random_scene(System& sys, std::mt19937& rng, int n, int m, SpringDamping damping) {
@@ -148,9 +160,15 @@ TEST_CASE("springs in runs take the chunked loop, which matches the reference th
     System sys;
     std::mt19937 rng(11);
     Springs& sp = lattice_scene(sys, rng, 11, 7, 5, model);  // 385 nodes: not a multiple of 8
+    // the energy takes the chunks too: its sum only regroups the reference's
+    const auto energy_matches = [&] {
+      const double r = reference_energy(sys, sp);
+      return r > 0 && std::abs(sp.potential_energy(sys.state()) - r) <= 1e-13 * r;
+    };
     Eigen::VectorXd f = forces(sys);
     CHECK(sp.num_in_runs() >= sp.num_alive() / 2);
     CHECK(max_abs(f - reference_forces(sys, sp)) <= 1e-13 * max_abs(f));
+    CHECK(energy_matches());
     // set_forces (the system's first term) must agree with add_forces.
     sys.compute_forces();
     const auto fs = sys.nodes().f();
@@ -175,6 +193,7 @@ TEST_CASE("springs in runs take the chunked loop, which matches the reference th
       sp.set_endpoints(s, sp.node_i(s), sp.node_j(s));
       f = forces(sys);
       REQUIRE(max_abs(f - reference_forces(sys, sp)) <= 1e-13 * max_abs(f));
+      REQUIRE(energy_matches());
       came_back = sp.num_in_runs() > before;
     }
     CHECK(came_back);
@@ -201,6 +220,7 @@ TEST_CASE("springs in runs take the chunked loop, which matches the reference th
       }
       f = forces(sys);
       REQUIRE(max_abs(f - reference_forces(sys, sp)) <= 1e-13 * max_abs(f));
+      REQUIRE(energy_matches());
     }
     sp.set_paper_viscosity(sys.nodes().masses());
     f = forces(sys);
@@ -209,6 +229,7 @@ TEST_CASE("springs in runs take the chunked loop, which matches the reference th
     f = forces(sys);
     CHECK(sp.num_in_runs() > 0);
     CHECK(max_abs(f - reference_forces(sys, sp)) <= 1e-13 * max_abs(f));
+    CHECK(energy_matches());
   }
 }
 

@@ -18,7 +18,10 @@ struct ModelAccess {
 
   static Map& map(Model& m) { return m.map_; }
   static std::vector<physics::Element>& elements(Model& m) { return m.elements_; }
-  static void set_refining(Model& m, bool on) { m.refining_ = on; }
+  static void set_refining(Model& m, bool on) {
+    m.refining_ = on;
+    if (on) m.ever_refined_ = true;
+  }
   static std::uint8_t dart_vertex(const Model& m, Dart d) { return m.dart_vertex_[d.index()]; }
 
   /// Sizes the per-dart codes to the map's dart capacity (insertions add darts).

@@ -189,6 +189,10 @@ class MssModel {
   /// True if dart d starts at a corner of its element (a hierarchical dart: the first dart of
   /// one of the element's sides); false if it starts at a T-junction. O(1).
   [[nodiscard]] bool is_corner_dart(Dart d) const { return dart_vertex_[d.index()] != not_a_corner; }
+  /// False until sewn::refine first splits an element. Until then every dart starts at a corner
+  /// and every element and edge is at level 1: the model has no T-junction and no level jump,
+  /// which lets a cut skip looking for them. Coarsening does not reset it. O(1).
+  [[nodiscard]] bool ever_refined() const { return ever_refined_; }
   /// The local vertex of its element that dart d starts at (not_a_corner for a T-junction). O(1).
   [[nodiscard]] int corner_of_dart(Dart d) const { return dart_vertex_[d.index()]; }
   /// The local side (local edge, see local_edges()) of its element that dart d lies on. O(1).
@@ -263,6 +267,7 @@ class MssModel {
   std::vector<std::uint32_t> seen_edge_, seen_element_, seen_node_, seen_spring_;
   std::string unsupported_;  // an edit the model cannot follow (element merge), reported by resync
   bool refining_ = false;    // element splits and merges are refinement and coarsening, which set up the elements
+  bool ever_refined_ = false;  // see ever_refined()
   std::vector<std::function<void()>> edit_listeners_;  // see after_edits()
   void notify_edited() {
     for (const auto& f : edit_listeners_) f();

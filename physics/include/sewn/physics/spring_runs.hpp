@@ -76,6 +76,10 @@ class SpringRuns {
   /// f (3n). β is the Rayleigh factor (stiffness_proportional only). O(n + m).
   void forces(const SpringArrays& a, RunDamping damping, double beta, std::span<const double> x,
               std::span<const double> v, std::span<double> f, bool accumulate, Index n) const;
+  /// Sets `energy` to Σ ½ k (|xj − xi| − l)² over the live springs at x (3n), eight chunked
+  /// springs at a time, the rest list one by one. Returns false, setting nothing, where there is
+  /// no vector kernel (a build without AVX-512). O(n + m).
+  bool potential_energy(const SpringArrays& a, std::span<const double> x, Index n, double& energy) const;
   /// Adds the stable-step rows of the chunked springs at x (3n) to rows, eight springs at a
   /// time; the rest list is the caller's. Returns false, adding nothing, where there is no
   /// vector kernel (a build without AVX-512) or the rows fold slaves. O(n + chunks).
