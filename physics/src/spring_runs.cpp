@@ -617,12 +617,16 @@ bool SpringRuns::potential_energy(const SpringArrays& a, std::span<const double>
     const std::size_t i = chunks_[c].i0, j = chunks_[c].j0;
     const auto diff = [&](const double* p) { return _mm512_sub_pd(_mm512_loadu_pd(p + j), _mm512_loadu_pd(p + i)); };
     const __m512d dx = diff(px), dy = diff(py), dz = diff(pz);
-    const __m512d d = _mm512_sqrt_pd(_mm512_fmadd_pd(dz, dz, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dx, dx))));
+    // (the zero-masked form: GCC 12 warns that the plain one reads an undefined register)
+    const __m512d d = _mm512_maskz_sqrt_pd(0xFF, _mm512_fmadd_pd(dz, dz, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dx, dx))));
     const __m512d t = _mm512_sub_pd(d, _mm512_load_pd(l_.data() + 8 * c));
     const __m512d e = _mm512_mul_pd(_mm512_mul_pd(half, _mm512_load_pd(k_.data() + 8 * c)), _mm512_mul_pd(t, t));
     sum = _mm512_mask_add_pd(sum, mask_[c], sum, e);
   }
-  double total = _mm512_reduce_add_pd(sum);
+  alignas(64) double lane[8];
+  _mm512_store_pd(lane, sum);
+  double total = 0;
+  for (const double v : lane) total += v;
   for (const Index r : rest_) {
     if (a.alive[r] == 0) continue;
     const std::size_t i = 3 * std::size_t{a.ni[r]}, j = 3 * std::size_t{a.nj[r]};
