@@ -13,6 +13,7 @@
 #include <Eigen/Dense>
 #include <doctest/doctest.h>
 
+#include "spun_step.hpp"
 #include "sewn/connect/curve_term.hpp"
 #include "sewn/physics/basic_terms.hpp"
 #include "sewn/physics/shells/shell_terms.hpp"
@@ -217,17 +218,7 @@ TEST_CASE("curve connections term: a trial's twist is capped; a rigid rotation a
 std::vector<double> spun_step(double max_turn, physics::integrate::NewtonReport& rep) {
   RodAlongShell s(TwistUpdate::incremental_ii);
   s.curve->set_max_trial_turn(max_turn);
-  const double h = 0.01;
-  s.sys.angles().rates()[0] = 3.0 / h;
-  physics::integrate::NewtonEulerOptions o;
-  o.solver = physics::integrate::LinearSolver::ldlt;
-  o.velocity_tolerance = 1e-9;
-  o.max_iterations = 200;
-  physics::integrate::NewtonEuler newton(o);
-  rep = newton.step(s.sys, h);
-  std::vector<double> q(s.sys.nodes().x().begin(), s.sys.nodes().x().end());
-  q.push_back(s.sys.angles().values()[0]);
-  q.push_back(s.sys.angles().values()[1]);
+  std::vector<double> q = sewn::connect::test::spun_step(s.sys, 0, 3.0, rep);
   CHECK(std::isfinite(s.sys.potential_energy()));
   return q;
 }
