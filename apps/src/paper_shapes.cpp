@@ -229,9 +229,9 @@ PaperShape jellyfish() {
 // Toy ball (proxy): a 96-triangle platform (disc of 4 rings of 6k points), a ball of the 226
 // tetrahedra nearest its centre in a 4³-cube grid (6 tets per cube), and a 203-edge helical
 // spring from the platform's centre to the ball's lowest point. The spring is short and wide
-// (4 turns of 4 cm diameter over 8 cm) so that it carries the ball without buckling: its
-// buckling load as a column falls with (D/L)² of the sag (docs/paper_scenes.md, "The toy
-// ball's spring").
+// (4 turns of 4 cm diameter over 8 cm) so that it carries the ball without buckling: a helical
+// spring buckles as a column at a compression proportional to D²/L, whatever its wire
+// (docs/paper_scenes.md, "The toy ball's spring").
 PaperShape toy_ball() {
   constexpr double spring_length = 0.08, coil_radius = 0.02, turns = 4, ball_radius = 0.02;
   PaperShape s;
