@@ -228,16 +228,20 @@ PaperShape jellyfish() {
 
 // Toy ball (proxy): a 96-triangle platform (disc of 4 rings of 6k points), a ball of the 226
 // tetrahedra nearest its centre in a 4³-cube grid (6 tets per cube), and a 203-edge helical
-// spring from the platform's centre to the ball's lowest point.
+// spring from the platform's centre to the ball's lowest point. The spring is short and wide
+// (4 turns of 4 cm diameter over 8 cm) so that it carries the ball without buckling: a helical
+// spring buckles as a column at a compression proportional to D²/L, whatever its wire
+// (docs/paper_scenes.md, "The toy ball's spring").
 PaperShape toy_ball() {
+  constexpr double spring_length = 0.08, coil_radius = 0.02, turns = 4, ball_radius = 0.02;
   PaperShape s;
   IndexedMesh& m = s.mesh;
   append_tagged(m, disc(0.04, 4, 6), 1);
   GridSpec g;
   g.spacing = {0.01, 0.01, 0.01};
-  g.origin = {-0.02, -0.02, 0.16};
+  g.origin = {-ball_radius, -ball_radius, spring_length};
   const IndexedMesh grid = tet_grid(4, 4, 4, TetSplit::kuhn6, g);
-  const Point3 c{0, 0, 0.18};
+  const Point3 c{0, 0, spring_length + ball_radius};
   std::vector<std::pair<double, std::uint32_t>> by_distance;
   for (std::uint32_t t = 0; t < grid.num_cells(); ++t) {
     Point3 mid{0, 0, 0};
@@ -263,7 +267,7 @@ PaperShape toy_ball() {
   }
   const Point3 end = m.points[lowest];
   add_rod(m, 0, 203, [&](double t) {
-    const double r = 0.015 * std::min({1.0, t / 0.05, (1 - t) / 0.05}), a = 2 * pi * 8 * t;
+    const double r = coil_radius * std::min({1.0, t / 0.05, (1 - t) / 0.05}), a = 2 * pi * turns * t;
     return Point3{end[0] * t + r * std::cos(a), end[1] * t + r * std::sin(a), end[2] * t};
   }, 3, lowest);
   s.names = {{shell, 1, "platform"}, {solid, 2, "ball"}, {rod, 3, "spring"}};

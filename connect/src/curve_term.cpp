@@ -6,6 +6,7 @@
 
 #include "sewn/physics/elements/element_math.hpp"
 #include "history.hpp"
+#include "trial_cap.hpp"
 
 namespace sewn::connect {
 
@@ -64,6 +65,17 @@ double CurveConnections::potential_energy(const StateView& s) const {
     E += (e.degenerate || aliasing) ? std::numeric_limits<double>::infinity() : e.energy;
   }
   return E;
+}
+
+void CurveConnections::set_max_trial_turn(double radians) {
+  if (!(radians > 0.0)) throw InputError("curve connections: max_trial_turn must be > 0 rad (infinity: no limit), got " + std::to_string(radians));
+  max_trial_turn_ = radians;
+}
+
+double CurveConnections::step_fraction(const StateView& s, const StateView& dq) const {
+  const auto evaluate = [&](const Item& it, const Eigen::VectorXd& q) { return it.connection.evaluate(q, update_, false).twist; };
+  const auto turn = [&](double from, double to) { return detail::twist_turn(from, to, update_ == TwistUpdate::direct); };
+  return detail::trial_fraction(items_, s, dq, max_trial_turn_, evaluate, turn);
 }
 
 void CurveConnections::collect_pairs(std::vector<physics::NodePair>& out) const {

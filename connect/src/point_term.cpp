@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <stdexcept>
 
 #include "sewn/physics/elements/element_math.hpp"
 #include "sewn/physics/nodes.hpp"
 #include "history.hpp"
+#include "trial_cap.hpp"
 
 namespace sewn::connect {
 
@@ -102,21 +102,11 @@ void PointConnections::set_max_trial_turn(double radians) {
 }
 
 double PointConnections::step_fraction(const StateView& s, const StateView& dq) const {
-  if (!std::isfinite(max_trial_turn_)) return 1.0;
-  constexpr int max_halvings = 40;  // 1e-12 of the step: a joint that cannot move at all
-  double alpha = 1.0;
-  for (const Item& it : items_) {
-    const Eigen::VectorXd q = it.dofs.gather(s, it.owner()), d = it.dofs.gather(dq, it.owner());
-    const PointEval from = it.connection.evaluate(q, update_, false);
-    // halving from the fraction the other joints left: only the smallest matters
-    for (int h = 0; h < max_halvings; ++h, alpha *= 0.5) {
-      const PointEval to = it.connection.evaluate(q + alpha * d, update_, false);
-      // the direct twist jumps by 2π where it wraps: a jump, not a turn
-      const double twist = update_ == TwistUpdate::direct ? std::remainder(to.twist - from.twist, 2 * std::numbers::pi) : to.twist - from.twist;
-      if (std::abs(twist) <= max_trial_turn_ && std::abs(to.bend_angle - from.bend_angle) <= max_trial_turn_) break;
-    }
-  }
-  return alpha;
+  const auto evaluate = [&](const Item& it, const Eigen::VectorXd& q) { return it.connection.evaluate(q, update_, false); };
+  const auto turn = [&](const PointEval& from, const PointEval& to) {
+    return std::max(detail::twist_turn(from.twist, to.twist, update_ == TwistUpdate::direct), std::abs(to.bend_angle - from.bend_angle));
+  };
+  return detail::trial_fraction(items_, s, dq, max_trial_turn_, evaluate, turn);
 }
 
 void PointConnections::collect_pairs(std::vector<physics::NodePair>& out) const {

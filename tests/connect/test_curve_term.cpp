@@ -5,6 +5,7 @@
 // where the direct angle fails); the guard; renumbering after compaction.
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -12,6 +13,7 @@
 #include <Eigen/Dense>
 #include <doctest/doctest.h>
 
+#include "spun_step.hpp"
 #include "sewn/connect/curve_term.hpp"
 #include "sewn/physics/basic_terms.hpp"
 #include "sewn/physics/shells/shell_terms.hpp"
@@ -186,6 +188,57 @@ TEST_CASE("curve connections term: guard, renumbering, errors naming the connect
                        doctest::Contains("curve connection 'off'"), physics::InputError);
   CHECK_THROWS_WITH_AS((void)t.curve->add("norod", 0, 1, RodEdgeRef{3, 0}, FaceSide{3}, 1.0, t.sys.state()),
                        doctest::Contains("curve connection 'norod': rod 3 edge 0 is out of range"), physics::InputError);
+}
+
+TEST_CASE("curve connections term: a trial's twist is capped; a rigid rotation about the edge is not") {
+  RodAlongShell s(TwistUpdate::incremental_ii);
+  const physics::StateView at = s.sys.state();
+  // dq: the shell's free nodes turned rigidly by `turn` about the rod's axis (x), rod edge 0's θ
+  // by `turn` + `twist`, edge 1's by `turn`: the joints' twists move by `twist` only.
+  auto fraction = [&](double turn, double twist) {
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(turn, Vec3::UnitX()).toRotationMatrix();
+    std::vector<double> dx(at.x.size(), 0.0), zero(at.x.size(), 0.0), dtheta{turn + twist, turn}, zero_theta(2, 0.0);
+    for (Index i = 3; i < s.sys.nodes().size(); ++i) {
+      const Vec3 p = s.sys.nodes().position(i), d = R * p - p;
+      for (int a = 0; a < 3; ++a) dx[3 * std::size_t{i} + static_cast<std::size_t>(a)] = d[a];
+    }
+    return s.curve->step_fraction(at, {dx, zero, at.mass, dtheta, zero_theta});
+  };
+  CHECK(fraction(1.5, 0.0) == 1.0);   // both sides turn together: no joint turns
+  CHECK(fraction(0.0, 3.0) == 0.25);  // 3 rad of twist halved until 3α ≤ π/4
+  CHECK(fraction(0.0, -0.5) == 1.0);
+  s.curve->set_max_trial_turn(std::numeric_limits<double>::infinity());
+  CHECK(fraction(0.0, 3.0) == 1.0);
+  CHECK_THROWS_WITH_AS(s.curve->set_max_trial_turn(-1.0), doctest::Contains("max_trial_turn"), physics::InputError);
+}
+
+// One step of RodAlongShell (the shell free) whose rod edge 0 spins at 3 rad per step, its θ
+// free: the initial guess θ_n + 3 rad lies past the jump guard. Returns the state after the
+// step (x, then both θ).
+std::vector<double> spun_step(double max_turn, physics::integrate::NewtonReport& rep) {
+  RodAlongShell s(TwistUpdate::incremental_ii);
+  s.curve->set_max_trial_turn(max_turn);
+  std::vector<double> q = sewn::connect::test::spun_step(s.sys, 0, 3.0, rep);
+  CHECK(std::isfinite(s.sys.potential_energy()));
+  return q;
+}
+
+TEST_CASE("curve connections term: a joint driven past its guard by the initial guess converges, as by small sub-steps") {
+  physics::integrate::NewtonReport capped, fine, uncapped;
+  // without the cap, the guess's energy is infinite: refused
+  CHECK_THROWS_AS((void)spun_step(std::numeric_limits<double>::infinity(), uncapped), physics::integrate::NewtonError);
+  const std::vector<double> a = spun_step(sewn::connect::default_max_trial_turn, capped);
+  const std::vector<double> b = spun_step(0.05, fine);
+  MESSAGE("spun curve joint: guess fraction " << capped.guess_fraction << " in " << capped.iterations << " iterations ("
+                                              << capped.term_step_limits << " capped); at 0.05 rad per trial "
+                                              << fine.guess_fraction << " in " << fine.iterations << " (" << fine.term_step_limits
+                                              << "); theta " << a[a.size() - 2] << " and " << b[b.size() - 2]);
+  CHECK(capped.guess_fraction == 0.25);
+  CHECK(fine.guess_fraction == 1.0 / 64);
+  CHECK(std::abs(a[a.size() - 2]) > 0.1);  // the spin carried the rod on
+  double largest = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) largest = std::max(largest, std::abs(a[k] - b[k]));
+  CHECK(largest < 1e-9);
 }
 
 // A cantilever plate (0.2 × 0.05 m, 8 × 2 cells of two triangles, E = 1 GPa, h = 2 mm, clamped

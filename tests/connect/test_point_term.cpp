@@ -16,6 +16,7 @@
 #include <Eigen/Dense>
 #include <doctest/doctest.h>
 
+#include "spun_step.hpp"
 #include "sewn/connect/point_term.hpp"
 #include "sewn/physics/basic_terms.hpp"
 #include "sewn/physics/integrate/newton_euler.hpp"
@@ -240,16 +241,8 @@ TEST_CASE("point connections term: a trial's joint turn is capped; a rigid rotat
 std::vector<double> spun_step(double max_turn, physics::integrate::NewtonReport& rep) {
   RodInShell s(TwistUpdate::incremental_ii);
   s.joint->set_max_trial_turn(max_turn);
-  const double h = 0.01;
-  s.sys.angles().rates()[s.theta] = 3.0 / h;
-  physics::integrate::NewtonEulerOptions o;
-  o.solver = physics::integrate::LinearSolver::ldlt;
-  o.velocity_tolerance = 1e-9;
-  o.max_iterations = 200;
-  physics::integrate::NewtonEuler newton(o);
-  rep = newton.step(s.sys, h);
-  std::vector<double> q(s.sys.nodes().x().begin(), s.sys.nodes().x().end());
-  q.push_back(s.sys.angles().values()[s.theta]);
+  std::vector<double> q = sewn::connect::test::spun_step(s.sys, s.theta, 3.0, rep);
+  REQUIRE(s.sys.angles().size() == 1);  // q ends with θ
   CHECK(std::isfinite(s.sys.potential_energy()));
   return q;
 }

@@ -13,7 +13,7 @@
 //   jellyfish     1465 / 1273 / 0 / 454  exact: a thin disc body (432 tets), an eyeball (22) on
 //                                        a stalk, 3 oral-arm loops, 12 tentacles
 //   toy_ball      proxy (the published counts cannot all hold): a 96-triangle platform (61
-//                 points), a 226-tet ball, a 203-edge helical spring between them
+//                 points), a 226-tet ball, a 203-edge helical spring (4 turns) between them
 //   sandwich      proxy (1510 shell faces cannot lie in 600 tets): 600 tets (a 10 × 2 × 5 cube
 //                 beam, 6 tets per cube) with its 4 interior horizontal face layers as shells
 //   toy_tunnel    620 / 60 / 1200 / 0    from Fig. 14 (no published counts): a cloth cylinder

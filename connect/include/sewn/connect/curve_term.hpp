@@ -7,7 +7,10 @@
 //
 // Guard: a state where a side's frame cannot be built (EdgeEval::degenerate) or the twist moved
 // by more than max_twist_increment since the last accepted step has infinite energy, so a line
-// search shortens the step instead of crossing it.
+// search shortens the step instead of crossing it. Before it, as for point connections,
+// step_fraction() keeps every Newton trial (and the initial guess) from changing any joint's
+// twist by more than max_trial_turn() from the iterate it starts at: a rod spun fast inside a
+// shell's edge is then followed by a few capped trials instead of a refused step.
 
 #include <string>
 #include <variant>
@@ -51,6 +54,10 @@ class CurveConnections final : public physics::ForceTerm {
   /// whether it was kept. Throws physics::InputError naming the connection for an id out of
   /// range (nothing changed). O(connections + renames).
   std::vector<bool> follow_nodes(Index num_nodes, const NodeDecision& decide);
+  /// The largest change of any joint's twist one Newton trial may make (rad, > 0; infinity: no
+  /// limit, the jump guard alone). Throws physics::InputError otherwise.
+  void set_max_trial_turn(double radians);
+  [[nodiscard]] double max_trial_turn() const { return max_trial_turn_; }
   [[nodiscard]] const EdgeConnection& connection(Index c) const { return items_.at(c).connection; }
   /// Values of connection c at state s. O(1).
   [[nodiscard]] EdgeEval evaluate(Index c, const physics::StateView& s) const;
@@ -59,6 +66,9 @@ class CurveConnections final : public physics::ForceTerm {
   [[nodiscard]] bool velocity_dependent() const override { return false; }
   void add_forces(const physics::StateView& s, std::span<double> f) const override;
   [[nodiscard]] double potential_energy(const physics::StateView& s) const override;
+  /// The largest α ≤ 1 (halving from 1) such that no joint's twist at s + α dq differs from its
+  /// value at s by more than max_trial_turn(). O(connections × halvings).
+  [[nodiscard]] double step_fraction(const physics::StateView& s, const physics::StateView& dq) const override;
   void collect_pairs(std::vector<physics::NodePair>& out) const override;
   void bind_pattern(const physics::BlockMatrix& pattern) override;
   void add_jacobians(const physics::StateView& s, const physics::JacobianRequest& req) const override;
@@ -75,6 +85,7 @@ class CurveConnections final : public physics::ForceTerm {
   const physics::rods::Rods* rods_;
   TwistUpdate update_;
   std::vector<Item> items_;
+  double max_trial_turn_ = default_max_trial_turn;
   std::uint64_t bound_pattern_ = ~std::uint64_t{0};
 };
 
