@@ -32,11 +32,6 @@ struct Jet {
   double v = 0;
   std::array<double, N> g{};
   std::array<double, H ? packed_size<N> : 1> h{};  // packed upper triangle (packed_at)
-  /// No derivative in any direction (g and h zero): an operation with a constant operand is a
-  /// scaling of the other's derivatives, not the full chain rule. Half the operations of the
-  /// connections' frames have one (a rod's stored tangent and director, its θ in the reduced
-  /// derivatives, literals), and the frisbee's curve connections cost 2x more without it.
-  bool constant = true;
 
   Jet() = default;
   Jet(double value) : v(value) {}  // NOLINT: constants mix freely, as with double
@@ -44,7 +39,6 @@ struct Jet {
   static Jet variable(double value, int i) {
     Jet r(value);
     r.g[static_cast<std::size_t>(i)] = 1;
-    r.constant = false;
     return r;
   }
   [[nodiscard]] double hessian(int i, int j) const {
@@ -53,12 +47,9 @@ struct Jet {
   }
 };
 
-/// f(a) with f' = f1, f'' = f2 at a.
 template <int N, bool H>
 Jet<N, H> unary(const Jet<N, H>& a, double f, double f1, double f2) {
   Jet<N, H> r(f);
-  if (a.constant) return r;
-  r.constant = false;
   for (std::size_t i = 0; i < N; ++i) r.g[i] = f1 * a.g[i];
   if constexpr (H) {
     std::size_t k = 0;
@@ -68,14 +59,10 @@ Jet<N, H> unary(const Jet<N, H>& a, double f, double f1, double f2) {
   return r;
 }
 
-/// f(a, b) with its first (fa, fb) and second (faa, fbb, fab) partial derivatives at (a, b).
 template <int N, bool H>
 Jet<N, H> binary(const Jet<N, H>& a, const Jet<N, H>& b, double f, double fa, double fb, double faa, double fbb,
                  double fab) {
-  if (b.constant) return unary(a, f, fa, faa);
-  if (a.constant) return unary(b, f, fb, fbb);
   Jet<N, H> r(f);
-  r.constant = false;
   for (std::size_t i = 0; i < N; ++i) r.g[i] = fa * a.g[i] + fb * b.g[i];
   if constexpr (H) {
     std::size_t k = 0;
@@ -88,26 +75,17 @@ Jet<N, H> binary(const Jet<N, H>& a, const Jet<N, H>& b, double f, double fa, do
   return r;
 }
 
-/// a + s b, s = ±1: sums and differences in one pass.
 template <int N, bool H>
-Jet<N, H> add_scaled(Jet<N, H> a, const Jet<N, H>& b, double s) {
-  a.v += s * b.v;
-  if (b.constant) return a;
-  a.constant = false;
-  for (std::size_t i = 0; i < a.g.size(); ++i) a.g[i] += s * b.g[i];
+Jet<N, H> operator+(Jet<N, H> a, const Jet<N, H>& b) {
+  a.v += b.v;
+  for (std::size_t i = 0; i < a.g.size(); ++i) a.g[i] += b.g[i];
   if constexpr (H)
-    for (std::size_t i = 0; i < a.h.size(); ++i) a.h[i] += s * b.h[i];
+    for (std::size_t i = 0; i < a.h.size(); ++i) a.h[i] += b.h[i];
   return a;
-}
-
-template <int N, bool H>
-Jet<N, H> operator+(const Jet<N, H>& a, const Jet<N, H>& b) {
-  return a.constant ? add_scaled(b, a, 1.0) : add_scaled(a, b, 1.0);
 }
 template <int N, bool H>
 Jet<N, H> operator-(Jet<N, H> a) {
   a.v = -a.v;
-  if (a.constant) return a;
   for (double& x : a.g) x = -x;
   if constexpr (H)
     for (double& x : a.h) x = -x;
@@ -115,12 +93,11 @@ Jet<N, H> operator-(Jet<N, H> a) {
 }
 template <int N, bool H>
 Jet<N, H> operator-(const Jet<N, H>& a, const Jet<N, H>& b) {
-  return add_scaled(a, b, -1.0);
+  return a + (-b);
 }
 template <int N, bool H>
 Jet<N, H> operator*(Jet<N, H> a, double s) {
   a.v *= s;
-  if (a.constant) return a;
   for (double& x : a.g) x *= s;
   if constexpr (H)
     for (double& x : a.h) x *= s;
