@@ -134,16 +134,24 @@ TEST_CASE("patch bending: every interior patch of an irregular mesh bends a quad
   }
 }
 
-TEST_CASE("shell terms: add_forces_and_energy equals potential_energy and add_forces on a bent, stretched mesh") {
-  const auto s = sewn::shell_strip::strip_mesh(sewn::shell_strip::Mesh::jittered, 20);
-  sewn::physics::System sys;
+// The jittered strip of 20 columns, its nodes added to sys moved from rest by up to `amplitude`
+// in x and y and 3 × that in z (bent and stretched).
+sewn::shell_strip::Strip bent_strip(sewn::physics::System& sys, unsigned seed, double amplitude) {
+  auto s = sewn::shell_strip::strip_mesh(sewn::shell_strip::Mesh::jittered, 20);
   const Index n = static_cast<Index>(s.rest.size() / 3);
-  std::mt19937 rng(7);
+  std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (Index i = 0; i < n; ++i) {
     const Eigen::Vector3d X(s.rest[3 * i], s.rest[3 * i + 1], s.rest[3 * i + 2]);
-    sys.nodes().add(X + 0.01 * Eigen::Vector3d(u(rng), u(rng), 3.0 * u(rng)), Eigen::Vector3d::Zero(), 1.0);
+    sys.nodes().add(X + amplitude * Eigen::Vector3d(u(rng), u(rng), 3.0 * u(rng)), Eigen::Vector3d::Zero(), 1.0);
   }
+  return s;
+}
+
+TEST_CASE("shell terms: add_forces_and_energy equals potential_energy and add_forces on a bent, stretched mesh") {
+  sewn::physics::System sys;
+  const auto s = bent_strip(sys, 7, 0.01);
+  const Index n = sys.nodes().size();
   const std::vector<shells::PlateMaterial> mat(s.triangles.size(), shells::plate_material(1e6, 0.3, 0.01));
   const shells::PatchTerms patches = shells::add_patch_bending(sys, s.triangles, s.rest, mat);
   auto& membranes = sys.add<shells::Membranes>();
@@ -189,15 +197,8 @@ void subtract_element_hessians(const shells::PatchBending<N>* term, const sewn::
 }
 
 TEST_CASE("patch bending: exact Jacobians assembled with each edge's angle derivatives shared equal the elements' own") {
-  const auto s = sewn::shell_strip::strip_mesh(sewn::shell_strip::Mesh::jittered, 20);
   sewn::physics::System sys;
-  const Index n = static_cast<Index>(s.rest.size() / 3);
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (Index i = 0; i < n; ++i) {
-    const Eigen::Vector3d X(s.rest[3 * i], s.rest[3 * i + 1], s.rest[3 * i + 2]);
-    sys.nodes().add(X + 0.02 * Eigen::Vector3d(u(rng), u(rng), 3.0 * u(rng)), Eigen::Vector3d::Zero(), 1.0);
-  }
+  const auto s = bent_strip(sys, 11, 0.02);
   const std::vector<shells::PlateMaterial> mat(s.triangles.size(), shells::plate_material(1e6, 0.3, 0.01));
   const shells::PatchTerms patches = shells::add_patch_bending(sys, s.triangles, s.rest, mat);
   REQUIRE(patches.three != nullptr);
