@@ -100,16 +100,19 @@ void StencilTerm<N>::bind_pattern(const BlockMatrix& pattern) {
 }
 
 template <int N>
+void StencilTerm<N>::for_each_hessian(const StateView& s, const std::function<void(Index, const Hessian&)>& visit) const {
+  for (Index e = 0; e < size(); ++e)
+    if (alive_[e] != 0) visit(e, element_hessian(e, gather(s, e)));
+}
+
+template <int N>
 void StencilTerm<N>::add_jacobians(const StateView& s, const JacobianRequest& req) const {
   if (req.matrix != nullptr && (req.matrix->pattern_version() != bound_pattern_ || bound_topology_ != topology_version()))
     throw InputError(std::string(name()) +
                      ": add_jacobians on a pattern that is not bound to the current elements; call System::refresh()");
   const bool product = !req.product_in.empty();
   if (req.cx == 0.0 && !product) return;
-  for (Index e = 0; e < size(); ++e) {
-    if (alive_[e] == 0) continue;
-    const Positions x = gather(s, e);
-    const Hessian H = req.options.project_element_hessians ? element_hessian_psd(e, x) : element_hessian(e, x);
+  auto add = [&](Index e, const Hessian& H) {
     const Nodes& n = nodes_[e];
     if (req.matrix != nullptr && req.cx != 0.0)
       for (int a = 0; a < N; ++a)
@@ -123,7 +126,13 @@ void StencilTerm<N>::add_jacobians(const StateView& s, const JacobianRequest& re
       for (int a = 0; a < N; ++a)
         for (int c = 0; c < 3; ++c) req.product_out[3 * std::size_t{n[a]} + c] -= q[3 * a + c];
     }
+  };
+  if (!req.options.project_element_hessians) {
+    for_each_hessian(s, add);
+    return;
   }
+  for (Index e = 0; e < size(); ++e)
+    if (alive_[e] != 0) add(e, element_hessian_psd(e, gather(s, e)));
 }
 
 template <int N>

@@ -1,5 +1,6 @@
 #include "sewn/physics/shells/patch_element.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -174,29 +175,59 @@ void scatter_row(Eigen::Matrix<double, 3, 3 * N>& J, int k, const std::array<int
 
 }  // namespace
 
-template <int N>
-elements::Mat<3 * N> patch_hessian(const PatchPositions<N>& x, const PatchRest& rest) {
+namespace {
+
+// H = Jᵀ S J + Σ_k (S d)_k ℓ_k ∇²θ_k, J's row k = ∂d_k/∂x = ℓ_k ∇θ_k, with hinge k's ∇θ_k and
+// ∇²θ_k from derivatives(k) = {g, H, cols}: the 12 entries of g and the 12×12 of H stand for the
+// patch columns cols (its hinge's in this patch's order, or reversed).
+template <int N, class Derivatives>
+elements::Mat<3 * N> hessian_from(const PatchPositions<N>& x, const PatchRest& rest, Derivatives&& derivatives) {
   const Eigen::Vector3d Sd = rest.stiffness * heights<N>(x, rest);
-  // J: row k is ∂d_k/∂x = ℓ_k ∇θ_k; H = Jᵀ S J + Σ_k (S d)_k ℓ_k ∇²θ_k
   Eigen::Matrix<double, 3, 3 * N> J = Eigen::Matrix<double, 3, 3 * N>::Zero();
   elements::Mat<3 * N> H = elements::Mat<3 * N>::Zero();
-  Vec12 gk;
-  Mat12 hk;
   for (int k = 0; k < rest.count; ++k) {
-    const auto cols = hinge_columns<N>(rest, k);
     const double lever = rest.lever[static_cast<std::size_t>(k)];
-    dihedral_derivatives(hinge_of<N>(x, cols), gk, hk);
+    const auto [gk, hk, cols] = derivatives(k);
     scatter_row<N>(J, k, cols, gk * lever);
     const double c = Sd[k] * lever;
     for (int a = 0; a < 4; ++a) {
       const int A = cols[static_cast<std::size_t>(a)];
-      for (int b = 0; b < 4; ++b) H.template block<3, 3>(3 * A, 3 * cols[static_cast<std::size_t>(b)]) += c * hk.block<3, 3>(3 * a, 3 * b);
+      for (int b = 0; b < 4; ++b) H.template block<3, 3>(3 * A, 3 * cols[static_cast<std::size_t>(b)]) += c * hk.template block<3, 3>(3 * a, 3 * b);
     }
   }
   // coefficient-wise products: Eigen's blocked GEMM costs more than the ~1k flops at this size
   const Eigen::Matrix<double, 3, 3 * N> SJ = rest.stiffness.lazyProduct(J);
   H.noalias() += J.transpose().lazyProduct(SJ);
   return 0.5 * (H + H.transpose());
+}
+
+struct HingeTerms {
+  const Vec12& g;
+  const Mat12& H;
+  std::array<int, 4> cols;
+};
+
+}  // namespace
+
+template <int N>
+elements::Mat<3 * N> patch_hessian(const PatchPositions<N>& x, const PatchRest& rest) {
+  Vec12 gk;
+  Mat12 hk;
+  return hessian_from<N>(x, rest, [&](int k) {
+    const auto cols = hinge_columns<N>(rest, k);
+    dihedral_derivatives(hinge_of<N>(x, cols), gk, hk);
+    return HingeTerms{gk, hk, cols};
+  });
+}
+
+template <int N>
+elements::Mat<3 * N> patch_hessian_shared(const PatchPositions<N>& x, const PatchRest& rest, const SharedHinges& hinges) {
+  return hessian_from<N>(x, rest, [&](int k) {
+    const auto kk = static_cast<std::size_t>(k);
+    auto cols = hinge_columns<N>(rest, k);
+    if (hinges.reversed[kk]) std::reverse(cols.begin(), cols.end());
+    return HingeTerms{hinges.of[kk]->g, hinges.of[kk]->H, cols};
+  });
 }
 
 template <int N>
@@ -223,6 +254,7 @@ elements::Mat<3 * N> patch_hessian_gauss_newton(const PatchPositions<N>& x, cons
   template elements::Vec<3 * N> patch_gradient<N>(const PatchPositions<N>&, const PatchRest&);                          \
   template double patch_energy_gradient<N>(const PatchPositions<N>&, const PatchRest&, elements::Vec<3 * N>&);          \
   template elements::Mat<3 * N> patch_hessian<N>(const PatchPositions<N>&, const PatchRest&);                         \
+  template elements::Mat<3 * N> patch_hessian_shared<N>(const PatchPositions<N>&, const PatchRest&, const SharedHinges&); \
   template elements::Mat<3 * N> patch_hessian_gauss_newton<N>(const PatchPositions<N>&, const PatchRest&);
 SEWN_PATCH_INSTANTIATE(4)
 SEWN_PATCH_INSTANTIATE(5)

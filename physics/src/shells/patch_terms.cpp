@@ -1,9 +1,12 @@
 #include "sewn/physics/shells/patch_terms.hpp"
 
+#include <map>
 #include <string>
+#include <utility>
 
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/shells/adjacency.hpp"
+#include "sewn/physics/shells/hinge_element.hpp"
 
 namespace sewn::physics::shells {
 
@@ -24,6 +27,61 @@ Index PatchBending<N>::add(const Nodes& nodes, const PatchPositions<N>& X, const
     return e;
   } catch (const InputError& err) {
     throw InputError(std::string(name()) + " element " + std::to_string(this->size()) + ": " + err.what());
+  }
+}
+
+template <int N>
+void PatchBending<N>::build_hinge_slots() const {
+  shared_.assign(this->size(), HingeSlots{});
+  hinge_nodes_.clear();
+  // An edge's slot, by its two nodes, while only one patch uses it.
+  std::map<std::pair<Index, Index>, Index> open;
+  for (Index e = 0; e < this->size(); ++e) {
+    if (!this->is_alive(e)) continue;
+    const Nodes& n = this->element_nodes(e);
+    const PatchRest& r = rest_[e];
+    for (int k = 0; k < r.count; ++k) {
+      const auto kk = static_cast<std::size_t>(k);
+      const int i = r.edge[kk];
+      const std::array<Index, 4> h{n[static_cast<std::size_t>(i)], n[static_cast<std::size_t>((i + 1) % 3)],
+                                   n[static_cast<std::size_t>((i + 2) % 3)], n[static_cast<std::size_t>(3 + k)]};
+      const auto key = std::minmax(h[1], h[2]);
+      const auto it = open.find(key);
+      // The neighbour's view of the edge is this hinge reversed (consistently oriented
+      // triangles); anything else keeps a slot of its own.
+      if (it != open.end() && hinge_nodes_[it->second] == std::array<Index, 4>{h[3], h[2], h[1], h[0]}) {
+        shared_[e].of[kk] = it->second;
+        shared_[e].reversed[kk] = true;
+        open.erase(it);
+        continue;
+      }
+      shared_[e].of[kk] = static_cast<Index>(hinge_nodes_.size());
+      open[key] = static_cast<Index>(hinge_nodes_.size());
+      hinge_nodes_.push_back(h);
+    }
+  }
+  derivatives_.resize(hinge_nodes_.size());
+  slots_topology_ = this->topology_version();
+}
+
+template <int N>
+void PatchBending<N>::for_each_hessian(const StateView& s, const std::function<void(Index, const Hessian&)>& visit) const {
+  if (slots_topology_ != this->topology_version()) build_hinge_slots();
+  for (std::size_t h = 0; h < hinge_nodes_.size(); ++h) {
+    HingePositions x;
+    for (int c = 0; c < 4; ++c)
+      for (int a = 0; a < 3; ++a) x(a, c) = s.x[3 * std::size_t{hinge_nodes_[h][static_cast<std::size_t>(c)]} + static_cast<std::size_t>(a)];
+    dihedral_derivatives(x, derivatives_[h].g, derivatives_[h].H);
+  }
+  SharedHinges hinges;
+  for (Index e = 0; e < this->size(); ++e) {
+    if (!this->is_alive(e)) continue;
+    for (int k = 0; k < rest_[e].count; ++k) {
+      const auto kk = static_cast<std::size_t>(k);
+      hinges.of[kk] = &derivatives_[shared_[e].of[kk]];
+      hinges.reversed[kk] = shared_[e].reversed[kk];
+    }
+    visit(e, patch_hessian_shared<N>(this->gather(s, e), rest_[e], hinges));
   }
 }
 

@@ -7,6 +7,7 @@
 #include <cholmod.h>
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <initializer_list>
 #include <string>
@@ -139,6 +140,7 @@ class Factorization {
       cholmod_free_factor(&L_, &c_);
       L_ = best;
     }
+    if (L_->is_super) build_permuted();
     // One PCG iteration: two triangular solves (2 flops per entry of L each), the product with
     // A (2 per stored scalar, both triangles) and the vector passes (~10 per unknown).
     const double n = static_cast<double>(L_->n), upper = static_cast<double>(src_.size());
@@ -156,7 +158,18 @@ class Factorization {
     bool ok = false;
     {
       const SerialLibraryRegions serial;  // one thread means one: CHOLMOD's own regions too
-      ok = cholmod_factorize(K_, L_, &c_) && c_.status == CHOLMOD_OK;
+      if (S_) {
+        // What cholmod_factorize does for a supernodal factor of an upper-triangular K, less
+        // its permuted transpose of K (rebuilt, allocated and freed at every call): the values
+        // go straight to their places in tril(PKPᵀ) (build_permuted()).
+        const auto* kx = static_cast<const double*>(K_->x);
+        auto* sx = static_cast<double*>(S_->x);
+        for (std::size_t e = 0; e < to_s_.size(); ++e) sx[to_s_[e]] = kx[e];
+        double zero[2] = {0.0, 0.0};
+        ok = cholmod_super_numeric(S_, nullptr, zero, L_, &c_) && c_.status == CHOLMOD_OK;
+      } else {
+        ok = cholmod_factorize(K_, L_, &c_) && c_.status == CHOLMOD_OK;
+      }
     }
     const std::size_t bad_pivot = ok ? nonpositive_pivot() : L_->minor;
     if (!ok && c_.status != CHOLMOD_NOT_POSDEF)
@@ -242,7 +255,39 @@ class Factorization {
     for (const int o : orderings) c_.method[k++].ordering = o;
     return cholmod_analyze(K_, &c_);
   }
+  // S_ = tril(P K Pᵀ) (P the analysis's ordering, L_->Perm) in sorted CSC, what
+  // cholmod_super_numeric factors, and to_s_: each entry of K's place in it. O(entries log).
+  void build_permuted() {
+    const std::size_t n = L_->n;
+    const auto* perm = static_cast<const int*>(L_->Perm);
+    std::vector<int> pinv(n);
+    for (std::size_t k = 0; k < n; ++k) pinv[static_cast<std::size_t>(perm[k])] = static_cast<int>(k);
+    const auto* kp = static_cast<const int*>(K_->p);
+    const auto* ki = static_cast<const int*>(K_->i);
+    const std::size_t nz = src_.size();
+    // (column, row, K entry) of each entry in the permuted lower triangle, sorted column-major
+    std::vector<std::array<int, 3>> at(nz);
+    for (std::size_t c = 0; c < n; ++c)
+      for (int e = kp[c]; e < kp[c + 1]; ++e) {
+        const int pr = pinv[static_cast<std::size_t>(ki[e])], pc = pinv[c];
+        at[static_cast<std::size_t>(e)] = {std::min(pr, pc), std::max(pr, pc), e};
+      }
+    std::sort(at.begin(), at.end());
+    S_ = cholmod_allocate_sparse(n, n, nz, 1, 1, -1, CHOLMOD_REAL, &c_);
+    if (!S_) throw SolverError("cholmod: out of memory for a matrix of " + std::to_string(nz) + " entries", 0, 0);
+    auto* sp = static_cast<int*>(S_->p);
+    auto* si = static_cast<int*>(S_->i);
+    std::fill(sp, sp + n + 1, 0);
+    to_s_.resize(nz);
+    for (std::size_t q = 0; q < nz; ++q) {
+      ++sp[static_cast<std::size_t>(at[q][0]) + 1];
+      si[q] = at[q][1];
+      to_s_[static_cast<std::size_t>(at[q][2])] = static_cast<int>(q);
+    }
+    for (std::size_t c = 0; c < n; ++c) sp[c + 1] += sp[c];
+  }
   void free_factor() {
+    if (S_) cholmod_free_sparse(&S_, &c_);
     if (L_) cholmod_free_factor(&L_, &c_);
     single_.clear();
     valid_ = false;
@@ -250,11 +295,13 @@ class Factorization {
 
   cholmod_common c_{};
   cholmod_sparse* K_ = nullptr;
+  cholmod_sparse* S_ = nullptr;  // tril(P K Pᵀ) of a supernodal analysis (build_permuted)
   cholmod_factor* L_ = nullptr;
   cholmod_dense *X_ = nullptr, *Y_ = nullptr, *E_ = nullptr;
   std::uint64_t pattern_ = 0;
   std::vector<std::size_t> src_;  // per entry of K: its index in A's value array
   std::vector<int> col_of_;       // per entry of K: its column
+  std::vector<int> to_s_;         // per entry of K: its index in S_
   std::vector<double> factored_;  // K's values when last factored (direct backend)
   bool valid_ = false;
   bool single_solves_;

@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -82,6 +83,11 @@ class StencilTerm : public ForceTerm {
     project_psd(H);
     return H;
   }
+  /// Every live element's exact Hessian at s, as visit(e, H) in element order: add_jacobians'
+  /// loop. Default: element_hessian(e, gather(s, e)) per element; a term whose elements share
+  /// work overrides it to do that work once (patch bending: the two patches of an edge share
+  /// its angle's derivatives), with the same Hessians up to round-off.
+  virtual void for_each_hessian(const StateView& s, const std::function<void(Index, const Hessian&)>& visit) const;
 
  protected:
   /// Appends an element; throws InputError (naming the term) if a node repeats. Returns its index.

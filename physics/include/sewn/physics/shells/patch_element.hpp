@@ -77,6 +77,24 @@ template <int N>
 /// Exact Hessian (symmetric, indefinite in general).
 template <int N>
 [[nodiscard]] elements::Mat<3 * N> patch_hessian(const PatchPositions<N>& x, const PatchRest& rest);
+/// ∇θ and ∇²θ of one hinge (dihedral_derivatives, hinge_element.hpp), as computed for the node
+/// order (x0, x1, x2, x3) of one patch's view of the edge: the patch across the edge sees it as
+/// (x3, x2, x1, x0), with the same angle and the same derivatives, blocks in reverse order.
+struct HingeDerivatives {
+  elements::Vec<12> g;
+  elements::Mat<12> H;
+};
+/// Where patch_hessian_shared takes hinge k's derivatives from: `of[k]`, computed in this
+/// patch's node order for hinge k, or in the reverse order where reversed[k].
+struct SharedHinges {
+  std::array<const HingeDerivatives*, 3> of{};
+  std::array<bool, 3> reversed{};
+};
+/// patch_hessian with the hinges' derivatives given (computed once per edge for both its
+/// patches: PatchBending::for_each_hessian); equal to patch_hessian up to round-off.
+template <int N>
+[[nodiscard]] elements::Mat<3 * N> patch_hessian_shared(const PatchPositions<N>& x, const PatchRest& rest,
+                                                       const SharedHinges& hinges);
 /// The Gauss-Newton part of the Hessian, JᵀSJ (J's row k = ℓ_k ∇θ_k): PSD by construction
 /// (S is positive definite), with no angle Hessian and no eigendecomposition. It drops the
 /// curvature terms Σ_k (S d)_k ℓ_k ∇²θ_k, so it is exact where every d_k = 0 (the rest angles)

@@ -6,8 +6,10 @@
 // Forces = -gradient; ∂F/∂x = -Hessian (exact, or PSD-projected per element when
 // JacobianOptions::project_element_hessians is set: the Gauss-Newton part, PSD by
 // construction); no damping of their own.
-// Cost per triangle: forces ~0.5 µs, exact Jacobians ~10 µs (three angle Hessians), projected
-// ones far less (three angle gradients and JᵀSJ, no eigen-projection).
+// Cost per triangle: forces ~0.5 µs, exact Jacobians ~10 µs (three angle Hessians, each
+// interior edge's computed once for the two patches of a term that share it:
+// for_each_hessian), projected ones far less (three angle gradients and JᵀSJ, no
+// eigen-projection).
 
 #include <array>
 #include <cstdint>
@@ -50,9 +52,26 @@ class PatchBending final : public elements::StencilTerm<N> {
   [[nodiscard]] Hessian element_hessian_psd(Index e, const Positions& x) const override {
     return patch_hessian_gauss_newton<N>(x, rest_[e]);
   }
+  /// The exact Hessians with each interior edge's angle derivatives computed once for the two
+  /// patches of this term that share it (patch_hessian_shared): half the angle Hessians of a
+  /// mesh whose triangles all have three neighbours. O(elements); the table of shared edges is
+  /// rebuilt after a topology change (O(hinges log hinges)). Not thread-safe per instance.
+  void for_each_hessian(const StateView& s, const std::function<void(Index, const Hessian&)>& visit) const override;
 
  private:
+  // Hinge k of element e is slot shared_[e].of[k] of hinge_nodes_ (in that slot's node order,
+  // or reversed); the slots' derivatives are computed at each for_each_hessian.
+  struct HingeSlots {
+    std::array<Index, 3> of{};
+    std::array<bool, 3> reversed{};
+  };
+  void build_hinge_slots() const;
+
   std::vector<PatchRest> rest_;
+  mutable std::vector<HingeSlots> shared_;
+  mutable std::vector<std::array<Index, 4>> hinge_nodes_;
+  mutable std::vector<HingeDerivatives> derivatives_;
+  mutable std::uint64_t slots_topology_ = ~std::uint64_t{0};
 };
 
 extern template class PatchBending<4>;
