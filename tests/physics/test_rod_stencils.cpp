@@ -8,6 +8,7 @@
 #include <random>
 #include <string>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <doctest/doctest.h>
 
@@ -131,6 +132,39 @@ TEST_CASE("rod stencil: bend-twist gradient and Hessian match finite differences
   }
 }
 
+TEST_CASE("rod stencil: the Gauss-Newton Hessian is exact at the natural strains and PSD elsewhere") {
+  std::mt19937 rng(4321);
+  const double turns[] = {0.8, 1e-5, 2.5};  // generic, nearly collinear, strongly bent
+  for (double turn : turns) {
+    CAPTURE(turn);
+    for (int trial = 0; trial < 20; ++trial) {
+      Case c = random_case(rng, turn, 0.2);
+      const BendTwistEval H = eval(c, c.q, Want::hessian), gn = eval(c, c.q, Want::gauss_newton);
+      // Only the Hessian stand-in is new: energy and gradient are the plain pass's, bit for bit.
+      const BendTwistEval g = eval(c, c.q, Want::gradient);
+      CHECK(gn.energy == g.energy);
+      CHECK(gn.gradient == g.gradient);
+      CHECK(gn.kappa1 == g.kappa1);
+      CHECK(gn.twist == g.twist);
+      // PSD by construction; symmetric exactly.
+      CHECK(gn.hessian == gn.hessian.transpose());
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 11, 11>> eig(gn.hessian);
+      CHECK(eig.eigenvalues().minCoeff() >= -1e-12 * gn.hessian.norm());
+      // Away from the natural strains the exact Hessian has the curvature terms GN drops: the two
+      // differ (the random natural strains are not the current ones).
+      CHECK((gn.hessian - H.hessian).norm() > 1e-6 * H.hessian.norm());
+      // At the natural strains (κ̄, m̄ := the current ones; distinct stiffnesses, so each strain's
+      // gradient is tested on its own) the dropped terms vanish: GN equals the AD Hessian.
+      c.rest.kappa1 = H.kappa1;
+      c.rest.kappa2 = H.kappa2;
+      c.rest.twist = H.twist;
+      const BendTwistEval at_rest = eval(c, c.q, Want::hessian), gn_rest = eval(c, c.q, Want::gauss_newton);
+      CHECK(gn_rest.energy < 1e-20);
+      CHECK((gn_rest.hessian - at_rest.hessian).norm() <= 1e-12 * at_rest.hessian.norm());
+    }
+  }
+}
+
 TEST_CASE("rod stencil: with frames at the current tangents the gradient is PHYSICS_NOTES 3.1's") {
   std::mt19937 rng(7);
   const Case c = random_case(rng, 0.6, 0.0);
@@ -242,12 +276,12 @@ TEST_CASE("rod sections: circular and elliptic moduli, bad input rejected") {
   CHECK_THROWS_AS((void)Section::elliptic(1e9, 0.3, 0.01, NAN), InputError);
 }
 
-TEST_CASE("rod stencil: cost of the closed-form gradient and the AD Hessian (report only)") {
+TEST_CASE("rod stencil: cost of the closed-form gradient, the AD and the Gauss-Newton Hessians (report only)") {
   // The machine is shared: the fastest of 30 batches is the least disturbed estimate.
   std::mt19937 rng(3);
   const Case c = random_case(rng, 0.7, 0.1);
   using clock = std::chrono::steady_clock;
-  double sink = 0, g_us = 1e9, h_us = 1e9;
+  double sink = 0, g_us = 1e9, h_us = 1e9, gn_us = 1e9;
   const int reps = 200;
   for (int batch = 0; batch < 30; ++batch) {
     auto t0 = clock::now();
@@ -255,10 +289,14 @@ TEST_CASE("rod stencil: cost of the closed-form gradient and the AD Hessian (rep
     auto t1 = clock::now();
     for (int k = 0; k < reps; ++k) sink += eval(c, c.q, Want::hessian).hessian(k % 11, 3);
     auto t2 = clock::now();
+    for (int k = 0; k < reps; ++k) sink += eval(c, c.q, Want::gauss_newton).hessian(k % 11, 3);
+    auto t3 = clock::now();
     g_us = std::min(g_us, std::chrono::duration<double, std::micro>(t1 - t0).count() / reps);
     h_us = std::min(h_us, std::chrono::duration<double, std::micro>(t2 - t1).count() / reps);
+    gn_us = std::min(gn_us, std::chrono::duration<double, std::micro>(t3 - t2).count() / reps);
   }
-  MESSAGE("bend-twist stencil (fastest of 30 batches): gradient " << g_us << " us, gradient+Hessian (AD) " << h_us << " us");
+  MESSAGE("bend-twist stencil (fastest of 30 batches): gradient " << g_us << " us, gradient+Hessian (AD) " << h_us
+                                                                   << " us, gradient+Gauss-Newton Hessian " << gn_us << " us");
   CHECK(std::isfinite(sink));
 }
 

@@ -4,8 +4,6 @@
 #include <cmath>
 #include <string>
 
-#include <Eigen/Eigenvalues>
-
 #include "sewn/physics/elements/element_math.hpp"
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/nodes.hpp"
@@ -18,17 +16,6 @@ template <int N>
 Eigen::Matrix<double, N, N> projected(Eigen::Matrix<double, N, N> H) {
   elements::project_psd(H);
   return H;
-}
-
-// The bend-twist stencil's 11×11 with angle DOFs: nearly every one is indefinite on a bent rod
-// (522 of 522 in the sticky hand's first 6 frames), so the eigensolver always runs; its
-// fixed-size instantiation avoids the dynamic one's allocations and loops of unknown length.
-template <>
-Eigen::Matrix<double, 11, 11> projected<11>(Eigen::Matrix<double, 11, 11> H) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 11, 11>> eig(H);
-  const Eigen::Matrix<double, 11, 1> d = eig.eigenvalues();
-  if (d.minCoeff() >= 0.0) return H;
-  return eig.eigenvectors() * d.cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
 }
 
 }  // namespace
@@ -329,6 +316,9 @@ void Rods::add_jacobians_with_angles(const StateView& s, const JacobianRequest& 
   // the PSD stand-in or the exact Hessian (exact_hessian_first): projecting regardless would
   // hand its "exact" pass a Hessian without the bend-twist coupling of a bent rod, and Newton
   // would converge linearly along the soft twist modes (the toy ball's helical spring).
+  // The PSD stand-in is the bend-twist stencils' Gauss-Newton Hessian (closed form, exact at the
+  // natural strains), not the eigen-projection of the AD Hessian: nearly every stencil of a
+  // bent rod is indefinite, and the 11×11 eigensolver was their largest cost.
   const bool project = project_ && req.options.project_element_hessians;
   for (Index r = 0; r < num_rods(); ++r) {
     const Entry& e = rods_[r];
@@ -342,11 +332,11 @@ void Rods::add_jacobians_with_angles(const StateView& s, const JacobianRequest& 
       const auto ed = e.rod.stencil_edges(st);
       const BendTwistEval b = bend_twist(x.col(v[0]), x.col(v[1]), x.col(v[2]), e.rod.theta()[static_cast<std::size_t>(ed[0])],
                                          e.rod.theta()[static_cast<std::size_t>(ed[1])], e.rod.stencil_rest(st),
-                                         e.rod.stencil_frames(st), Want::hessian);
+                                         e.rod.stencil_frames(st), project ? Want::gauss_newton : Want::hessian);
       std::array<Index, 5> block{};
       std::array<int, 11> comp{};
       stencil_blocks(e, st, block, comp);
-      scatter_hessian<11>(project ? projected<11>(b.hessian) : b.hessian, block, comp, stencil_group, slots.subspan(slot), req);
+      scatter_hessian<11>(b.hessian, block, comp, stencil_group, slots.subspan(slot), req);
     }
     const int n = e.rod.num_vertices();
     for (int j = 0; j < e.rod.num_edges(); ++j, slot += 4) {

@@ -118,7 +118,8 @@ class Rods final : public ForceTerm {
   void collect_pairs(std::vector<NodePair>& out) const override;
   void bind_pattern(const BlockMatrix& pattern) override;
   /// −H_xx as described above, at the θ of the last solve (with angles in the system: the
-  /// stencils' full Hessians over positions and angles). O(stencils), a few µs each (AD
+  /// stencils' full Hessians over positions and angles; their PSD stand-in is the bend–twist
+  /// Gauss–Newton Hessian, Want::gauss_newton, 1.5 µs). O(stencils), a few µs each (AD
   /// Hessian, 2.4 µs measured, and a 9×9 eigen-decomposition).
   void add_jacobians(const StateView& s, const JacobianRequest& req) const override;
   void add_stability_rows(const StateView& s, StabilityRows& rows) const override;
