@@ -1,5 +1,7 @@
 #include "sewn/physics/system.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -108,14 +110,78 @@ void StabilityRows::offdiagonal_block(Which w, Index i, Index j, const Eigen::Ma
 
 double StabilityRows::row(Which w, Index i, int axis) const {
   if (!(mass_[i] > 0) || ((fixed_[i] >> axis) & 1u) != 0) return 0.0;
-  const double* d = diag_[w].data() + i;
-  double row = 0;
-  for (int b = 0; b < 3; ++b)
-    if (((fixed_[i] >> b) & 1u) == 0) row += std::abs(d[sym_entry[3 * b + axis] * stride_]);
-  return row / mass_[i] + off_[w][axis * stride_ + i];
+  double rows[1];
+  axis_rows(w, axis, i, i + 1, rows);
+  return rows[0];
+}
+
+// Rows [i0, i1) of `axis` (0 for a fixed axis or a node without mass): the diagonal block's row
+// over the free axes, over the mass, plus the off-diagonal sums. Branch-free, so that the loop
+// vectorizes; row() and bound() both use it, so they agree to the bit.
+void StabilityRows::axis_rows(Which w, int axis, std::size_t i0, std::size_t i1, double* __restrict out) const {
+  const double* __restrict m = mass_.data();
+  const double* __restrict f[3] = {free_.data(), free_.data() + stride_, free_.data() + 2 * stride_};
+  const double* __restrict d[3];
+  for (int b = 0; b < 3; ++b) d[b] = diag_[w].data() + static_cast<std::size_t>(sym_entry[3 * b + axis]) * stride_;
+  const double* __restrict o = off_[w].data() + static_cast<std::size_t>(axis) * stride_;
+  const double* __restrict fa = f[axis];
+  for (std::size_t i = i0; i < i1; ++i) {
+    const double row = (f[0][i] != 0 ? std::abs(d[0][i]) : 0.0) + (f[1][i] != 0 ? std::abs(d[1][i]) : 0.0) +
+                       (f[2][i] != 0 ? std::abs(d[2][i]) : 0.0);
+    const double r = row / m[i] + o[i];
+    const bool keep = (m[i] > 0) & (fa[i] != 0);
+    out[i - i0] = keep ? r : 0.0;
+  }
 }
 
 StabilityRows::Bound StabilityRows::bound(Which w) const {
+  // Blocks of nodes: each block's rows in loops the compiler vectorizes and their largest, then
+  // the node found in the first block holding the overall largest, scanning as the rows are
+  // ordered (node, then axis), so that the node is the first with the largest row.
+  constexpr std::size_t block = 256;
+  const std::size_t n = mass_.size();
+  std::array<std::array<double, block>, 3> rows;
+  double best = 0;
+  std::size_t best_block = n;
+  bool nan = false;
+  for (std::size_t b0 = 0; b0 < n; b0 += block) {
+    const std::size_t b1 = std::min(n, b0 + block);
+    // Four independent maxima (one chain would wait on each compare), and sums that a NaN
+    // row makes NaN (rows are ≥ 0, so an infinite one does not).
+    double top4[4] = {0, 0, 0, 0}, sum4[4] = {0, 0, 0, 0};
+    for (std::size_t a = 0; a < 3; ++a) {
+      axis_rows(w, static_cast<int>(a), b0, b1, rows[a].data());
+      const std::size_t count = b1 - b0;
+      for (std::size_t k = count; k < (count + 3) / 4 * 4; ++k) rows[a][k] = 0;
+      for (std::size_t k = 0; k < count; k += 4)
+        for (std::size_t u = 0; u < 4; ++u) {
+          const double r = rows[a][k + u];
+          top4[u] = r > top4[u] ? r : top4[u];
+          sum4[u] += r;
+        }
+    }
+    nan |= std::isnan((sum4[0] + sum4[1]) + (sum4[2] + sum4[3]));
+    const double top = std::max(std::max(top4[0], top4[1]), std::max(top4[2], top4[3]));
+    if (top > best) {
+      best = top;
+      best_block = b0;
+    }
+  }
+  if (nan) return bound_with_nan(w);
+  Bound out;
+  if (best_block == n) return out;
+  out.value = best;
+  const std::size_t b1 = std::min(n, best_block + block);
+  for (int a = 0; a < 3; ++a) axis_rows(w, a, best_block, b1, rows[static_cast<std::size_t>(a)].data());
+  for (std::size_t k = 0; k < b1 - best_block && out.node == invalid_index; ++k)
+    for (std::size_t a = 0; a < 3; ++a)
+      if (rows[a][k] == best) out.node = static_cast<Index>(best_block + k);
+  return out;
+}
+
+// bound() when a row is NaN: the largest row as the rows come, a NaN taken if it comes before
+// any positive row (then nothing beats it), so that a broken state names a node.
+StabilityRows::Bound StabilityRows::bound_with_nan(Which w) const {
   Bound out;
   for (Index i = 0; i < mass_.size(); ++i) {
     if (!(mass_[i] > 0)) continue;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <span>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -211,6 +212,73 @@ TEST_CASE("stability rows: the springs' eight-lane kernel gives the rows of the 
     }
     CHECK(lanes.bound(StabilityRows::stiffness).value > 0);
     CHECK((lanes.bound(StabilityRows::damping).value > 0) == (model != SpringDamping::none));
+  }
+}
+
+// The bound as rows are read one by one (node, then axis): the first largest row, a NaN row
+// taken if it comes before any positive one. What StabilityRows::bound must give.
+StabilityRows::Bound bound_one_by_one(const StabilityRows& rows, StabilityRows::Which w, std::span<const double> mass,
+                                      std::span<const AxisMask> fixed) {
+  StabilityRows::Bound out;
+  for (Index i = 0; i < mass.size(); ++i)
+    for (int a = 0; a < 3; ++a) {
+      if (!(mass[i] > 0) || ((fixed[i] >> a) & 1u) != 0) continue;
+      const double r = rows.row(w, i, a);
+      if (r > out.value || (std::isnan(r) && out.node == invalid_index)) {
+        out.value = r;
+        out.node = i;
+      }
+    }
+  return out;
+}
+
+TEST_CASE("stability rows: the bound is the first largest row over blocks of nodes, and a NaN row is named") {
+  // 1331 nodes: several of bound()'s blocks of 256. Random states, fixed axes and a removed
+  // node; then equal largest rows in two blocks (the first wins), then a NaN.
+  for (unsigned seed = 1; seed <= 4; ++seed) {
+    CAPTURE(seed);
+    System sys;
+    const BoxLattice L = cube_lattice(sys, 10, 0.1, 1e5, 0.3, 1000, SpringDamping::viscous);
+    for (Index j = 0; j <= 10; ++j) sys.nodes().fix(L.node(0, j, 0), axis_x | axis_z);
+    perturb(sys, 0.2 * 0.1 / 10, 0.0, seed);
+    const Index removed = L.node(5, 5, 5);
+    for (Index s = 0; s < L.springs->size(); ++s)
+      if (L.springs->node_i(s) == removed || L.springs->node_j(s) == removed) L.springs->remove(s);
+    sys.nodes().remove(removed);
+    sys.refresh();
+    sys.compute_forces();  // the chunk plan is built
+    StabilityRows rows(sys.nodes().masses(), sys.nodes().fixed_masks());
+    L.springs->add_stability_rows(sys.state(), rows);
+    for (auto w : {StabilityRows::stiffness, StabilityRows::damping}) {
+      const auto ref = bound_one_by_one(rows, w, sys.nodes().masses(), sys.nodes().fixed_masks());
+      REQUIRE(ref.node != invalid_index);
+      CHECK(rows.bound(w).value == ref.value);
+      CHECK(rows.bound(w).node == ref.node);
+    }
+  }
+  // Two nodes far apart (different blocks) with the same largest row: the lower one is named.
+  {
+    const std::vector<double> mass(600, 1.0);
+    const std::vector<AxisMask> fixed(600, no_axes);
+    StabilityRows rows(mass, fixed);
+    Eigen::Matrix3d B = Eigen::Matrix3d::Identity();
+    for (Index i = 0; i < 600; ++i) rows.add_diagonal(StabilityRows::stiffness, i, (1.0 + 0.001 * (i % 7)) * B);
+    rows.add_diagonal(StabilityRows::stiffness, 510, 5.0 * B);  // 510 ≡ 300 (mod 7): equal rows
+    rows.add_diagonal(StabilityRows::stiffness, 300, 5.0 * B);
+    rows.add_diagonal(StabilityRows::stiffness, 301, 4.0 * B);
+    const auto b = rows.bound(StabilityRows::stiffness);
+    CHECK(b.node == 300);
+    CHECK(b.value == rows.row(StabilityRows::stiffness, 510, 2));
+    // A NaN row after the largest is not the bound (as the rows are read one by one); a NaN row
+    // before any positive row is.
+    rows.add_diagonal(StabilityRows::stiffness, 400, std::nan("") * B);
+    CHECK(rows.bound(StabilityRows::stiffness).node == bound_one_by_one(rows, StabilityRows::stiffness, mass, fixed).node);
+    CHECK(rows.bound(StabilityRows::stiffness).node == 300);
+    StabilityRows first_nan(mass, fixed);
+    first_nan.add_diagonal(StabilityRows::stiffness, 0, std::nan("") * B);
+    for (Index i = 1; i < 600; ++i) first_nan.add_diagonal(StabilityRows::stiffness, i, B);
+    CHECK(first_nan.bound(StabilityRows::stiffness).node == 0);
+    CHECK(std::isnan(first_nan.bound(StabilityRows::stiffness).value));
   }
 }
 

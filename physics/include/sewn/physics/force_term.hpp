@@ -138,6 +138,8 @@ class StabilityRows {
   void offdiagonal_block(Which w, Index i, Index j, const Eigen::Matrix3d& B);
   void add_pair_folded(Index i, Index j, const SymBlock& K, const SymBlock& C);
   [[nodiscard]] bool fold_is_slave(Index i) const;
+  void axis_rows(Which w, int axis, std::size_t i0, std::size_t i1, double* out) const;
+  [[nodiscard]] Bound bound_with_nan(Which w) const;
   std::span<const double> mass_;
   const SlaveExpansion* fold_ = nullptr;
   std::span<const AxisMask> fixed_;
