@@ -122,6 +122,22 @@ physics::EnergyWatchdog::State get_watchdog(Decoder& d) {
   return w;
 }
 
+void put_solver(Encoder& e, const physics::solve::SolverState& s) {
+  e.put(s.factored);
+  e.put<std::uint8_t>(s.refresh_due);
+  e.put(s.cycle_solves);
+  e.put(s.cycle_iterations);
+}
+
+physics::solve::SolverState get_solver(Decoder& d) {
+  physics::solve::SolverState s;
+  d.get(s.factored, "factored matrix");
+  s.refresh_due = d.flag("factorization refresh flag");
+  s.cycle_solves = d.get<std::uint64_t>("solves since the factorization");
+  s.cycle_iterations = d.get<std::uint64_t>("iterations since the factorization");
+  return s;
+}
+
 void put_vec3s(Encoder& e, const std::vector<physics::rods::Vec3>& v) {
   std::vector<double> flat;
   for (const auto& p : v) flat.insert(flat.end(), {p.x(), p.y(), p.z()});
@@ -195,12 +211,11 @@ std::string encode_payload(const Checkpoint& c) {
   e.put(c.implicit.warm_start);
   e.put(c.implicit.steps);
   put_watchdog(e, c.implicit.watchdog);
-  e.put(c.implicit.solver.factored);
-  e.put<std::uint8_t>(c.implicit.solver.refresh_due);
-  e.put(c.implicit.solver.cycle_solves);
-  e.put(c.implicit.solver.cycle_iterations);
+  put_solver(e, c.implicit.solver);
   e.put(c.midpoint.steps);
   put_watchdog(e, c.midpoint.watchdog);
+  put_solver(e, c.newton.solver);
+  e.put<std::uint8_t>(c.newton.direct_failed);
   const auto& l = c.ledger;
   for (double x : {l.total0, l.external0, l.last_total, l.last_moving, l.last_external}) e.put(x);
   e.put(l.rises);
@@ -271,12 +286,11 @@ Checkpoint decode_payload(Decoder& d) {
   d.get(c.implicit.warm_start, "warm start");
   c.implicit.steps = d.get<std::uint64_t>("implicit steps");
   c.implicit.watchdog = get_watchdog(d);
-  d.get(c.implicit.solver.factored, "factored matrix");
-  c.implicit.solver.refresh_due = d.flag("factorization refresh flag");
-  c.implicit.solver.cycle_solves = d.get<std::uint64_t>("solves since the factorization");
-  c.implicit.solver.cycle_iterations = d.get<std::uint64_t>("iterations since the factorization");
+  c.implicit.solver = get_solver(d);
   c.midpoint.steps = d.get<std::uint64_t>("midpoint steps");
   c.midpoint.watchdog = get_watchdog(d);
+  c.newton.solver = get_solver(d);
+  c.newton.direct_failed = d.flag("Newton's direct factorization failure flag");
   auto& l = c.ledger;
   for (double* x : {&l.total0, &l.external0, &l.last_total, &l.last_moving, &l.last_external}) *x = d.get<double>("energy ledger");
   l.rises = d.get<std::uint64_t>("energy rises");

@@ -305,6 +305,7 @@ void RunLoop::restore_integrators() {
     semi_.restore(model_.system(), ck_.semi);
     implicit_.restore(model_.system(), ck_.implicit);
     midpoint_.restore(model_.system(), ck_.midpoint);
+    if (use_newton_) newton_.restore(model_.system(), ck_.newton);
   } catch (const physics::InputError& e) {
     throw CheckpointError(options_.resume.string(), e.what());
   }
@@ -392,6 +393,7 @@ void RunLoop::save_checkpoint(double wall) {
   c.semi = semi_.history(model_.system());
   if (use_implicit_ && !use_midpoint_) c.implicit = implicit_.history(model_.system());
   if (use_midpoint_) c.midpoint = midpoint_.history(model_.system());
+  if (use_newton_) c.newton = newton_.history(model_.system());
   c.ledger = ledger_.state();
   if (b_.refinement) c.refinement = b_.refinement->state();
   if (b_.continuum.rods) c.rods = b_.continuum.rods->history();

@@ -300,6 +300,10 @@ TEST_CASE("the CHOLMOD backends resume to the same bytes: cholmod-pcg's kept fac
   SUBCASE("cholmod, a plane cut before the checkpoint") {
     check_continuation("direct", beam("direct", R"({"type": "implicit", "step": 0.002, "solver": "cholmod"})", plane_cut), 5, {1});
   }
+  SUBCASE("Newton with cholmod-pcg (its factorization kept across steps), stopped at every frame") {
+    check_continuation("newton_pcg", beam("newton_pcg", R"({"type": "newton", "step": 0.002, "solver": "cholmod-pcg"})", plane_cut), 1,
+                       {1, 1, 1, 1});
+  }
 }
 
 TEST_CASE("a run killed at any moment after its first checkpoint resumes to the same bytes") {
@@ -343,11 +347,13 @@ TEST_CASE("a checkpoint that is not this run's, or not whole, is refused with ex
   SUBCASE("another format version") {
     std::string bad = bytes;
     bad[8] = 1;  // the format before rods, solver state and the energy-ratio peak
-    check_refused(saved, put("v1.checkpoint", bad), "format version 1, but this sewn reads version 3 only");
+    check_refused(saved, put("v1.checkpoint", bad), "format version 1, but this sewn reads version 4 only");
     bad[8] = 2;  // the format before angle DOFs, connection histories and the refresh rule's counters
-    check_refused(saved, put("v2.checkpoint", bad), "format version 2, but this sewn reads version 3 only");
-    bad[8] = 4;
-    check_refused(saved, put("v4.checkpoint", bad), "format version 4, but this sewn reads version 3 only");
+    check_refused(saved, put("v2.checkpoint", bad), "format version 2, but this sewn reads version 4 only");
+    bad[8] = 3;  // the format before Newton's solver state
+    check_refused(saved, put("v3.checkpoint", bad), "format version 3, but this sewn reads version 4 only");
+    bad[8] = 5;
+    check_refused(saved, put("v5.checkpoint", bad), "format version 5, but this sewn reads version 4 only");
   }
   SUBCASE("not a checkpoint") { check_refused(saved, saved.scene, "not a Sewn checkpoint"); }
   SUBCASE("missing") { check_refused(saved, scratch("nowhere.checkpoint"), "cannot be opened: No such file or directory"); }
@@ -451,6 +457,8 @@ TEST_CASE("the checkpoint format: every field comes back, and every shorter file
   c.implicit.watchdog = {true, true, 13, 14, 15, 16};
   c.implicit.solver = {{1.5, -2.5, 3.5}, true, 42, 43};
   c.midpoint = {34, {true, true, 35, 36, 37, 38}};
+  c.newton.solver = {{4.5, -5.5}, true, 44, 45};
+  c.newton.direct_failed = true;
   c.ledger = {17, 18, 19, 20, 21, 22, 41};
   sewn::physics::rods::Rods::RodHistory rod;
   rod.rod.theta = {0.1, 0.2};
@@ -493,6 +501,11 @@ TEST_CASE("the checkpoint format: every field comes back, and every shorter file
   CHECK(d.implicit.solver.refresh_due);
   CHECK(d.implicit.solver.cycle_solves == 42);
   CHECK(d.implicit.solver.cycle_iterations == 43);
+  CHECK(d.newton.solver.factored == c.newton.solver.factored);
+  CHECK(d.newton.solver.refresh_due);
+  CHECK(d.newton.solver.cycle_solves == 44);
+  CHECK(d.newton.solver.cycle_iterations == 45);
+  CHECK(d.newton.direct_failed);
   REQUIRE(d.rods.size() == 2);
   CHECK(d.rods[0].rod.theta == rod.rod.theta);
   CHECK(d.rods[0].rod.director[1] == rod.rod.director[1]);

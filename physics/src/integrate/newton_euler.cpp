@@ -253,8 +253,8 @@ void NewtonEuler::limit_term_step(const System& sys, double& slope, NewtonReport
   ++rep.term_step_limits;
 }
 
-int NewtonEuler::solve_kept_pcg(const BlockMatrix& A, double tolerance) {
-  const std::size_t n = dof_count();
+solve::LinearSolver& NewtonEuler::kept_pcg() {
+  if (!ldlt_) ldlt_ = std::make_unique<LdltCache>();
   if (!ldlt_->kept_pcg) {
     if (!solve::available(solve::Backend::cholmod_pcg))
       throw InputError("newton euler: the solver cholmod-pcg needs CHOLMOD, which this build lacks");
@@ -264,18 +264,45 @@ int NewtonEuler::solve_kept_pcg(const BlockMatrix& A, double tolerance) {
     o.max_iterations = opt_.cg_max_iterations;
     ldlt_->kept_pcg = solve::make_solver(solve::Backend::cholmod_pcg, o);
   }
-  ldlt_->kept_pcg->options().tolerance = tolerance;
+  return *ldlt_->kept_pcg;
+}
+
+int NewtonEuler::solve_kept_pcg(const BlockMatrix& A, double tolerance) {
+  const std::size_t n = dof_count();
+  solve::LinearSolver& solver = kept_pcg();
+  solver.options().tolerance = tolerance;
   try {
-    const solve::SolveReport r = ldlt_->kept_pcg->solve(A, std::span<const double>(rhs_.data(), n),
-                                                        std::span<double>(p_.data(), n), std::span<const double>(free_.data(), n));
+    const solve::SolveReport r = solver.solve(A, std::span<const double>(rhs_.data(), n), std::span<double>(p_.data(), n),
+                                              std::span<const double>(free_.data(), n));
     return r.iterations;
   } catch (const SolverError&) {
     // A fresh factorization of the projected H failed (round-off on a semi-definite matrix):
     // p = 0 is no descent, and step() falls back on the scaled gradient.
     std::fill(p_.begin(), p_.begin() + static_cast<std::ptrdiff_t>(n), 0.0);
-    ldlt_->kept_pcg->reset();
+    solver.reset();
     return 0;
   }
+}
+
+NewtonEuler::History NewtonEuler::history(const System& sys) const {
+  History h;
+  if (!ldlt_) return h;
+  h.direct_failed = ldlt_->cholmod_failed;
+  if (ldlt_->kept_pcg && sys.topology_key() == kept_topology_) h.solver = ldlt_->kept_pcg->state();
+  return h;
+}
+
+void NewtonEuler::restore(System& sys, const History& h) {
+  if (!h.direct_failed && h.solver.factored.empty() && !h.solver.refresh_due && h.solver.cycle_solves == 0) {
+    ldlt_.reset();
+    return;
+  }
+  ldlt_ = std::make_unique<LdltCache>();
+  ldlt_->cholmod_failed = h.direct_failed;
+  if (h.solver.factored.empty() && !h.solver.refresh_due && h.solver.cycle_solves == 0) return;
+  sys.refresh();
+  kept_pcg().restore(sys.matrix(), h.solver);
+  kept_topology_ = sys.topology_key();
 }
 
 void NewtonEuler::steepest_descent(const BlockMatrix& A, double& slope, double& pmax) {
@@ -452,6 +479,7 @@ NewtonReport NewtonEuler::step(System& sys, double h) {
     if (free_[k] != 0.0) angles.rates()[a] = (q_[k] - xn_[k]) / h;
   }
   nodes.mark_state_finite();
+  if (opt_.solver == LinearSolver::cholmod_pcg) kept_topology_ = sys.topology_key();
   // History frozen within the step (rods' time-parallel frames, connections' accepted twist)
   // moves on to the accepted state.
   sys.step_accepted();

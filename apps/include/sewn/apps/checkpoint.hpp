@@ -15,7 +15,8 @@
 //   - the integrator's history (symplectic Euler's cached stable step; linearly implicit
 //     Euler's warm start and, with cholmod-pcg, the matrix its kept factorization was made
 //     of; the step counters and energy watchdogs of these two and of the implicit midpoint
-//     rule; Newton's backward Euler keeps none) and the energy ledger;
+//     rule; Newton's backward Euler's kept cholmod-pcg factorization, as linearly implicit
+//     Euler's, and whether its direct factorization once failed) and the energy ledger;
 //   - the rods' own state: material angles θ, time-parallel reference frames, tracked
 //     reference twists, and the positions θ was last solved at;
 //   - the system's angle DOFs and their rates (the rods' θ, when connections make them DOFs),
@@ -43,6 +44,7 @@
 
 #include "sewn/physics/integrate/energy_ledger.hpp"
 #include "sewn/physics/integrate/implicit_midpoint.hpp"
+#include "sewn/physics/integrate/newton_euler.hpp"
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/rods/rods_term.hpp"
 #include "sewn/apps/refine_keys.hpp"
@@ -75,7 +77,7 @@ struct AppliedCut {
 };
 
 struct Checkpoint {
-  static constexpr std::uint32_t format_version = 3;
+  static constexpr std::uint32_t format_version = 4;
 
   std::uint64_t run_hash = 0;    ///< the scene's text, its built model, steps and frames
   std::uint64_t model_hash = 0;  ///< the model's tables after the cuts below
@@ -90,6 +92,7 @@ struct Checkpoint {
   physics::SymplecticEuler::History semi;
   physics::LinearlyImplicitEuler::History implicit;
   physics::ImplicitMidpoint::History midpoint;
+  physics::integrate::NewtonEuler::History newton;
   physics::EnergyLedger::State ledger;
   std::vector<physics::rods::Rods::RodHistory> rods;  ///< per rod of the scene, in build order
   std::vector<double> angles, angle_rates;  ///< the system's angle DOFs (rods' θ when connections hold them)

@@ -68,6 +68,7 @@
 #include "sewn/physics/cg.hpp"
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/system.hpp"
+#include "sewn/physics/solve/linear_solver.hpp"
 
 namespace sewn::physics::integrate {
 
@@ -155,6 +156,22 @@ class NewtonEuler {
   /// monotone decrease). Valid after a step; evaluates with that step's q_n, v_n and h.
   [[nodiscard]] double incremental_potential(const System& sys, std::span<const double> q);
 
+  /// What a step reads from earlier steps besides the system's state, for a checkpoint:
+  /// cholmod-pcg's factorization of an earlier matrix and its refresh rule (solve::SolverState:
+  /// which matrix was factored decides every later iterate), and whether CHOLMOD's direct
+  /// factorization once failed (ldlt uses the simplicial LDLᵀ from then on).
+  struct History {
+    solve::SolverState solver;
+    bool direct_failed = false;
+  };
+  /// The solver's state is left out (empty) when the topology changed since its last solve:
+  /// the next solve starts afresh on the new pattern anyway.
+  [[nodiscard]] History history(const System& sys) const;
+  /// Takes up a history of a run of the same system (its topology rebuilt as it was). Throws
+  /// InputError if the solver state does not fit the system's pattern, SolverError if the
+  /// stored matrix cannot be factored. O(factorization).
+  void restore(System& sys, const History& h);
+
  private:
   struct LdltCache;
   void prepare(System& sys, double h);
@@ -178,6 +195,8 @@ class NewtonEuler {
   void predict(const System& sys, NewtonReport& rep);
   // Scales p_ and its slope gᵀp to the fraction of it the terms allow from q_.
   void limit_term_step(const System& sys, double& slope, NewtonReport& rep);
+  // The cholmod-pcg backend, made on first use.
+  solve::LinearSolver& kept_pcg();
   // solve_linear() for LinearSolver::cholmod_pcg; returns the CG iterations.
   // Its relative tolerance given; starts from p_ as it is.
   int solve_kept_pcg(const BlockMatrix& A, double tolerance);
@@ -200,6 +219,7 @@ class NewtonEuler {
   AlignedVector<double> xn_, vn_, qhat_, q_, trial_, inertia_, free_, condensed_, length_, g_, f_, fv_, f0_, vel_, p_, rhs_, precond_, zeros_;
   CgWorkspace ws_;
   std::unique_ptr<LdltCache> ldlt_;
+  std::uint64_t kept_topology_ = ~std::uint64_t{0};  // the system's topology at the kept factor's last solve
 };
 
 }  // namespace sewn::physics::integrate
