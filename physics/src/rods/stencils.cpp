@@ -24,11 +24,11 @@ struct Geometry {
   Vec3 t[2], tb[2];   // current and start-of-step tangents
   Vec3 m1[2], m2[2];  // material directors
   Vec3 kb;            // curvature binormal 2 t0×t1/χ, χ = 1 + t0·t1
-  Vec3 spin[2];       // w_j = −κ̂_j/(2 l_j): the transported frame's spin is w_j·de_j
+  Vec3 spin[2];       // w_j = −κ̂_j/(2 l_j): the transported frame's spin is w_j·de_j (derivatives only)
   double kappa1, kappa2, twist, reference_twist;
 };
 
-Geometry geometry(const Q& q, const BendTwistFrames& f) {
+Geometry geometry(const Q& q, const BendTwistFrames& f, bool derivatives) {
   Geometry g;
   const Vec3 e[2] = {q.segment<3>(3) - q.segment<3>(0), q.segment<3>(6) - q.segment<3>(3)};
   const Vec3 director[2] = {f.director0, f.director1};
@@ -44,7 +44,7 @@ Geometry geometry(const Q& q, const BendTwistFrames& f) {
     const double c = std::cos(q[9 + j]), s = std::sin(q[9 + j]);
     g.m1[j] = c * a[j] + s * b;
     g.m2[j] = c * b - s * a[j];
-    g.spin[j] = (-1.0 / ((1.0 + g.tb[j].dot(g.t[j])) * g.l[j])) * g.tb[j].cross(g.t[j]);
+    if (derivatives) g.spin[j] = (-1.0 / ((1.0 + g.tb[j].dot(g.t[j])) * g.l[j])) * g.tb[j].cross(g.t[j]);
   }
   g.chi = 1.0 + g.t[0].dot(g.t[1]);
   g.kb = (2.0 / g.chi) * g.t[0].cross(g.t[1]);
@@ -96,27 +96,22 @@ Mat3 cross_matrix(const Vec3& a) {
   return A;
 }
 
-// Second derivative of a·t(e), t = e/|e|, for a fixed a: −(a tᵀ + t aᵀ + (a·t)(I − 3ttᵀ))/l².
-Mat3 unit_hessian(const Vec3& t, double l, const Vec3& a) {
-  return -(a * t.transpose() + t * a.transpose() + a.dot(t) * (Mat3::Identity() - 3.0 * t * t.transpose())) / (l * l);
-}
-
 // ∂w/∂e for the spin w = −(t̄×t)/(μ l), μ = 1 + t̄·t: with dt = P de/l (P = I − ttᵀ) and dl = t·de,
-// dw = −[t̄×dt/(μl) − (t̄×t)(t̄·dt)/(μ²l) − (t̄×t)dl/(μl²)].
+// dw = −[t̄×dt/(μl) − (t̄×t)(t̄·dt)/(μ²l) − (t̄×t)dl/(μl²)], and [t̄]×P = [t̄]× − (t̄×t)tᵀ.
 Mat3 spin_jacobian(const Vec3& tb, const Vec3& t, double l) {
   const double mu = 1.0 + tb.dot(t);
   const Vec3 n = tb.cross(t);
-  const Mat3 T = (Mat3::Identity() - t * t.transpose()) / l;
-  return (-1.0 / (mu * l)) * (cross_matrix(tb) * T - n * (T * tb).transpose() / mu - n * t.transpose() / l);
+  const Vec3 tb_across = tb - t.dot(tb) * t;
+  return (-1.0 / (mu * l * l)) * (cross_matrix(tb) - 2.0 * n * t.transpose() - n * tb_across.transpose() / mu);
 }
 
 // ∇²L over (e0, e1, θ0, θ1) for fixed weights: the second variation of dL above, term by term
 // (docs/rods.md, "The exact Hessian"). Several terms are not symmetric on their own (the spin is
-// not a differential); their sum is, and the result is symmetrised for round-off.
+// not a differential); their sum is. H accumulates a matrix whose symmetric part is ∇²L, so a
+// symmetric pair A + Aᵀ enters as 2A, and is symmetrised at the end.
 Mat8 weighted_hessian(const Geometry& g, const Weights& w) {
   Mat8 H = Mat8::Zero();
   const Vec3 v[2] = {bend_vector(g, w, 0), bend_vector(g, w, 1)};
-  const Vec3 u[2] = {turned_bend_vector(g, w, 0), turned_bend_vector(g, w, 1)};
   const Vec3 c = v[0] + v[1];
   const std::array<double, 2> sigma = spin_weights(g, w);
   const double f = c.dot(g.kb);
@@ -126,36 +121,44 @@ Mat8 weighted_hessian(const Geometry& g, const Weights& w) {
   // ∂κb/∂e_j.
   const Mat3 K[2] = {(-2.0 * cross_matrix(g.t[1]) - g.kb * ts.transpose()) / (g.l[0] * g.chi),
                      (2.0 * cross_matrix(g.t[0]) - g.kb * ts.transpose()) / (g.l[1] * g.chi)};
-  // c·∇²κb: κb·c = 2c·(t0×t1)/χ as a function of the unit tangents (partials a_j, second
-  // partials F), chained through t_j(e_j).
+  // c·∇²κb: κb·c = 2c·(t0×t1)/χ as a function of the unit tangents, with partials a_j and second
+  // partials F_00 = −(t1a_0ᵀ + a_0t1ᵀ)/χ, F_11 = −(t0a_1ᵀ + a_1t0ᵀ)/χ, F_01, chained through
+  // t_j(e_j): T_j F_jj T_j = −(P_j t_k)(P_j a_j)ᵀ/(χ l_j²) + its transpose (k the other edge),
+  // plus a_j·∂²t_j = −(a_j t_jᵀ + t_j a_jᵀ + (a_j·t_j)(I − 3t_jt_jᵀ))/l_j².
   const Vec3 a[2] = {(2.0 * g.t[1].cross(c) - f * g.t[1]) / g.chi, (-2.0 * g.t[0].cross(c) - f * g.t[0]) / g.chi};
-  const Mat3 F00 = -(g.t[1] * a[0].transpose() + a[0] * g.t[1].transpose()) / g.chi;
-  const Mat3 F11 = -(g.t[0] * a[1].transpose() + a[1] * g.t[0].transpose()) / g.chi;
+  for (int j = 0; j < 2; ++j) {
+    const Vec3& tj = g.t[j];
+    const Vec3& tk = g.t[1 - j];
+    const double l2 = g.l[j] * g.l[j];
+    const Vec3 tk_across = tk - tj.dot(tk) * tj, aj_across = a[j] - tj.dot(a[j]) * tj;
+    H.block<3, 3>(3 * j, 3 * j) = (-2.0 / (g.chi * l2)) * tk_across * aj_across.transpose() +
+                                  (-1.0 / l2) * (2.0 * a[j] * tj.transpose() + a[j].dot(tj) * (Mat3::Identity() - 3.0 * tj * tj.transpose()));
+  }
   const Mat3 F01 = (-2.0 * cross_matrix(c) - f * Mat3::Identity() - g.t[1] * a[1].transpose() - a[0] * g.t[0].transpose()) / g.chi;
-  H.block<3, 3>(0, 0) = T[0] * F00 * T[0] + unit_hessian(g.t[0], g.l[0], a[0]);
-  H.block<3, 3>(3, 3) = T[1] * F11 * T[1] + unit_hessian(g.t[1], g.l[1], a[1]);
-  H.block<3, 3>(0, 3) = T[0] * F01 * T[1];
-  H.block<3, 3>(3, 0) = H.block<3, 3>(0, 3).transpose();
+  H.block<3, 3>(0, 3) = 2.0 * T[0] * F01 * T[1];
   for (int j = 0; j < 2; ++j) {
     const int ej = 3 * j;
     const double l2 = g.l[j] * g.l[j];
-    // c turns with the frames: its tilt (dc = −t_j(v_j·dt_j)) against dκb, since t_j·dκb = −κb·dt_j ...
+    // c turns with the frames: its tilt (dc = −t_j(v_j·dt_j)) against dκb, since t_j·dκb = −κb·dt_j.
     H.block<3, 3>(ej, ej) += g.kb * v[j].transpose() / l2;
-    // ... and the spin of v_j against dκb (both orders).
-    Vec8 Ku = Vec8::Zero(), S = Vec8::Zero();
-    Ku.segment<3>(0) = K[0].transpose() * u[j];
-    Ku.segment<3>(3) = K[1].transpose() * u[j];
-    S.segment<3>(ej) = g.spin[j];
-    S[6 + j] = 1.0;
-    H.noalias() += Ku * S.transpose() + S * Ku.transpose();
-    // σ_j's own spin: dσ_j ⊃ −(κb·v_j) s_j.
-    H.noalias() -= g.kb.dot(v[j]) * S * S.transpose();
+    // The spin s_j (gradient S: w_j at e_j, 1 at θ_j) turns v_j by u_j against dκb, in c·dκb and
+    // in σ_j, a symmetric pair; and σ_j's own spin, dσ_j ⊃ −(κb·v_j) s_j: together
+    // 2·sym((∇(u_j·κb) − ½(κb·v_j)S) Sᵀ).
+    const Vec3 u = turned_bend_vector(g, w, j);
+    Vec8 X = Vec8::Zero();
+    X.segment<3>(0) = K[0].transpose() * u;
+    X.segment<3>(3) = K[1].transpose() * u;
+    const double half_kv = 0.5 * g.kb.dot(v[j]);
+    X.segment<3>(ej) -= half_kv * g.spin[j];
+    X[6 + j] -= half_kv;
+    H.middleCols<3>(ej).noalias() += 2.0 * X * g.spin[j].transpose();
+    H.col(6 + j) += 2.0 * X;
     // The spin's coefficient w_j(e_j) varies.
     H.block<3, 3>(ej, ej) += sigma[j] * spin_jacobian(g.tb[j], g.t[j], g.l[j]);
     // The twist's ½κb·dt_j: κb and t_j vary (κb·t_j = 0 drops the rest of t_j's second derivative).
     H.block<3, 3>(ej, 0) += (0.5 * w.m) * T[j] * K[0];
     H.block<3, 3>(ej, 3) += (0.5 * w.m) * T[j] * K[1];
-    H.block<3, 3>(ej, ej) -= (0.5 * w.m / l2) * (g.kb * g.t[j].transpose() + g.t[j] * g.kb.transpose());
+    H.block<3, 3>(ej, ej) -= (w.m / l2) * g.kb * g.t[j].transpose();
   }
   return 0.5 * (H + H.transpose());
 }
@@ -308,7 +311,7 @@ Eigen::Matrix<double, 6, 6> stretch_hessian_psd(const Vec3& x0, const Vec3& x1, 
 BendTwistEval bend_twist(const Vec3& x0, const Vec3& x1, const Vec3& x2, double theta0, double theta1,
                          const BendTwistRest& rest, const BendTwistFrames& frames, Want want) {
   BendTwistEval out;
-  const Geometry g = geometry(pack(x0, x1, x2, theta0, theta1), frames);
+  const Geometry g = geometry(pack(x0, x1, x2, theta0, theta1), frames, want != Want::energy);
   const Strains s = strains(g, rest);
   out.energy = 0.5 * (s.stiffness[0] * s.d[0] * s.d[0] + s.stiffness[1] * s.d[1] * s.d[1] + s.stiffness[2] * s.d[2] * s.d[2]);
   out.kappa1 = g.kappa1;
@@ -326,7 +329,7 @@ BendTwistEval bend_twist(const Vec3& x0, const Vec3& x1, const Vec3& x2, double 
 
 MaterialStrains material_strains(const Vec3& x0, const Vec3& x1, const Vec3& x2, double theta0, double theta1,
                                  const BendTwistFrames& frames) {
-  const Geometry g = geometry(pack(x0, x1, x2, theta0, theta1), frames);
+  const Geometry g = geometry(pack(x0, x1, x2, theta0, theta1), frames, false);
   return {g.kappa1, g.kappa2, g.twist, g.reference_twist};
 }
 
