@@ -118,7 +118,7 @@ enum class Want { energy, gradient, hessian, angle_hessian, gauss_newton };
 
 /// Evaluates the bend–twist stencil. Everything is closed form (PHYSICS_NOTES §3.1 plus the
 /// transported frames' spin; the Hessian's second variation is derived in docs/rods.md), O(1):
-/// measured 0.34 µs for the gradient, 0.67 µs with the Gauss–Newton Hessian, 1.07 µs with the
+/// measured 0.35 µs for the gradient, 0.71 µs with the Gauss–Newton Hessian, 1.08 µs with the
 /// exact Hessian (docs/rods.md). Near a kink of 180° (1 + t^{i−1}·t^i → 0) the energy grows
 /// like tan²(φ/2) and the values become non-finite at exactly 180°; callers check finiteness.
 [[nodiscard]] BendTwistEval bend_twist(const Vec3& x0, const Vec3& x1, const Vec3& x2, double theta0, double theta1,
