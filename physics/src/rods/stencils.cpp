@@ -155,31 +155,41 @@ Mat8 weighted_hessian(const Geometry& g, const Weights& w) {
     H.col(6 + j) += 2.0 * X;
     // The spin's coefficient w_j(e_j) varies.
     H.block<3, 3>(ej, ej) += sigma[j] * spin_jacobian(g.tb[j], g.t[j], g.l[j]);
-    // The twist's ½κb·dt_j: κb and t_j vary (κb·t_j = 0 drops the rest of t_j's second derivative).
-    H.block<3, 3>(ej, 0) += (0.5 * w.m) * T[j] * K[0];
-    H.block<3, 3>(ej, 3) += (0.5 * w.m) * T[j] * K[1];
-    H.block<3, 3>(ej, ej) -= (w.m / l2) * g.kb * g.t[j].transpose();
+    // The twist's ½κb·dt_j: κb varies, T_j K_k = (K_k + δ_jk t_j κbᵀ/l_j)/l_j (P_j κb = κb,
+    // P_j[t_j]× = [t_j]×, and t0×t1 = ½χκb); and t_j does, −½(κb t_jᵀ + t_j κbᵀ)/l_j² (κb·t_j = 0
+    // drops the rest of t_j's second derivative). The t_j κbᵀ terms cancel in the symmetric part.
+    H.block<3, 3>(ej, 0) += (0.5 * w.m / g.l[j]) * K[0];
+    H.block<3, 3>(ej, 3) += (0.5 * w.m / g.l[j]) * K[1];
+    H.block<3, 3>(ej, ej) -= (0.5 * w.m / l2) * g.kb * g.t[j].transpose();
   }
   return 0.5 * (H + H.transpose());
 }
 
 // An (e0, e1, θ0, θ1) gradient or Hessian in the stencil's DOFs (x0, x1, x2, θ0, θ1):
 // ∂/∂x0 = −∂/∂e0, ∂/∂x1 = ∂/∂e0 − ∂/∂e1, ∂/∂x2 = ∂/∂e1.
-template <int C>
-Eigen::Matrix<double, 11, C> expand_rows(const Eigen::Matrix<double, 8, C>& m) {
-  Eigen::Matrix<double, 11, C> out;
-  out.template middleRows<3>(0) = -m.template middleRows<3>(0);
-  out.template middleRows<3>(3) = m.template middleRows<3>(0) - m.template middleRows<3>(3);
-  out.template middleRows<3>(6) = m.template middleRows<3>(3);
-  out.template middleRows<2>(9) = m.template middleRows<2>(6);
+Eigen::Matrix<double, 11, 1> expand(const Vec8& g) {
+  Eigen::Matrix<double, 11, 1> out;
+  out << -g.segment<3>(0), g.segment<3>(0) - g.segment<3>(3), g.segment<3>(3), g.segment<2>(6);
   return out;
 }
 
-// Of a symmetric H: the sums and differences are rounded in different orders above and below
-// the diagonal, so the upper triangle is mirrored to keep the result exactly symmetric.
+// Of a symmetric H, blockwise: with E_jk its (e_j, e_k) blocks and A_j its (e_j, θ) rows, the
+// position blocks are E00, E01 − E00, −E01 | E00 − E01 − E10 + E11, E01 − E11 | E11. Only the
+// upper triangle is formed, and mirrored: the result is exactly symmetric.
 Eigen::Matrix<double, 11, 11> expand(const Mat8& H) {
-  const Eigen::Matrix<double, 11, 8> rows = expand_rows<8>(H);
-  Eigen::Matrix<double, 11, 11> out = expand_rows<11>(Eigen::Matrix<double, 8, 11>(rows.transpose()));
+  const Mat3 E00 = H.block<3, 3>(0, 0), E01 = H.block<3, 3>(0, 3), E11 = H.block<3, 3>(3, 3);
+  const Eigen::Matrix<double, 3, 2> A0 = H.block<3, 2>(0, 6), A1 = H.block<3, 2>(3, 6);
+  Eigen::Matrix<double, 11, 11> out;
+  out.block<3, 3>(0, 0) = E00;
+  out.block<3, 3>(0, 3) = E01 - E00;
+  out.block<3, 3>(0, 6) = -E01;
+  out.block<3, 3>(3, 3) = E00 - E01 - E01.transpose() + E11;
+  out.block<3, 3>(3, 6) = E01 - E11;
+  out.block<3, 3>(6, 6) = E11;
+  out.block<3, 2>(0, 9) = -A0;
+  out.block<3, 2>(3, 9) = A0 - A1;
+  out.block<3, 2>(6, 9) = A1;
+  out.block<2, 2>(9, 9) = H.block<2, 2>(6, 6);
   out.triangularView<Eigen::StrictlyLower>() = out.transpose();
   return out;
 }
@@ -320,10 +330,10 @@ BendTwistEval bend_twist(const Vec3& x0, const Vec3& x1, const Vec3& x2, double 
   out.reference_twist = g.reference_twist;
   if (want == Want::energy) return out;
   const Weights w{s.stiffness[0] * s.d[0], s.stiffness[1] * s.d[1], s.stiffness[2] * s.d[2]};  // ∂E/∂s
-  out.gradient = expand_rows<1>(weighted_gradient(g, w));
+  out.gradient = expand(weighted_gradient(g, w));
   if (want == Want::angle_hessian) out.hessian.bottomRightCorner<2, 2>() = angle_hessian(g, s, w);
   if (want == Want::gauss_newton) out.hessian = expand(gauss_newton(g, s));
-  if (want == Want::hessian) out.hessian = expand(gauss_newton(g, s) + weighted_hessian(g, w));
+  if (want == Want::hessian) out.hessian = expand(Mat8(gauss_newton(g, s) + weighted_hessian(g, w)));
   return out;
 }
 
