@@ -302,13 +302,21 @@ void scatter_hessian(const Eigen::Matrix<double, N, N>& H, std::span<const Index
     while (i < std::size_t{N} && static_cast<std::size_t>(group[i]) == g) ++i;
   }
   first[groups] = N;
+  // A node's group holds its 3 components in order: its blocks are whole 3×3 blocks of H.
+  std::array<bool, N> whole{};
+  for (std::size_t g = 0; g < groups; ++g)
+    whole[g] = first[g + 1] - first[g] == 3 && comp[first[g]] == 0 && comp[first[g] + 1] == 1 && comp[first[g] + 2] == 2;
   if (req.matrix)
     for (std::size_t gi = 0; gi < groups; ++gi)
       for (std::size_t gj = 0; gj < groups; ++gj) {
-        double* b = req.matrix->block(slots[gi * groups + gj]).data();  // column-major 3×3
+        BlockMatrix::BlockMap b = req.matrix->block(slots[gi * groups + gj]);
+        if (whole[gi] && whole[gj]) {
+          b.noalias() -= req.cx * H.template block<3, 3>(static_cast<Eigen::Index>(first[gi]), static_cast<Eigen::Index>(first[gj]));
+          continue;
+        }
         for (std::size_t i = first[gi]; i < first[gi + 1]; ++i)
           for (std::size_t j = first[gj]; j < first[gj + 1]; ++j)
-            b[comp[i] + 3 * comp[j]] -= req.cx * H(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
+            b(comp[i], comp[j]) -= req.cx * H(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
       }
   if (req.product_in.empty()) return;
   std::array<std::size_t, N> flat{};
