@@ -111,7 +111,7 @@ TEST_CASE("rod stencil: bend-twist gradient and Hessian match finite differences
   // (χ = 1 − cos(φ) ≈ 1.5e-4: the energy scales like 1/χ², so the step is scaled down with it);
   // frames far (1.5 rad) from the current tangents; a twist of 3 rad past the natural one.
   const Regime regimes[] = {{"generic", 0.8, 0.2, 0.0, 1e-6, 1e-6},
-                            {"nearly collinear", 1e-5, 0.05, 0.0, 1e-7, 1e-5},
+                            {"nearly collinear", 1e-5, 0.05, 0.0, 1e-7, 1e-6},
                             {"synced frames", 0.5, 0.0, 0.0, 1e-6, 1e-6},
                             {"nearly folded", std::acos(-0.9), 0.2, 0.0, 1e-6, 1e-6},
                             {"frames far off", 0.8, 1.5, 0.0, 1e-6, 1e-6},
@@ -120,11 +120,14 @@ TEST_CASE("rod stencil: bend-twist gradient and Hessian match finite differences
   for (const Regime& r : regimes) {
     const std::string regime = r.name;
     CAPTURE(regime);
+    double worst = 0;
     for (int trial = 0; trial < 20; ++trial) {
       const Case c = random_case(rng, r.turn, r.tilt, r.twist);
       CHECK(eval(c, c.q, Want::energy).energy > 0);
       CHECK(gradient_error(c, r.h) < r.tol);
-      CHECK(hessian_error(c, r.h) < r.tol);
+      const double herr = hessian_error(c, r.h);
+      worst = std::max(worst, herr);
+      CHECK(herr < r.tol);
       // Every request returns the same energy and gradient; the Hessian is exactly symmetric.
       const BendTwistEval g = eval(c, c.q, Want::gradient), H = eval(c, c.q, Want::hessian);
       CHECK(H.energy == g.energy);
@@ -137,6 +140,7 @@ TEST_CASE("rod stencil: bend-twist gradient and Hessian match finite differences
             1e-12 * (1 + H.hessian.bottomRightCorner<2, 2>().norm()));
       CHECK(a.hessian.topLeftCorner<9, 11>().isZero());
     }
+    MESSAGE(regime << ": largest relative Hessian error " << worst);
   }
 }
 
