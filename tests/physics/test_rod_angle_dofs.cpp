@@ -146,6 +146,15 @@ TEST_CASE("rod angle DOFs: torques and forces are minus the gradient, the Jacobi
   CHECK(scale_f > 1e-3);
   CHECK(worst_f < 1e-6 * scale_f);
   CHECK(worst_j < 1e-5 * scale_j);
+  // The product pass (∂F/∂q·v without the matrix) is the same Jacobian.
+  Eigen::VectorXd v(J.cols()), Jv = Eigen::VectorXd::Zero(J.cols());
+  for (Eigen::Index k = 0; k < v.size(); ++k) v[k] = noise(rng);
+  JacobianRequest product;
+  product.product_in = std::span<const double>(v.data(), static_cast<std::size_t>(v.size()));
+  product.product_out = std::span<double>(Jv.data(), static_cast<std::size_t>(Jv.size()));
+  for (const auto& t : sys.terms()) t->add_jacobians(flat_view(sys, q0, zero), product);
+  CHECK((Jv - J * v).norm() <= 1e-12 * (J * v).norm());
+  CHECK((J * v).norm() > 0);
   // Asked for the PSD stand-in, the term projects every stencil: −∂F/∂q is then PSD, where the
   // exact one of this strained helix is not (so the two requests really differ).
   req.options.project_element_hessians = true;

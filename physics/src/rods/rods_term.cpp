@@ -289,21 +289,42 @@ void Rods::for_each_block(const Entry& e, const Points& x, bool project, Visit&&
 namespace {
 
 // matrix += cx·(−H) and product_out += −H·product_in for a stencil Hessian H whose DOF i is
-// component comp[i] of group group[i], the groups sitting in block rows block[] with the
-// groups × groups slots from slot0 on (flat index of a component: 3·block + component).
+// component comp[i] of group group[i] (each group's DOFs contiguous), the groups sitting in block
+// rows block[] with the groups × groups slots from slot0 on (flat index of a component:
+// 3·block + component). The matrix is filled a 3×3 block at a time, its slot looked up once.
 template <int N>
 void scatter_hessian(const Eigen::Matrix<double, N, N>& H, std::span<const Index> block, std::span<const int> comp,
                      std::span<const int> group, std::span<const Index> slots, const JacobianRequest& req) {
-  const bool product = !req.product_in.empty();
+  const std::size_t groups = block.size();
+  std::array<std::size_t, N + 1> first{};  // group g's DOFs: first[g] .. first[g + 1] − 1
+  for (std::size_t g = 0, i = 0; g < groups; ++g) {
+    first[g] = i;
+    while (i < std::size_t{N} && static_cast<std::size_t>(group[i]) == g) ++i;
+  }
+  first[groups] = N;
+  // A node's group holds its 3 components in order: its blocks are whole 3×3 blocks of H.
+  std::array<bool, N> whole{};
+  for (std::size_t g = 0; g < groups; ++g)
+    whole[g] = first[g + 1] - first[g] == 3 && comp[first[g]] == 0 && comp[first[g] + 1] == 1 && comp[first[g] + 2] == 2;
+  if (req.matrix)
+    for (std::size_t gi = 0; gi < groups; ++gi)
+      for (std::size_t gj = 0; gj < groups; ++gj) {
+        BlockMatrix::BlockMap b = req.matrix->block(slots[gi * groups + gj]);
+        if (whole[gi] && whole[gj]) {
+          b.noalias() -= req.cx * H.template block<3, 3>(static_cast<Eigen::Index>(first[gi]), static_cast<Eigen::Index>(first[gj]));
+          continue;
+        }
+        for (std::size_t i = first[gi]; i < first[gi + 1]; ++i)
+          for (std::size_t j = first[gj]; j < first[gj + 1]; ++j)
+            b(comp[i], comp[j]) -= req.cx * H(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
+      }
+  if (req.product_in.empty()) return;
+  std::array<std::size_t, N> flat{};
   for (std::size_t i = 0; i < std::size_t{N}; ++i)
-    for (std::size_t j = 0; j < std::size_t{N}; ++j) {
-      const auto gi = static_cast<std::size_t>(group[i]), gj = static_cast<std::size_t>(group[j]);
-      const double h = H(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
-      if (req.matrix) req.matrix->block(slots[gi * block.size() + gj])(comp[i], comp[j]) -= req.cx * h;
-      if (product)
-        req.product_out[3 * std::size_t{block[gi]} + static_cast<std::size_t>(comp[i])] -=
-            h * req.product_in[3 * std::size_t{block[gj]} + static_cast<std::size_t>(comp[j])];
-    }
+    flat[i] = 3 * std::size_t{block[static_cast<std::size_t>(group[i])]} + static_cast<std::size_t>(comp[i]);
+  for (std::size_t i = 0; i < std::size_t{N}; ++i)
+    for (std::size_t j = 0; j < std::size_t{N}; ++j)
+      req.product_out[flat[i]] -= H(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) * req.product_in[flat[j]];
 }
 
 }  // namespace

@@ -5,7 +5,9 @@
 #include <numbers>
 #include <string>
 
-#include <unsupported/Eigen/AutoDiff>
+#ifdef __AVX__
+#include <immintrin.h>
+#endif
 
 #include "sewn/physics/errors.hpp"
 
@@ -15,131 +17,239 @@ namespace {
 
 constexpr double two_pi = 2 * std::numbers::pi;
 
-template <class T>
-using V3 = Eigen::Matrix<T, 3, 1>;
-using AD = Eigen::AutoDiffScalar<Eigen::Matrix<double, 11, 1>>;
+using Q = Eigen::Matrix<double, 11, 1>;
+using Vec8 = Eigen::Matrix<double, 8, 1>;  // derivatives over (e0, e1, θ0, θ1), e0 = x1 − x0, e1 = x2 − x1
+using Mat8 = Eigen::Matrix<double, 8, 8>;
+using Mat3 = Eigen::Matrix3d;
 
-double value_of(double v) { return v; }
-double value_of(const AD& v) { return v.value(); }
-
-template <class T>
-struct Core {
-  T energy{};
-  Eigen::Matrix<T, 11, 1> gradient;
-  double kappa1 = 0, kappa2 = 0, twist = 0, reference_twist = 0;
+// Everything the strains and their derivatives are built from, at one configuration.
+struct Geometry {
+  double l[2], chi;
+  Vec3 t[2], tb[2];   // current and start-of-step tangents
+  Vec3 m1[2], m2[2];  // material directors
+  Vec3 kb;            // curvature binormal 2 t0×t1/χ, χ = 1 + t0·t1
+  Vec3 spin[2];       // w_j = −κ̂_j/(2 l_j): the transported frame's spin is w_j·de_j (derivatives only)
+  double kappa1, kappa2, twist, reference_twist;
 };
 
-// Energy and closed-form gradient of the bend-twist stencil over q = (x0, x1, x2, θ0, θ1).
-// Instantiated with double (values) and AutoDiffScalar (Hessian = derivative of the gradient).
-template <class T>
-Core<T> core(const Eigen::Matrix<T, 11, 1>& q, const BendTwistRest& r, const BendTwistFrames& f, bool with_gradient,
-             Eigen::Matrix2d* angle_hessian = nullptr) {
-  Core<T> out;
-  const V3<T> e0 = q.template segment<3>(3) - q.template segment<3>(0);
-  const V3<T> e1 = q.template segment<3>(6) - q.template segment<3>(3);
-  using std::cos;
-  using std::sin;
-  using std::sqrt;
-  using std::atan2;
-  const T l0 = sqrt(e0.dot(e0)), l1 = sqrt(e1.dot(e1));
-  const V3<T> t0 = e0 / l0, t1 = e1 / l1;
-  const V3<T> tb0 = f.tangent0.cast<T>(), tb1 = f.tangent1.cast<T>();
-  // Reference frames: the start-of-step directors transported to the current tangents.
-  const V3<T> a0 = transport_exact<T>(tb0, t0, f.director0.cast<T>());
-  const V3<T> a1 = transport_exact<T>(tb1, t1, f.director1.cast<T>());
-  const V3<T> b0 = t0.cross(a0), b1 = t1.cross(a1);
-  const T c0 = cos(q[9]), s0 = sin(q[9]), c1 = cos(q[10]), s1 = sin(q[10]);
-  const V3<T> m1_0 = c0 * a0 + s0 * b0, m2_0 = c0 * b0 - s0 * a0;
-  const V3<T> m1_1 = c1 * a1 + s1 * b1, m2_1 = c1 * b1 - s1 * a1;
-  const T chi = T(1.0) + t0.dot(t1);
-  const V3<T> kb = (T(2.0) / chi) * t0.cross(t1);
-  const T k1 = T(0.5) * (m2_0 + m2_1).dot(kb);
-  const T k2 = T(-0.5) * (m1_0 + m1_1).dot(kb);
-  const V3<T> u = transport_exact<T>(t0, t1, a0);
-  const T raw = atan2(u.cross(a1).dot(t1), u.dot(a1));
-  const double wrap = two_pi * std::round((f.reference_twist - value_of(raw)) / two_pi);
-  const T mref = raw + wrap;
-  const T m = q[10] - q[9] + mref;
-  const T d1 = k1 - r.kappa1, d2 = k2 - r.kappa2, dm = m - r.twist;
-  const double inv_d = 1.0 / r.voronoi;
-  out.energy = (0.5 * inv_d) * (r.EI1 * d1 * d1 + r.EI2 * d2 * d2 + r.GJ * dm * dm);
-  out.kappa1 = value_of(k1);
-  out.kappa2 = value_of(k2);
-  out.twist = value_of(m);
-  out.reference_twist = value_of(mref);
-  if (!with_gradient) return out;
-
-  // dE = c·dκb + σ0 s0 + σ1 s1 + tw·½κb·(de0/l0 + de1/l1), with s_j = dθ_j + ω_j the spin of
-  // material frame j and ω_j = −½ κ̂_j·de_j/l_j, κ̂_j = 2 t̄_j×t_j/(1 + t̄_j·t_j) (the spin of a
-  // transported frame; zero at t = t̄). Tilts of the directors along t drop out (κb ⟂ t).
-  const V3<T> c = (inv_d * T(0.5)) * ((r.EI1 * d1) * (m2_0 + m2_1) - (r.EI2 * d2) * (m1_0 + m1_1));
-  const T tw = (r.GJ * inv_d) * dm;
-  const T sigma0 = (-0.5 * inv_d) * (r.EI1 * d1 * kb.dot(m1_0) + r.EI2 * d2 * kb.dot(m2_0)) - tw;
-  const T sigma1 = (-0.5 * inv_d) * (r.EI1 * d1 * kb.dot(m1_1) + r.EI2 * d2 * kb.dot(m2_1)) + tw;
-  const V3<T> kh0 = (T(2.0) / (T(1.0) + tb0.dot(t0))) * tb0.cross(t0);
-  const V3<T> kh1 = (T(2.0) / (T(1.0) + tb1.dot(t1))) * tb1.cross(t1);
-  const T kc = kb.dot(c);
-  const V3<T> ts = t0 + t1;
-  // (∂κb/∂e0)ᵀc = (2 t1×c − (κb·c)(t0+t1))/(l0χ), (∂κb/∂e1)ᵀc = (−2 t0×c − (κb·c)(t0+t1))/(l1χ).
-  const V3<T> ge0 = (T(2.0) * t1.cross(c) - kc * ts) / (l0 * chi) + (tw * kb - sigma0 * kh0) / (T(2.0) * l0);
-  const V3<T> ge1 = (T(-2.0) * t0.cross(c) - kc * ts) / (l1 * chi) + (tw * kb - sigma1 * kh1) / (T(2.0) * l1);
-  out.gradient.template segment<3>(0) = -ge0;
-  out.gradient.template segment<3>(3) = ge0 - ge1;
-  out.gradient.template segment<3>(6) = ge1;
-  out.gradient[9] = sigma0;
-  out.gradient[10] = sigma1;
-  if (angle_hessian) {
-    // ∂κ1/∂θj = −½ m1^j·κb, ∂κ2/∂θj = −½ m2^j·κb; since ∂m1/∂θ = m2 and ∂m2/∂θ = −m1, the
-    // second derivatives are ∂²κ1/∂θj² = ∂κ2/∂θj and ∂²κ2/∂θj² = −∂κ1/∂θj (no cross terms);
-    // the twist is linear in θ with ∂m/∂θ = (−1, 1).
-    const double dk1[2] = {-0.5 * value_of(m1_0.dot(kb)), -0.5 * value_of(m1_1.dot(kb))};
-    const double dk2[2] = {-0.5 * value_of(m2_0.dot(kb)), -0.5 * value_of(m2_1.dot(kb))};
-    const double dm[2] = {-1.0, 1.0};
-    const double e1 = value_of(d1), e2 = value_of(d2);
-    for (int j = 0; j < 2; ++j)
-      for (int k = 0; k < 2; ++k) {
-        double h = r.EI1 * dk1[j] * dk1[k] + r.EI2 * dk2[j] * dk2[k] + r.GJ * dm[j] * dm[k];
-        if (j == k) h += r.EI1 * e1 * dk2[j] - r.EI2 * e2 * dk1[j];
-        (*angle_hessian)(j, k) = inv_d * h;
-      }
+Geometry geometry(const Q& q, const BendTwistFrames& f, bool derivatives) {
+#ifdef __AVX__
+  // glibc's atan2 and round wrappers are legacy-SSE code: entered while some earlier code has
+  // left the upper halves of the YMM registers dirty, every SSE instruction in them pays a
+  // state transition. Measured natively (AVX-512 Xeon) in scenes/rod_spring.json, whose twist
+  // solves evaluate stencil energies in a loop: 1.3x slower without this (the forward-AD
+  // Hessian it replaced happened to clean the state). Costs one uop when the state is clean.
+  _mm256_zeroupper();
+#endif
+  Geometry g;
+  const Vec3 e[2] = {q.segment<3>(3) - q.segment<3>(0), q.segment<3>(6) - q.segment<3>(3)};
+  const Vec3 director[2] = {f.director0, f.director1};
+  g.tb[0] = f.tangent0;
+  g.tb[1] = f.tangent1;
+  Vec3 a[2];
+  for (int j = 0; j < 2; ++j) {
+    g.l[j] = e[j].norm();
+    g.t[j] = e[j] / g.l[j];
+    // Reference frame: the start-of-step director transported to the current tangent.
+    a[j] = transport_exact<double>(g.tb[j], g.t[j], director[j]);
+    const Vec3 b = g.t[j].cross(a[j]);
+    const double c = std::cos(q[9 + j]), s = std::sin(q[9 + j]);
+    g.m1[j] = c * a[j] + s * b;
+    g.m2[j] = c * b - s * a[j];
+    if (derivatives) g.spin[j] = (-1.0 / ((1.0 + g.tb[j].dot(g.t[j])) * g.l[j])) * g.tb[j].cross(g.t[j]);
   }
+  g.chi = 1.0 + g.t[0].dot(g.t[1]);
+  g.kb = (2.0 / g.chi) * g.t[0].cross(g.t[1]);
+  g.kappa1 = 0.5 * (g.m2[0] + g.m2[1]).dot(g.kb);
+  g.kappa2 = -0.5 * (g.m1[0] + g.m1[1]).dot(g.kb);
+  const Vec3 u = transport_exact<double>(g.t[0], g.t[1], a[0]);
+  const double raw = std::atan2(u.cross(a[1]).dot(g.t[1]), u.dot(a[1]));
+  g.reference_twist = raw + two_pi * std::round((f.reference_twist - raw) / two_pi);
+  g.twist = q[10] - q[9] + g.reference_twist;
+  return g;
+}
+
+// A linear combination L = w.k1·κ1 + w.k2·κ2 + w.m·m of the strains with fixed weights: the
+// energy's gradient is ∇L with w = ∂E/∂s, each strain's gradient ∇L with a unit weight.
+struct Weights {
+  double k1 = 0, k2 = 0, m = 0;
+};
+
+// Per edge j, L's bending part is v_0·κb + v_1·κb with v_j = ½(w.k1 m2^j − w.k2 m1^j). Turning
+// frame j about t^j by ds turns v_j by ds·t^j×v_j = ds·u_j, u_j = −½(w.k1 m1^j + w.k2 m2^j).
+Vec3 bend_vector(const Geometry& g, const Weights& w, int j) { return 0.5 * (w.k1 * g.m2[j] - w.k2 * g.m1[j]); }
+Vec3 turned_bend_vector(const Geometry& g, const Weights& w, int j) { return -0.5 * (w.k1 * g.m1[j] + w.k2 * g.m2[j]); }
+
+// ∂L/∂s_j, s_j = dθ_j + w_j·de_j the spin of material frame j: κb·u_j from bending, ∓w.m from
+// the twist (m = θ1 − θ0 + m_ref, and m_ref turns with the frames: dm_ref = s-spins + ½κb·(dt0 + dt1)).
+std::array<double, 2> spin_weights(const Geometry& g, const Weights& w) {
+  return {g.kb.dot(turned_bend_vector(g, w, 0)) - w.m, g.kb.dot(turned_bend_vector(g, w, 1)) + w.m};
+}
+
+// ∇L over (e0, e1, θ0, θ1): dL = c·dκb + σ0 s0 + σ1 s1 + w.m·½κb·(de0/l0 + de1/l1), c = v_0 + v_1
+// (tilts of the directors along t drop out: κb ⟂ t).
+Vec8 weighted_gradient(const Geometry& g, const Weights& w) {
+  const Vec3 c = bend_vector(g, w, 0) + bend_vector(g, w, 1);
+  const std::array<double, 2> sigma = spin_weights(g, w);
+  const double kc = g.kb.dot(c);
+  const Vec3 ts = g.t[0] + g.t[1];
+  // (∂κb/∂e0)ᵀc = (2 t1×c − (κb·c)(t0+t1))/(l0χ), (∂κb/∂e1)ᵀc = (−2 t0×c − (κb·c)(t0+t1))/(l1χ).
+  Vec8 out;
+  out.segment<3>(0) = (2.0 * g.t[1].cross(c) - kc * ts) / (g.l[0] * g.chi) + (0.5 * w.m / g.l[0]) * g.kb + sigma[0] * g.spin[0];
+  out.segment<3>(3) = (-2.0 * g.t[0].cross(c) - kc * ts) / (g.l[1] * g.chi) + (0.5 * w.m / g.l[1]) * g.kb + sigma[1] * g.spin[1];
+  out[6] = sigma[0];
+  out[7] = sigma[1];
   return out;
 }
 
-Eigen::Matrix<double, 11, 1> pack(const Vec3& x0, const Vec3& x1, const Vec3& x2, double th0, double th1) {
-  Eigen::Matrix<double, 11, 1> q;
-  q << x0, x1, x2, th0, th1;
-  return q;
+Mat3 cross_matrix(const Vec3& a) {
+  Mat3 A;
+  A << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+  return A;
 }
 
-// One strain's gradient through core()'s closed-form gradient: the energy (1/2D)·D·(s − (s − 1))²
-// has the gradient (s − s̄)∇s = ∇s (one stiffness D, the others 0, s̄ one below the current s),
-// so the gradient code serves the strains' gradients too (a separate copy of it would have to be
-// kept in step; making it take the weights ∂E/∂s cost the AD Hessian pass ~30 %). 4 gradients'
-// work in all, against the AD Hessian's ~15 and the 11×11 eigendecomposition.
-Eigen::Matrix<double, 11, 1> strain_gradient(const Eigen::Matrix<double, 11, 1>& q, const BendTwistRest& rest,
-                                             const BendTwistFrames& frames, const Core<double>& at, int strain) {
-  BendTwistRest unit = rest;
-  unit.EI1 = strain == 0 ? rest.voronoi : 0.0;
-  unit.EI2 = strain == 1 ? rest.voronoi : 0.0;
-  unit.GJ = strain == 2 ? rest.voronoi : 0.0;
-  unit.kappa1 = at.kappa1 - 1;
-  unit.kappa2 = at.kappa2 - 1;
-  unit.twist = at.twist - 1;
-  return core<double>(q, unit, frames, true).gradient;
+// ∂w/∂e for the spin w = −(t̄×t)/(μ l), μ = 1 + t̄·t: with dt = P de/l (P = I − ttᵀ) and dl = t·de,
+// dw = −[t̄×dt/(μl) − (t̄×t)(t̄·dt)/(μ²l) − (t̄×t)dl/(μl²)], and [t̄]×P = [t̄]× − (t̄×t)tᵀ.
+Mat3 spin_jacobian(const Vec3& tb, const Vec3& t, double l) {
+  const double mu = 1.0 + tb.dot(t);
+  const Vec3 n = tb.cross(t);
+  const Vec3 tb_across = tb - t.dot(tb) * t;
+  return (-1.0 / (mu * l * l)) * (cross_matrix(tb) - 2.0 * n * t.transpose() - n * tb_across.transpose() / mu);
 }
 
-// (1/D)[EI1 ∇κ1∇κ1ᵀ + EI2 ∇κ2∇κ2ᵀ + GJ ∇m∇mᵀ] at q, whose strains core() gave as `at`.
-Eigen::Matrix<double, 11, 11> gauss_newton_hessian(const Eigen::Matrix<double, 11, 1>& q, const BendTwistRest& rest,
-                                                   const BendTwistFrames& frames, const Core<double>& at) {
-  const double stiffness[3] = {rest.EI1, rest.EI2, rest.GJ};
-  Eigen::Matrix<double, 11, 11> H = Eigen::Matrix<double, 11, 11>::Zero();
+// ∇²L over (e0, e1, θ0, θ1) for fixed weights: the second variation of dL above, term by term
+// (docs/rods.md, "The exact Hessian"). Several terms are not symmetric on their own (the spin is
+// not a differential); their sum is. H accumulates a matrix whose symmetric part is ∇²L, so a
+// symmetric pair A + Aᵀ enters as 2A, and is symmetrised at the end.
+Mat8 weighted_hessian(const Geometry& g, const Weights& w) {
+  Mat8 H = Mat8::Zero();
+  const Vec3 v[2] = {bend_vector(g, w, 0), bend_vector(g, w, 1)};
+  const Vec3 c = v[0] + v[1];
+  const std::array<double, 2> sigma = spin_weights(g, w);
+  const double f = c.dot(g.kb);
+  const Vec3 ts = g.t[0] + g.t[1];
+  const Mat3 T[2] = {(Mat3::Identity() - g.t[0] * g.t[0].transpose()) / g.l[0],
+                     (Mat3::Identity() - g.t[1] * g.t[1].transpose()) / g.l[1]};
+  // ∂κb/∂e_j.
+  const Mat3 K[2] = {(-2.0 * cross_matrix(g.t[1]) - g.kb * ts.transpose()) / (g.l[0] * g.chi),
+                     (2.0 * cross_matrix(g.t[0]) - g.kb * ts.transpose()) / (g.l[1] * g.chi)};
+  // c·∇²κb: κb·c = 2c·(t0×t1)/χ as a function of the unit tangents, with partials a_j and second
+  // partials F_00 = −(t1a_0ᵀ + a_0t1ᵀ)/χ, F_11 = −(t0a_1ᵀ + a_1t0ᵀ)/χ, F_01, chained through
+  // t_j(e_j): T_j F_jj T_j = −(P_j t_k)(P_j a_j)ᵀ/(χ l_j²) + its transpose (k the other edge),
+  // plus a_j·∂²t_j = −(a_j t_jᵀ + t_j a_jᵀ + (a_j·t_j)(I − 3t_jt_jᵀ))/l_j².
+  const Vec3 a[2] = {(2.0 * g.t[1].cross(c) - f * g.t[1]) / g.chi, (-2.0 * g.t[0].cross(c) - f * g.t[0]) / g.chi};
+  for (int j = 0; j < 2; ++j) {
+    const Vec3& tj = g.t[j];
+    const Vec3& tk = g.t[1 - j];
+    const double l2 = g.l[j] * g.l[j];
+    const Vec3 tk_across = tk - tj.dot(tk) * tj, aj_across = a[j] - tj.dot(a[j]) * tj;
+    H.block<3, 3>(3 * j, 3 * j) = (-2.0 / (g.chi * l2)) * tk_across * aj_across.transpose() +
+                                  (-1.0 / l2) * (2.0 * a[j] * tj.transpose() + a[j].dot(tj) * (Mat3::Identity() - 3.0 * tj * tj.transpose()));
+  }
+  const Mat3 F01 = (-2.0 * cross_matrix(c) - f * Mat3::Identity() - g.t[1] * a[1].transpose() - a[0] * g.t[0].transpose()) / g.chi;
+  H.block<3, 3>(0, 3) = 2.0 * T[0] * F01 * T[1];
+  for (int j = 0; j < 2; ++j) {
+    const int ej = 3 * j;
+    const double l2 = g.l[j] * g.l[j];
+    // c turns with the frames: its tilt (dc = −t_j(v_j·dt_j)) against dκb, since t_j·dκb = −κb·dt_j.
+    H.block<3, 3>(ej, ej) += g.kb * v[j].transpose() / l2;
+    // The spin s_j (gradient S: w_j at e_j, 1 at θ_j) turns v_j by u_j against dκb, in c·dκb and
+    // in σ_j, a symmetric pair; and σ_j's own spin, dσ_j ⊃ −(κb·v_j) s_j: together
+    // 2·sym((∇(u_j·κb) − ½(κb·v_j)S) Sᵀ).
+    const Vec3 u = turned_bend_vector(g, w, j);
+    Vec8 X = Vec8::Zero();
+    X.segment<3>(0) = K[0].transpose() * u;
+    X.segment<3>(3) = K[1].transpose() * u;
+    const double half_kv = 0.5 * g.kb.dot(v[j]);
+    X.segment<3>(ej) -= half_kv * g.spin[j];
+    X[6 + j] -= half_kv;
+    H.middleCols<3>(ej).noalias() += 2.0 * X * g.spin[j].transpose();
+    H.col(6 + j) += 2.0 * X;
+    // The spin's coefficient w_j(e_j) varies.
+    H.block<3, 3>(ej, ej) += sigma[j] * spin_jacobian(g.tb[j], g.t[j], g.l[j]);
+    // The twist's ½κb·dt_j: κb varies, T_j K_k = (K_k + δ_jk t_j κbᵀ/l_j)/l_j (P_j κb = κb,
+    // P_j[t_j]× = [t_j]×, and t0×t1 = ½χκb); and t_j does, −½(κb t_jᵀ + t_j κbᵀ)/l_j² (κb·t_j = 0
+    // drops the rest of t_j's second derivative). The t_j κbᵀ terms cancel in the symmetric part.
+    H.block<3, 3>(ej, 0) += (0.5 * w.m / g.l[j]) * K[0];
+    H.block<3, 3>(ej, 3) += (0.5 * w.m / g.l[j]) * K[1];
+    H.block<3, 3>(ej, ej) -= (0.5 * w.m / l2) * g.kb * g.t[j].transpose();
+  }
+  return 0.5 * (H + H.transpose());
+}
+
+// An (e0, e1, θ0, θ1) gradient or Hessian in the stencil's DOFs (x0, x1, x2, θ0, θ1):
+// ∂/∂x0 = −∂/∂e0, ∂/∂x1 = ∂/∂e0 − ∂/∂e1, ∂/∂x2 = ∂/∂e1.
+Eigen::Matrix<double, 11, 1> expand(const Vec8& g) {
+  Eigen::Matrix<double, 11, 1> out;
+  out << -g.segment<3>(0), g.segment<3>(0) - g.segment<3>(3), g.segment<3>(3), g.segment<2>(6);
+  return out;
+}
+
+// Of a symmetric H, blockwise: with E_jk its (e_j, e_k) blocks and A_j its (e_j, θ) rows, the
+// position blocks are E00, E01 − E00, −E01 | E00 − E01 − E10 + E11, E01 − E11 | E11. Only the
+// upper triangle is formed, and mirrored: the result is exactly symmetric.
+Eigen::Matrix<double, 11, 11> expand(const Mat8& H) {
+  const Mat3 E00 = H.block<3, 3>(0, 0), E01 = H.block<3, 3>(0, 3), E11 = H.block<3, 3>(3, 3);
+  const Eigen::Matrix<double, 3, 2> A0 = H.block<3, 2>(0, 6), A1 = H.block<3, 2>(3, 6);
+  Eigen::Matrix<double, 11, 11> out;
+  out.block<3, 3>(0, 0) = E00;
+  out.block<3, 3>(0, 3) = E01 - E00;
+  out.block<3, 3>(0, 6) = -E01;
+  out.block<3, 3>(3, 3) = E00 - E01 - E01.transpose() + E11;
+  out.block<3, 3>(3, 6) = E01 - E11;
+  out.block<3, 3>(6, 6) = E11;
+  out.block<3, 2>(0, 9) = -A0;
+  out.block<3, 2>(3, 9) = A0 - A1;
+  out.block<3, 2>(6, 9) = A1;
+  out.block<2, 2>(9, 9) = H.block<2, 2>(6, 6);
+  out.triangularView<Eigen::StrictlyLower>() = out.transpose();
+  return out;
+}
+
+struct Strains {
+  double d[3];          // s − s̄ for κ1, κ2, m
+  double stiffness[3];  // EI1/D, EI2/D, GJ/D
+};
+
+Strains strains(const Geometry& g, const BendTwistRest& r) {
+  const double inv_d = 1.0 / r.voronoi;
+  return {{g.kappa1 - r.kappa1, g.kappa2 - r.kappa2, g.twist - r.twist}, {r.EI1 * inv_d, r.EI2 * inv_d, r.GJ * inv_d}};
+}
+
+Weights unit_weight(int strain) {
+  Weights w;
+  (strain == 0 ? w.k1 : strain == 1 ? w.k2 : w.m) = 1.0;
+  return w;
+}
+
+// (1/D) Σ_s k_s ∇s∇sᵀ over (e0, e1, θ0, θ1): the Gauss–Newton part of the Hessian.
+Mat8 gauss_newton(const Geometry& g, const Strains& s) {
+  Mat8 H = Mat8::Zero();
   for (int a = 0; a < 3; ++a) {
-    if (stiffness[a] == 0.0) continue;
-    const Eigen::Matrix<double, 11, 1> g = strain_gradient(q, rest, frames, at, a);
-    H.noalias() += (stiffness[a] / rest.voronoi) * g.lazyProduct(g.transpose());
+    if (s.stiffness[a] == 0.0) continue;
+    const Vec8 grad = weighted_gradient(g, unit_weight(a));
+    H.noalias() += s.stiffness[a] * grad * grad.transpose();
   }
   return H;
+}
+
+// The θθ block of the exact Hessian at a gradient's cost: ∇s's θ entries are the spin weights
+// of a unit weight, and of ∇²L only σ_j's own spin, −(κb·v_j) per θ_j, reaches it.
+Eigen::Matrix2d angle_hessian(const Geometry& g, const Strains& s, const Weights& w) {
+  Eigen::Matrix2d H = Eigen::Matrix2d::Zero();
+  for (int a = 0; a < 3; ++a) {
+    const std::array<double, 2> ds = spin_weights(g, unit_weight(a));
+    const Eigen::Vector2d grad(ds[0], ds[1]);
+    H.noalias() += s.stiffness[a] * grad * grad.transpose();
+  }
+  for (int j = 0; j < 2; ++j) H(j, j) -= g.kb.dot(bend_vector(g, w, j));
+  return H;
+}
+
+Q pack(const Vec3& x0, const Vec3& x1, const Vec3& x2, double th0, double th1) {
+  Q q;
+  q << x0, x1, x2, th0, th1;
+  return q;
 }
 
 void check_section_inputs(double E, double nu, double a, double b, const char* who) {
@@ -223,43 +333,26 @@ Eigen::Matrix<double, 6, 6> stretch_hessian_psd(const Vec3& x0, const Vec3& x1, 
 BendTwistEval bend_twist(const Vec3& x0, const Vec3& x1, const Vec3& x2, double theta0, double theta1,
                          const BendTwistRest& rest, const BendTwistFrames& frames, Want want) {
   BendTwistEval out;
-  const Eigen::Matrix<double, 11, 1> q = pack(x0, x1, x2, theta0, theta1);
-  if (want != Want::hessian) {
-    Eigen::Matrix2d angles;
-    const bool grad = want != Want::energy;
-    const Core<double> c = core<double>(q, rest, frames, grad, want == Want::angle_hessian ? &angles : nullptr);
-    out.energy = c.energy;
-    if (grad) out.gradient = c.gradient;
-    if (want == Want::angle_hessian) out.hessian.bottomRightCorner<2, 2>() = angles;
-    if (want == Want::gauss_newton) out.hessian = gauss_newton_hessian(q, rest, frames, c);
-    out.kappa1 = c.kappa1;
-    out.kappa2 = c.kappa2;
-    out.twist = c.twist;
-    out.reference_twist = c.reference_twist;
-    return out;
-  }
-  Eigen::Matrix<AD, 11, 1> qa;
-  for (int k = 0; k < 11; ++k) qa[k] = AD(q[k], 11, k);
-  const Core<AD> c = core<AD>(qa, rest, frames, true);
-  out.energy = c.energy.value();
-  for (int k = 0; k < 11; ++k) {
-    out.gradient[k] = c.gradient[k].value();
-    out.hessian.row(k) = c.gradient[k].derivatives().transpose();
-  }
-  // Exact up to round-off; symmetrised so solvers see a symmetric matrix.
-  out.hessian = 0.5 * (out.hessian + out.hessian.transpose()).eval();
-  out.kappa1 = c.kappa1;
-  out.kappa2 = c.kappa2;
-  out.twist = c.twist;
-  out.reference_twist = c.reference_twist;
+  const Geometry g = geometry(pack(x0, x1, x2, theta0, theta1), frames, want != Want::energy);
+  const Strains s = strains(g, rest);
+  out.energy = 0.5 * (s.stiffness[0] * s.d[0] * s.d[0] + s.stiffness[1] * s.d[1] * s.d[1] + s.stiffness[2] * s.d[2] * s.d[2]);
+  out.kappa1 = g.kappa1;
+  out.kappa2 = g.kappa2;
+  out.twist = g.twist;
+  out.reference_twist = g.reference_twist;
+  if (want == Want::energy) return out;
+  const Weights w{s.stiffness[0] * s.d[0], s.stiffness[1] * s.d[1], s.stiffness[2] * s.d[2]};  // ∂E/∂s
+  out.gradient = expand(weighted_gradient(g, w));
+  if (want == Want::angle_hessian) out.hessian.bottomRightCorner<2, 2>() = angle_hessian(g, s, w);
+  if (want == Want::gauss_newton) out.hessian = expand(gauss_newton(g, s));
+  if (want == Want::hessian) out.hessian = expand(Mat8(gauss_newton(g, s) + weighted_hessian(g, w)));
   return out;
 }
 
 MaterialStrains material_strains(const Vec3& x0, const Vec3& x1, const Vec3& x2, double theta0, double theta1,
                                  const BendTwistFrames& frames) {
-  BendTwistRest unit;
-  const Core<double> c = core<double>(pack(x0, x1, x2, theta0, theta1), unit, frames, false);
-  return {c.kappa1, c.kappa2, c.twist, c.reference_twist};
+  const Geometry g = geometry(pack(x0, x1, x2, theta0, theta1), frames, false);
+  return {g.kappa1, g.kappa2, g.twist, g.reference_twist};
 }
 
 }  // namespace sewn::physics::rods
