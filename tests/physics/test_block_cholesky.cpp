@@ -146,6 +146,21 @@ TEST_CASE("block cholesky refuses an indefinite matrix naming the node and axis,
   CHECK_THROWS_AS(block_solve(f, A, random_problem(A, nullptr, 0.0, 3)), SolverError);
 }
 
+TEST_CASE("block cholesky: an empty matrix and a single node") {
+  BlockMatrix E;
+  E.build_pattern(0, {});
+  solve::BlockCholesky f;
+  std::vector<double> none;
+  f.factorize(E, none, "test");
+  f.solve(none, none);
+  CHECK(f.flops() == 0);
+  BlockMatrix A;
+  A.build_pattern(1, {});
+  A.block(A.diagonal(0)) << 4, 1, 0, 1, 3, 0, 0, 0, 2;
+  const Problem p = random_problem(A, nullptr, 0.0, 8);
+  CHECK(max_difference(block_solve(f, A, p), reference_solve(A, p)) < 1e-15);
+}
+
 TEST_CASE("block cholesky: bad sizes are refused naming what") {
   BlockMatrix A;
   chain(A, 5);
