@@ -31,7 +31,6 @@ constexpr int max_dofs = 24;  // tet + tet
 // The chained Hessian's scalars: a side's frame in 9 (rod, triangle) or 12 (tet) directions,
 // the core in 12.
 constexpr int side_dofs_max = 12;  // the whole-stencil and per-side jets; a vertex side has its own
-using C2 = detail::Jet<12, true>;
 using Coef = std::array<double, 6>;
 
 [[noreturn]] void fail(const std::string& name, const std::string& why) {
@@ -167,30 +166,32 @@ Frame<T> build_frame(const Side& side, const Q& q, int at, double sign, const Co
 // side's DOFs (the first 7 or 9 columns are used).
 using SideJet = detail::FrameJet;
 
-template <int N>
+template <int N, bool H>
 SideJet side_jet_n(const Side& side, const Eigen::VectorXd& q, int at, int dofs, double sign, const Coef& coef) {
-  using S2 = detail::Jet<N, true>;
-  std::array<S2, side_dofs_max> qa;  // sized for any side, so no path reads past it
-  for (int i = 0; i < dofs; ++i) qa[static_cast<std::size_t>(i)] = S2::variable(q[at + i], i);
-  const Frame<S2> f = build_frame<S2>(side, qa, 0, sign, coef);
+  using S = detail::Jet<N, H>;
+  std::array<S, side_dofs_max> qa;  // sized for any side, so no path reads past it
+  for (int i = 0; i < dofs; ++i) qa[static_cast<std::size_t>(i)] = S::variable(q[at + i], i);
+  const Frame<S> f = build_frame<S>(side, qa, 0, sign, coef);
   SideJet jet;
   jet.jacobian = Eigen::MatrixXd::Zero(6, dofs);
-  const std::array<const S2*, 6> out{&f.m1.x, &f.m1.y, &f.m1.z, &f.m3.x, &f.m3.y, &f.m3.z};
+  const std::array<const S*, 6> out{&f.m1.x, &f.m1.y, &f.m1.z, &f.m3.x, &f.m3.y, &f.m3.z};
   for (int k = 0; k < 6; ++k) {
-    const S2& v = *out[static_cast<std::size_t>(k)];
+    const S& v = *out[static_cast<std::size_t>(k)];
     jet.value[k] = v.v;
-    jet.hessian[static_cast<std::size_t>(k)] = Eigen::MatrixXd::Zero(dofs, dofs);
-    for (int i = 0; i < dofs; ++i) {
-      jet.jacobian(k, i) = v.g[static_cast<std::size_t>(i)];
-      for (int j = 0; j < dofs; ++j) jet.hessian[static_cast<std::size_t>(k)](i, j) = v.hessian(i, j);
+    for (int i = 0; i < dofs; ++i) jet.jacobian(k, i) = v.g[static_cast<std::size_t>(i)];
+    if constexpr (H) {
+      jet.hessian[static_cast<std::size_t>(k)] = Eigen::MatrixXd::Zero(dofs, dofs);
+      for (int i = 0; i < dofs; ++i)
+        for (int j = 0; j < dofs; ++j) jet.hessian[static_cast<std::size_t>(k)](i, j) = v.hessian(i, j);
     }
   }
   return jet;
 }
-// In as few directions as the side needs.
+// In as few directions as the side needs; second derivatives if H.
+template <bool H>
 SideJet side_jet(const Side& side, const Eigen::VectorXd& q, int at, int dofs, double sign, const Coef& coef) {
-  if (const auto* v = std::get_if<VertexSide>(&side)) return detail::vertex_frame_jet(q, at, static_cast<int>(v->ring.size()), sign);
-  return dofs <= 9 ? side_jet_n<9>(side, q, at, dofs, sign, coef) : side_jet_n<12>(side, q, at, dofs, sign, coef);
+  if (const auto* v = std::get_if<VertexSide>(&side)) return detail::vertex_frame_jet(q, at, static_cast<int>(v->ring.size()), sign, H);
+  return dofs <= 9 ? side_jet_n<9, H>(side, q, at, dofs, sign, coef) : side_jet_n<12, H>(side, q, at, dofs, sign, coef);
 }
 
 // The first side's frame turned by the constant rotation R fixed at rest (m'_j = Σ_i R(i, j) m_i):
@@ -413,24 +414,17 @@ PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update
     }
     return Core<double>{value_of(ca.energy), ca.twist, ca.twist_raw, ca.bend, ca.one_plus_c};
   };
-  const bool wide = num_dofs() > 18;  // a tet side
-  const bool vertex = std::holds_alternative<VertexSide>(m_) || std::holds_alternative<VertexSide>(n_);
-  Eigen::MatrixXd chained_h;  // a vertex side's gradient comes with its chained Hessian
-  if (vertex && (hessian || want_gradient)) {
-    if (!hessian) hessian = &chained_h;
-    method = HessianMethod::chained;
-  }
-  Core<double> c;
-  const Eigen::Index n = q.size();
-  if (hessian && method == HessianMethod::chained) {
-    // E(q) = C(F_m(q_m), F_n(q_n)) with F = (m1, m3) per side: ∇²E = Jᵀ C_FF J + Σ_k C_F[k] ∇²F_k,
-    // J block-diagonal. Second-order AD of each side's frame (≤ 9 directions) and of the core
-    // (12 directions) instead of the whole stencil at once (18).
-    const SideJet jm = side_jet(m_, q, 0, dofs_m_, sign_m_, coef_m_);
-    const SideJet jn = side_jet(n_, q, dofs_m_, dofs_n_, sign_n_, coef_n_);
-    std::array<C2, 12> F;
-    for (int i = 0; i < 12; ++i) F[static_cast<std::size_t>(i)] = C2::variable((i < 6 ? jm : jn).value[i % 6], i);
-    Frame<C2> fm, fn;
+  // E(q) = C(F_m(q_m), F_n(q_n)) with F = (m1, m3) per side: ∇E = Jᵀ C_F and ∇²E = Jᵀ C_FF J +
+  // Σ_k C_F[k] ∇²F_k, J block-diagonal. AD of each side's frame (≤ 9 directions, or a vertex
+  // side's chained jets) and of the core (12 directions) instead of the whole stencil at once
+  // (18); second order only if H.
+  auto chained = [&]<bool H>() {
+    const SideJet jm = side_jet<H>(m_, q, 0, dofs_m_, sign_m_, coef_m_);
+    const SideJet jn = side_jet<H>(n_, q, dofs_m_, dofs_n_, sign_n_, coef_n_);
+    using CF = detail::Jet<12, H>;
+    std::array<CF, 12> F;
+    for (int i = 0; i < 12; ++i) F[static_cast<std::size_t>(i)] = CF::variable((i < 6 ? jm : jn).value[i % 6], i);
+    Frame<CF> fm, fn;
     fm.m1 = {F[0], F[1], F[2]};
     fm.m3 = {F[3], F[4], F[5]};
     fm.m2 = detail::cross(fm.m3, fm.m1);
@@ -438,23 +432,33 @@ PointEval PointConnection::evaluate(const Eigen::VectorXd& q, TwistUpdate update
     fn.m3 = {F[9], F[10], F[11]};
     fn.m2 = detail::cross(fn.m3, fn.m1);
     const auto cc = core(fm, fn);
-    c = {value_of(cc.energy), cc.twist, cc.twist_raw, cc.bend, cc.one_plus_c};
     Eigen::Matrix<double, 12, 1> eF;
-    Eigen::Matrix<double, 12, 12> eFF;
-    for (int i = 0; i < 12; ++i) {
-      eF[i] = cc.energy.g[static_cast<std::size_t>(i)];
-      for (int j = 0; j < 12; ++j) eFF(i, j) = cc.energy.hessian(i, j);
-    }
+    for (int i = 0; i < 12; ++i) eF[i] = cc.energy.g[static_cast<std::size_t>(i)];
     const Eigen::Index dm = dofs_m_, dn = dofs_n_;
-    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(12, n);
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(12, q.size());
     J.topLeftCorner(6, dm) = jm.jacobian.leftCols(dm);
     J.bottomRightCorner(6, dn) = jn.jacobian.leftCols(dn);
     out.gradient = J.transpose() * eF;
-    *hessian = J.transpose() * eFF * J;
-    for (int k = 0; k < 6; ++k) {
-      hessian->topLeftCorner(dm, dm) += eF[k] * jm.hessian[static_cast<std::size_t>(k)].topLeftCorner(dm, dm);
-      hessian->bottomRightCorner(dn, dn) += eF[6 + k] * jn.hessian[static_cast<std::size_t>(k)].topLeftCorner(dn, dn);
+    if constexpr (H) {
+      Eigen::Matrix<double, 12, 12> eFF;
+      for (int i = 0; i < 12; ++i)
+        for (int j = 0; j < 12; ++j) eFF(i, j) = cc.energy.hessian(i, j);
+      *hessian = J.transpose() * eFF * J;
+      for (int k = 0; k < 6; ++k) {
+        hessian->topLeftCorner(dm, dm) += eF[k] * jm.hessian[static_cast<std::size_t>(k)].topLeftCorner(dm, dm);
+        hessian->bottomRightCorner(dn, dn) += eF[6 + k] * jn.hessian[static_cast<std::size_t>(k)].topLeftCorner(dn, dn);
+      }
     }
+    return Core<double>{value_of(cc.energy), cc.twist, cc.twist_raw, cc.bend, cc.one_plus_c};
+  };
+  const bool wide = num_dofs() > 18;  // a tet side
+  // A vertex side's one-ring is wider than the whole-stencil jets: its derivatives are chained.
+  const bool vertex = std::holds_alternative<VertexSide>(m_) || std::holds_alternative<VertexSide>(n_);
+  Core<double> c;
+  if (hessian && (vertex || method == HessianMethod::chained)) {
+    c = chained.template operator()<true>();
+  } else if (want_gradient && vertex) {
+    c = chained.template operator()<false>();
   } else if (hessian) {
     c = wide ? whole.template operator()<max_dofs, true>() : whole.template operator()<18, true>();
   } else if (want_gradient) {

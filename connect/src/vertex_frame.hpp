@@ -17,7 +17,7 @@
 namespace sewn::connect::detail {
 
 /// A side's frame (m1, m3) as 6 values, with their Jacobian (6 × DOFs) and each value's
-/// second derivatives (DOFs × DOFs) over the side's DOFs.
+/// second derivatives (DOFs × DOFs) over the side's DOFs (empty if not asked for).
 struct FrameJet {
   Eigen::Matrix<double, 6, 1> value;
   Eigen::MatrixXd jacobian;
@@ -28,7 +28,8 @@ struct FrameJet {
 /// positions. Non-finite where w = 0 or e1 ∥ w (the caller refuses those at rest). O(ring).
 [[nodiscard]] std::array<Eigen::Vector3d, 2> vertex_frame(const Eigen::VectorXd& q, int at, int ring, double sign);
 
-/// The same with its first and second derivatives over the side's 3(ring + 1) DOFs. O(ring²).
-[[nodiscard]] FrameJet vertex_frame_jet(const Eigen::VectorXd& q, int at, int ring, double sign);
+/// The same with its first (and, if second_order, second) derivatives over the side's
+/// 3(ring + 1) DOFs. O(ring²) with second derivatives, else O(ring).
+[[nodiscard]] FrameJet vertex_frame_jet(const Eigen::VectorXd& q, int at, int ring, double sign, bool second_order);
 
 }  // namespace sewn::connect::detail

@@ -1,5 +1,6 @@
 #include "sewn/physics/solids/tet_element.hpp"
 
+#include <array>
 #include <cmath>
 #include <sstream>
 
@@ -222,9 +223,26 @@ Vec12 tet_gradient(TetLaw law, const TetPositions& x, const TetRest& rest, const
 
 namespace {
 
+// V̄ Bᵀ D B with B = ∂vec(F)/∂x, without forming B: ∂F(a, b)/∂x_k,a' = δaa' G(k, b), G's rows
+// the shape functions' gradients (row 0 minus the sum of Dm⁻¹'s rows), so the 3×3 block (k, m)
+// is V̄ Σ_bd G(k, b) G(m, d) D_bd, D_bd D's 3×3 blocks. 756 multiply-adds against the dense
+// product's 2268, and none of Eigen's GEMM set-up, which these sizes take: 12 % of the toy
+// ball's Newton step went to the dense form.
 Mat12 tet_hessian_from(const elements::Mat<9>& D, const TetRest& rest) {
-  const auto B = elements::deformation_jacobian<3>(rest.Dm_inv);
-  const Mat12 H = rest.volume * (B.transpose() * D * B);
+  Eigen::Matrix<double, 4, 3> G;
+  G.row(0) = -rest.Dm_inv.colwise().sum();
+  G.bottomRows<3>() = rest.Dm_inv;
+  std::array<Eigen::Matrix3d, 12> M;  // M[3m + b] = Σ_d G(m, d) D_bd
+  for (int m = 0; m < 4; ++m)
+    for (int b = 0; b < 3; ++b)
+      M[static_cast<std::size_t>(3 * m + b)] =
+          G(m, 0) * D.block<3, 3>(3 * b, 0) + G(m, 1) * D.block<3, 3>(3 * b, 3) + G(m, 2) * D.block<3, 3>(3 * b, 6);
+  Mat12 H;
+  for (int k = 0; k < 4; ++k)
+    for (int m = 0; m < 4; ++m) {
+      const auto* Mm = &M[static_cast<std::size_t>(3 * m)];
+      H.block<3, 3>(3 * k, 3 * m) = rest.volume * (G(k, 0) * Mm[0] + G(k, 1) * Mm[1] + G(k, 2) * Mm[2]);
+    }
   return 0.5 * (H + H.transpose());
 }
 

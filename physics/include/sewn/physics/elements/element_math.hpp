@@ -32,20 +32,4 @@ inline Eigen::Matrix3d cofactor(const Eigen::Matrix3d& A) {
   return C;
 }
 
-/// For a linear element of K+1 nodes whose deformation gradient is F = Ds·Dm⁻¹ (Ds's column j
-/// = x_{j+1} - x_0, F is 3×K), the constant (3K)×(3K+3) matrix B with vec(F) = B·q (vec
-/// column-major, q node-major). Energies chain through it: ∇q = Bᵀ vec(P), ∇²q = Bᵀ (∂P/∂F) B.
-template <int K>
-Eigen::Matrix<double, 3 * K, 3 * K + 3> deformation_jacobian(const Eigen::Matrix<double, K, K>& Dm_inv) {
-  Eigen::Matrix<double, 3 * K, 3 * K + 3> B = Eigen::Matrix<double, 3 * K, 3 * K + 3>::Zero();
-  for (int b = 0; b < K; ++b) {
-    const double w0 = -Dm_inv.col(b).sum();
-    for (int a = 0; a < 3; ++a) {
-      B(a + 3 * b, a) = w0;
-      for (int k = 1; k <= K; ++k) B(a + 3 * b, 3 * k + a) = Dm_inv(k - 1, b);
-    }
-  }
-  return B;
-}
-
 }  // namespace sewn::physics::elements
