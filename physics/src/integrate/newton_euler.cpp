@@ -293,13 +293,11 @@ NewtonEuler::History NewtonEuler::history(const System& sys) const {
 }
 
 void NewtonEuler::restore(System& sys, const History& h) {
-  if (!h.direct_failed && h.solver.factored.empty() && !h.solver.refresh_due && h.solver.cycle_solves == 0) {
-    ldlt_.reset();
-    return;
-  }
+  // A fresh cache, as at the start of a run, then what the history says it held.
   ldlt_ = std::make_unique<LdltCache>();
   ldlt_->cholmod_failed = h.direct_failed;
-  if (h.solver.factored.empty() && !h.solver.refresh_due && h.solver.cycle_solves == 0) return;
+  const bool kept = !h.solver.factored.empty() || h.solver.refresh_due || h.solver.cycle_solves != 0;
+  if (!kept) return;
   sys.refresh();
   kept_pcg().restore(sys.matrix(), h.solver);
   kept_topology_ = sys.topology_key();
