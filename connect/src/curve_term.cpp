@@ -1,11 +1,8 @@
 #include "sewn/connect/curve_term.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "sewn/physics/elements/element_math.hpp"
-#include "history.hpp"
 #include "trial_cap.hpp"
 
 namespace sewn::connect {
@@ -13,7 +10,7 @@ namespace sewn::connect {
 using physics::InputError;
 using physics::StateView;
 
-CurveConnections::CurveConnections(const physics::rods::Rods* rods, TwistUpdate update) : rods_(rods), update_(update) {}
+CurveConnections::CurveConnections(const physics::rods::Rods* rods, TwistUpdate update) : ConnectionTerm(rods, update) {}
 
 Index CurveConnections::add(const std::string& name, Index a, Index b, const EdgeSideRef& m, const EdgeSideRef& n,
                             double k_per_length, const StateView& s) {
@@ -41,19 +38,12 @@ Index CurveConnections::add(const std::string& name, Index a, Index b, const Edg
     }
   }
   const Eigen::VectorXd q_rest = dofs.gather(s, owner);
-  items_.push_back(Item{EdgeConnection(name, a, b, sm, sn, k_per_length, q_rest), std::move(dofs)});
-  touch_topology();
-  return size() - 1;
+  return push(EdgeConnection(name, a, b, sm, sn, k_per_length, q_rest), std::move(dofs));
 }
 
 EdgeEval CurveConnections::evaluate(Index c, const StateView& s) const {
   const Item& it = items_.at(c);
   return it.connection.evaluate(it.dofs.gather(s, it.owner()), update_, false);
-}
-
-void CurveConnections::add_forces(const StateView& s, std::span<double> f) const {
-  for (const Item& it : items_)
-    it.dofs.subtract_gradient(it.connection.evaluate(it.dofs.gather(s, it.owner()), update_, true).gradient, s, f);
 }
 
 double CurveConnections::potential_energy(const StateView& s) const {
@@ -67,69 +57,10 @@ double CurveConnections::potential_energy(const StateView& s) const {
   return E;
 }
 
-void CurveConnections::set_max_trial_turn(double radians) {
-  if (!(radians > 0.0)) throw InputError("curve connections: max_trial_turn must be > 0 rad (infinity: no limit), got " + std::to_string(radians));
-  max_trial_turn_ = radians;
-}
-
 double CurveConnections::step_fraction(const StateView& s, const StateView& dq) const {
   const auto evaluate = [&](const Item& it, const Eigen::VectorXd& q) { return it.connection.evaluate(q, update_, false).twist; };
   const auto turn = [&](double from, double to) { return detail::twist_turn(from, to, update_ == TwistUpdate::direct); };
   return detail::trial_fraction(items_, s, dq, max_trial_turn_, evaluate, turn);
-}
-
-void CurveConnections::collect_pairs(std::vector<physics::NodePair>& out) const {
-  for (const Item& it : items_) it.dofs.collect_pairs(angle_layout(), out);
-}
-
-void CurveConnections::bind_pattern(const physics::BlockMatrix& pattern) {
-  for (Item& it : items_) it.dofs.bind(angle_layout(), pattern);
-  bound_pattern_ = pattern.pattern_version();
-}
-
-void CurveConnections::add_jacobians(const StateView& s, const physics::JacobianRequest& req) const {
-  if (req.matrix && req.matrix->pattern_version() != bound_pattern_)
-    throw InputError("connect::CurveConnections::add_jacobians: the matrix does not carry the pattern this term was bound to");
-  for (const Item& it : items_) {
-    Eigen::MatrixXd H;
-    (void)it.connection.evaluate(it.dofs.gather(s, it.owner()), update_, true, &H);
-    if (req.options.project_element_hessians) physics::elements::project_psd(H);
-    it.dofs.add_hessian(H, angle_layout(), req);
-  }
-}
-
-void CurveConnections::step_accepted(const StateView& s) {
-  for (Item& it : items_) it.connection.accept(it.dofs.gather(s, it.owner()), update_);
-}
-
-void CurveConnections::check_nodes(const physics::NodeTable& nodes) const {
-  for (const Item& it : items_) it.dofs.check_nodes(nodes, it.owner());
-}
-
-Index CurveConnections::remove_dangling(const physics::NodeTable& nodes) {
-  const auto before = items_.size();
-  std::erase_if(items_, [&](const Item& it) { return it.dofs.touches_removed(nodes); });
-  const auto removed = static_cast<Index>(before - items_.size());
-  if (removed > 0) touch_topology();
-  return removed;
-}
-
-void CurveConnections::remap_nodes(std::span<const Index> old_to_new) {
-  for (Item& it : items_) {
-    it.dofs.remap_nodes(old_to_new);
-    it.connection.remap_nodes(old_to_new);
-  }
-  touch_topology();
-}
-
-std::vector<double> CurveConnections::history() const { return detail::items_history(items_); }
-
-void CurveConnections::restore(std::span<const double> h) { detail::restore_items(items_, h, std::string(name())); }
-
-std::vector<bool> CurveConnections::follow_nodes(Index num_nodes, const NodeDecision& decide) {
-  std::vector<bool> kept = detail::follow_items(items_, num_nodes, decide);
-  touch_topology();
-  return kept;
 }
 
 }  // namespace sewn::connect

@@ -4,14 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
-#include <span>
 #include <string>
 #include <variant>
 #include <vector>
 
 #include "sewn/connect/point.hpp"
-#include "sewn/connect/stencil_dofs.hpp"
 
 namespace sewn::connect::detail {
 
@@ -58,65 +55,6 @@ double take_history(const ConnectionHistory& h, SideVariant& m, SideVariant& n, 
     at += 6;
   }
   return h[0];
-}
-
-/// A term's history: its connections' in order, history_size values each.
-template <class Items>
-std::vector<double> items_history(const Items& items) {
-  std::vector<double> out;
-  out.reserve(items.size() * history_size);
-  for (const auto& it : items) {
-    const ConnectionHistory h = it.connection.history();
-    out.insert(out.end(), h.begin(), h.end());
-  }
-  return out;
-}
-
-/// Takes up items_history() of a term built the same way; nothing changes if a value does not
-/// fit (physics::InputError naming `term` or the connection).
-template <class Items>
-void restore_items(Items& items, std::span<const double> h, const std::string& term) {
-  if (h.size() != items.size() * history_size)
-    throw physics::InputError(term + ": a history of " + std::to_string(h.size()) + " values for " + std::to_string(items.size()) +
-                              " connections (" + std::to_string(history_size) + " each)");
-  std::vector<decltype(items.front().connection)> restored;
-  restored.reserve(items.size());
-  for (std::size_t c = 0; c < items.size(); ++c) {
-    ConnectionHistory one{};
-    std::copy(h.begin() + static_cast<std::ptrdiff_t>(c * history_size), h.begin() + static_cast<std::ptrdiff_t>((c + 1) * history_size),
-              one.begin());
-    restored.push_back(items[c].connection);
-    restored.back().restore(one);
-  }
-  for (std::size_t c = 0; c < items.size(); ++c) items[c].connection = std::move(restored[c]);
-}
-
-/// The rule under cuts for a term's items (follow_nodes): per item, remove or rename its nodes.
-template <class Items>
-std::vector<bool> follow_items(Items& items, Index num_nodes, const NodeDecision& decide) {
-  // every decision first, checked, then applied: an id out of range changes nothing
-  std::vector<bool> kept(items.size(), false);
-  std::vector<std::vector<std::pair<Index, Index>>> renames(items.size());
-  for (std::size_t c = 0; c < items.size(); ++c) {
-    kept[c] = decide(static_cast<Index>(c), renames[c]);
-    for (const auto& r : renames[c])
-      if (r.first >= num_nodes || r.second >= num_nodes)
-        throw physics::InputError(items[c].owner() + ": renamed node " + std::to_string(r.first) + " -> " + std::to_string(r.second) +
-                                  " is not below the node count " + std::to_string(num_nodes));
-  }
-  std::vector<Index> map(num_nodes);
-  std::iota(map.begin(), map.end(), Index{0});
-  Items out;
-  for (std::size_t c = 0; c < items.size(); ++c) {
-    if (!kept[c]) continue;
-    for (const auto& r : renames[c]) map[r.first] = r.second;
-    items[c].dofs.remap_nodes(map);
-    items[c].connection.remap_nodes(map);
-    for (const auto& r : renames[c]) map[r.first] = r.first;
-    out.push_back(std::move(items[c]));
-  }
-  items = std::move(out);
-  return kept;
 }
 
 }  // namespace sewn::connect::detail

@@ -3,11 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 
-#include "sewn/physics/elements/element_math.hpp"
-#include "sewn/physics/nodes.hpp"
-#include "history.hpp"
 #include "trial_cap.hpp"
 
 namespace sewn::connect {
@@ -40,7 +36,7 @@ RodEdgeBinding bind_rod_edge(const physics::rods::Rods* rods, const RodEdgeRef& 
   return out;
 }
 
-PointConnections::PointConnections(const physics::rods::Rods* rods, TwistUpdate update) : rods_(rods), update_(update) {}
+PointConnections::PointConnections(const physics::rods::Rods* rods, TwistUpdate update) : ConnectionTerm(rods, update) {}
 
 Index PointConnections::add(const std::string& name, const SideRef& m, const SideRef& n, PointStiffness k, const StateView& s) {
   std::array<Index, 2> angle{physics::invalid_index, physics::invalid_index};
@@ -65,9 +61,7 @@ Index PointConnections::add(const std::string& name, const SideRef& m, const Sid
     if (rod) dofs.add_angle(angle[static_cast<std::size_t>(which)]);
   }
   const Eigen::VectorXd q_rest = dofs.gather(s, "point connection '" + name + "'");
-  items_.push_back(Item{PointConnection(name, sm, sn, k, q_rest), std::move(dofs)});
-  touch_topology();
-  return size() - 1;
+  return push(PointConnection(name, sm, sn, k, q_rest), std::move(dofs));
 }
 
 PointEval PointConnections::evaluate(Index c, const StateView& s) const {
@@ -85,20 +79,10 @@ double PointConnections::guarded_energy(const Item& it, const PointEval& e) cons
   return (e.singular() || aliasing) ? std::numeric_limits<double>::infinity() : e.energy;
 }
 
-void PointConnections::add_forces(const StateView& s, std::span<double> f) const {
-  for (const Item& it : items_)
-    it.dofs.subtract_gradient(it.connection.evaluate(it.dofs.gather(s, it.owner()), update_, true).gradient, s, f);
-}
-
 double PointConnections::potential_energy(const StateView& s) const {
   double E = 0;
   for (const Item& it : items_) E += guarded_energy(it, it.connection.evaluate(it.dofs.gather(s, it.owner()), update_, false));
   return E;
-}
-
-void PointConnections::set_max_trial_turn(double radians) {
-  if (!(radians > 0.0)) throw InputError("point connections: max_trial_turn must be > 0 rad (infinity: no limit), got " + std::to_string(radians));
-  max_trial_turn_ = radians;
 }
 
 double PointConnections::step_fraction(const StateView& s, const StateView& dq) const {
@@ -107,62 +91,6 @@ double PointConnections::step_fraction(const StateView& s, const StateView& dq) 
     return std::max(detail::twist_turn(from.twist, to.twist, update_ == TwistUpdate::direct), std::abs(to.bend_angle - from.bend_angle));
   };
   return detail::trial_fraction(items_, s, dq, max_trial_turn_, evaluate, turn);
-}
-
-void PointConnections::collect_pairs(std::vector<physics::NodePair>& out) const {
-  for (const Item& it : items_) it.dofs.collect_pairs(angle_layout(), out);
-}
-
-void PointConnections::bind_pattern(const physics::BlockMatrix& pattern) {
-  for (Item& it : items_) it.dofs.bind(angle_layout(), pattern);
-  bound_pattern_ = pattern.pattern_version();
-}
-
-void PointConnections::add_jacobians(const StateView& s, const physics::JacobianRequest& req) const {
-  if (req.matrix && req.matrix->pattern_version() != bound_pattern_)
-    throw InputError("connect::PointConnections::add_jacobians: the matrix does not carry the pattern this term was bound to");
-  for (const Item& it : items_) {
-    Eigen::MatrixXd H;
-    (void)it.connection.evaluate(it.dofs.gather(s, it.owner()), update_, true, &H);
-    if (req.options.project_element_hessians) physics::elements::project_psd(H);
-    it.dofs.add_hessian(H, angle_layout(), req);
-  }
-}
-
-void PointConnections::step_accepted(const StateView& s) {
-  for (Item& it : items_) it.connection.accept(it.dofs.gather(s, it.owner()), update_);
-}
-
-void PointConnections::check_nodes(const physics::NodeTable& nodes) const {
-  for (const Item& it : items_) it.dofs.check_nodes(nodes, it.owner());
-}
-
-Index PointConnections::remove_dangling(const physics::NodeTable& nodes) {
-  const auto before = items_.size();
-  std::erase_if(items_, [&](const Item& it) { return it.dofs.touches_removed(nodes); });
-  const auto removed = static_cast<Index>(before - items_.size());
-  if (removed > 0) touch_topology();
-  return removed;
-}
-
-void PointConnections::remap_nodes(std::span<const Index> old_to_new) {
-  // Both the DOF table and the connection's own node ids (its sides, joint and layout), so that
-  // errors name the current nodes.
-  for (Item& it : items_) {
-    it.dofs.remap_nodes(old_to_new);
-    it.connection.remap_nodes(old_to_new);
-  }
-  touch_topology();
-}
-
-std::vector<double> PointConnections::history() const { return detail::items_history(items_); }
-
-void PointConnections::restore(std::span<const double> h) { detail::restore_items(items_, h, std::string(name())); }
-
-std::vector<bool> PointConnections::follow_nodes(Index num_nodes, const NodeDecision& decide) {
-  std::vector<bool> kept = detail::follow_items(items_, num_nodes, decide);
-  touch_topology();
-  return kept;
 }
 
 }  // namespace sewn::connect

@@ -65,6 +65,8 @@ enum class EdgeDerivatives { reduced, whole_stencil };
 
 class EdgeConnection {
  public:
+  /// How errors and reports name a connection of this kind.
+  static constexpr std::string_view kind = "curve connection";
   /// Joins sides m and n along the edge (a, b) with stiffness `k_per_length` (N/rad, ≥ 0) at
   /// the rest configuration q_rest (stencil order; stencil_nodes() gives the nodes, which
   /// edge_stencil_nodes() gives before construction). Sets l̄, δ̄ and the accepted δ.

@@ -36,6 +36,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -139,6 +140,8 @@ inline constexpr double bend_margin = 1e-2;
 
 class PointConnection {
  public:
+  /// How errors and reports name a connection of this kind.
+  static constexpr std::string_view kind = "point connection";
   /// Joins sides m and n at their shared node, with the rest configuration q_rest (stencil
   /// order, see position_nodes() after construction: build q_rest from those nodes — use
   /// stencil_layout() first if needed). Sets δ̄, d̄ and the accepted δ from the rest state.
