@@ -205,6 +205,8 @@ def markdown(suite, header, rows, reps, scale, date, plots, written, sections=()
         out += [f"Written by `bench/run.sh {suite}`: regenerate, never edit.", ""]
     out.append(f"- CPU: {header['cpu']}")
     out.append(f"- Compiler: {header['compiler']}")
+    if header.get("blas"):
+        out.append(f"- Dense kernels of CHOLMOD's factorizations: {header['blas']}")
     out.append(f"- Date: {date}")
     if header.get("load"):
         out.append(f"- Machine load (1-minute average) when the benchmarks started / when the report was written: "
@@ -271,6 +273,7 @@ def main():
         "suite": args.suite,
         "cpu": f"{cpu_model()} ({cpus} logical CPUs)",
         "compiler": ctx.get("sewn_build", "unknown compiler"),
+        "blas": ctx.get("sewn_blas"),
         "load": machine_load(ctx),
     }
     reps = max(len(r["time"]) for r in runs.values())

@@ -23,6 +23,7 @@
 #include "sewn/io/read.hpp"
 #include "sewn/io/write_gmsh.hpp"
 #include "sewn/physics/errors.hpp"
+#include "sewn/physics/solve/blas_kernels.hpp"
 
 namespace {
 
@@ -337,6 +338,8 @@ int main(int argc, char** argv) {
   const std::vector<std::string> all(argv + 1, argv + argc);
   const std::string cmd = all.empty() ? "--help" : all[0];
   const std::vector<std::string> args(all.begin() + (all.empty() ? 0 : 1), all.end());
+  // Only a run factors matrices: the other commands do not pay for a second start.
+  if (cmd == "run") sewn::physics::solve::restart_with_cpu_kernels(argv);
   try {
     if (cmd == "--help" || cmd == "-h" || cmd == "help") {
       std::fputs(usage, stdout);

@@ -1,8 +1,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <set>
+#include <string>
 #include <vector>
 
+#include "sewn/physics/solve/blas_kernels.hpp"
 #include "sewn_bench.hpp"
 
 namespace sewn::bench {
@@ -64,8 +66,12 @@ bool first_time(const std::string& key) {
 }  // namespace sewn::bench
 
 int main(int argc, char** argv) {
+  // the kernels `sewn run` factors with (blas_kernels.hpp), so the reports measure what it gets
+  sewn::physics::solve::restart_with_cpu_kernels(argv);
   const sewn::bench::Scale scale = sewn::bench::scale();
   benchmark::AddCustomContext("sewn_build", SEWN_BENCH_BUILD);
+  if (const std::string kernels = sewn::physics::solve::openblas_kernels(); !kernels.empty())
+    benchmark::AddCustomContext("sewn_blas", "OpenBLAS, " + kernels + " kernels");
   benchmark::AddCustomContext("sewn_scale", sewn::bench::to_string(scale));
   for (auto fn : sewn::bench::registrations()) fn();
   benchmark::Initialize(&argc, argv);

@@ -18,6 +18,7 @@
 #include "sewn/io/errors.hpp"
 #include "sewn/io/geometry.hpp"
 #include "sewn/physics/errors.hpp"
+#include "sewn/physics/solve/blas_kernels.hpp"
 #include "scratch.hpp"
 
 namespace fs = std::filesystem;
@@ -84,10 +85,11 @@ void expect_run_error(const std::string& scene_text, const std::string& needle) 
   }
 }
 
-// Runs the sewn binary; returns its exit code and fills `err` with what it printed.
-int run_binary(const std::string& args, std::string& err) {
+// Runs the sewn binary (with the shell's variable assignments `env` before it); returns its exit
+// code and fills `err` with what it printed.
+int run_binary(const std::string& args, std::string& err, const std::string& env = "") {
   const fs::path log = scratch("stderr.txt");
-  const std::string cmd = std::string(SEWN_BINARY) + " " + args + " > /dev/null 2> " + log.string();
+  const std::string cmd = env + " " + std::string(SEWN_BINARY) + " " + args + " > /dev/null 2> " + log.string();
   const int status = std::system(cmd.c_str());
   std::ifstream in(log);
   err.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
@@ -541,6 +543,41 @@ TEST_CASE("model solid: finite-element tetrahedra replace the springs, stepped b
       "cuts": [{"type": "plane", "time": 0.05, "point": [0.1, 0, 0], "normal": [1, 0, 0]}]})";
     expect_run_error<SceneError>(rod, "cutting is supported on solid tetrahedra and shells only, and this scene has 2 rod segments");
   }
+}
+
+// OPENBLAS_VERBOSE=2 makes OpenBLAS print the kernels it loads ("Core: <name>"), once per process.
+std::vector<std::string> openblas_cores(const std::string& printed) {
+  std::vector<std::string> cores;
+  std::istringstream in(printed);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("Core: ", 0) == 0) cores.push_back(line.substr(6));
+  return cores;
+}
+
+TEST_CASE("sewn run starts again with the CPU's OpenBLAS kernels where OpenBLAS fell back to its generic ones") {
+  namespace solve = sewn::physics::solve;
+  if (solve::openblas_kernels().empty()) return;  // built without OpenBLAS: nothing to choose
+  // This process loaded the same OpenBLAS from the same environment: it says what the tool sees.
+  const std::string wanted = solve::openblas_coretype_wanted();
+  std::string err;
+  REQUIRE(run_binary("run --until 0.01 --quiet --out " + scratch("kernels").string(), err, "OPENBLAS_VERBOSE=2") == 0);
+  const std::vector<std::string> cores = openblas_cores(err);
+  CAPTURE(err);
+  if (wanted.empty()) {
+    CHECK(cores.size() == 1);
+  } else {
+    REQUIRE(cores.size() == 2);
+    CHECK(cores[0] == solve::openblas_kernels());
+    CHECK(cores[1] == wanted);
+  }
+  // the user's choice stands: one process, the kernels asked for
+  REQUIRE(run_binary("run --until 0.01 --quiet --out " + scratch("kernels").string(), err,
+                     "OPENBLAS_VERBOSE=2 OPENBLAS_CORETYPE=Prescott") == 0);
+  REQUIRE(openblas_cores(err).size() == 1);
+  CHECK(openblas_cores(err)[0] == "Prescott");
+  // other commands do not start twice
+  REQUIRE(run_binary("--help", err, "OPENBLAS_VERBOSE=2") == 0);
+  CHECK(openblas_cores(err).size() == 1);
 }
 
 }  // namespace test_run
