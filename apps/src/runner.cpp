@@ -21,6 +21,7 @@
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/rods/rods_term.hpp"
 #include "sewn/physics/solids/inversion.hpp"
+#include "sewn/physics/solve/linear_solver.hpp"
 #include "sewn/physics/threads.hpp"
 #include "sewn/refine/cut.hpp"
 #include "sewn/refine/hierarchy.hpp"
@@ -112,15 +113,32 @@ physics::integrate::NewtonEulerOptions newton_options(const Scene& scene) {
   return o;
 }
 
-// Whether the system simulates discrete elastic rods. Their bend-twist stiffness, orders of
-// magnitude above their stretch and bending in the mass-weighted metric, leaves block-Jacobi CG
-// with hundreds to tens of thousands of iterations a Newton system (a 16-edge helix at h = 10 ms:
-// 519 a step; docs/solvers.md), where a direct factorization solves it exactly: so a Newton
-// scene with rods and solver `auto` solves by `ldlt` (CHOLMOD when built, else Eigen's LDLᵀ).
+// Whether the system simulates discrete elastic rods.
 bool has_rods(const physics::System& sys) {
   for (const auto& t : sys.terms())
     if (dynamic_cast<const physics::rods::Rods*>(t.get()) != nullptr) return true;
   return false;
+}
+
+// What solver `auto` gives Newton, by the model's size (docs/solvers.md, "Newton's default").
+// Elastic models are stiff against their mass: block-Jacobi CG took 440-1300 iterations a Newton
+// system on the elastic scenes and beams, rods far more (a 16-edge helix at h = 10 ms: 519 a
+// step; ~28 000 on a hanging rod), where a factorization solves exactly. Measured with
+// `sewn run`: up to ~1000 nodes the direct `ldlt` was 3-13x faster than CG and on a par with
+// `cholmod-pcg`; on a 6561-node solid cantilever `cholmod-pcg` (a factor kept across Newton
+// iterations and steps) was 1.5x faster than `ldlt` and 4.8x than CG. Past the size where the
+// implicit integrators' `auto` stops keeping a factor (8000 nodes: factors of hundreds of MB),
+// CG, or `ldlt` with rods, which leave CG no chance.
+constexpr physics::Index newton_direct_nodes = 2000;
+constexpr physics::Index newton_kept_factor_nodes = 8000;
+
+physics::integrate::LinearSolver newton_auto_solver(const physics::System& sys) {
+  using physics::integrate::LinearSolver;
+  const physics::Index nodes = sys.nodes().num_alive();
+  if (nodes <= newton_direct_nodes) return LinearSolver::ldlt;
+  if (nodes <= newton_kept_factor_nodes && physics::solve::available(physics::solve::Backend::cholmod_pcg))
+    return LinearSolver::cholmod_pcg;
+  return has_rods(sys) ? LinearSolver::ldlt : LinearSolver::cg;
 }
 
 // The warning for the first implicit step that created energy.
@@ -225,7 +243,7 @@ RunLoop::RunLoop(const Scene& scene, const RunOptions& options, Bodies& bodies, 
       use_implicit_(scene.integrator == "implicit" || use_midpoint_),
       use_newton_(scene.integrator == "newton"),
       bar_(!options.quiet && options.progress && isatty(STDERR_FILENO)) {
-  if (use_newton_ && scene.solver == "auto" && has_rods(model_.system())) newton_.options().solver = physics::integrate::LinearSolver::ldlt;
+  if (use_newton_ && scene.solver == "auto") newton_.options().solver = newton_auto_solver(model_.system());
   for (std::size_t k = 0; k < scene.cuts.size(); ++k) cuts_.emplace_back(scene.cuts[k].time, k);
   std::stable_sort(cuts_.begin(), cuts_.end());
   if (resuming_ || options.checkpoint_every > 0) run_id_ = detail::run_hash(scene, model_, steps_, frames_);

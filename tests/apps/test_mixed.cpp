@@ -24,6 +24,7 @@
 #include "sewn/physics/rods/rods_term.hpp"
 #include "sewn/physics/shells/shell_terms.hpp"
 #include "sewn/physics/solids/tets.hpp"
+#include "sewn/physics/solve/linear_solver.hpp"
 
 #include "force_check.hpp"
 #include "scratch.hpp"
@@ -449,7 +450,20 @@ RunSummary run_helix(const std::string& solver) {
   return run_quietly(j, "helix");
 }
 
-TEST_CASE("Newton's solver `auto` solves a scene with rods by the direct factorization, others by block-Jacobi CG") {
+// A beam of tetrahedra (cells x 2 x 2 to x 15 x 15, 6 Kuhn tets a cell) clamped at x = 0, one Newton step
+// of h with the scene's `solver`.
+RunSummary run_tet_beam(const std::string& solver, std::vector<int> cells, double h) {
+  nlohmann::json j = {{"materials", {{"m", {{"young", 1e6}, {"density", 1000}}}}},
+                      {"meshes", {{{"type", "tet_grid"}, {"material", "m"}, {"cells", cells}, {"size", {0.3, 0.1, 0.1}}}}},
+                      {"model", {{"type", "solid"}}},
+                      {"damping", {{"model", "rayleigh"}, {"alpha", 1.0}}},
+                      {"fixed", {{{"where", {{"type", "box"}, {"min", {-1, -1, -1}}, {"max", {0.001, 1, 1}}}}}}},
+                      {"integrator", {{"type", "newton"}, {"step", h}, {"solver", solver}}},
+                      {"duration", h}};
+  return run_quietly(j, "solid");
+}
+
+TEST_CASE("Newton's solver `auto` picks by size: ldlt, then cholmod-pcg, then block-Jacobi CG (ldlt with rods)") {
   // Block-Jacobi CG needs ~500 iterations a step here (hopeless on stiffer rods); `auto` must
   // take ldlt's path: no CG iteration, the same Newton iterations and state as `ldlt`.
   const RunSummary automatic = run_helix("auto"), direct = run_helix("ldlt"), jacobi = run_helix("jacobi");
@@ -457,15 +471,21 @@ TEST_CASE("Newton's solver `auto` solves a scene with rods by the direct factori
   CHECK(automatic.newton_iterations == direct.newton_iterations);
   CHECK(automatic.kinetic_end == direct.kinetic_end);
   CHECK(jacobi.linear_iterations > 100 * jacobi.steps);
-  // Without rods `auto` stays block-Jacobi CG (a Newton scene of tetrahedra).
-  nlohmann::json j = {{"materials", {{"m", {{"young", 1e6}, {"density", 1000}}}}},
-                      {"meshes", {{{"type", "tet_grid"}, {"material", "m"}, {"cells", {3, 1, 1}}, {"size", {0.3, 0.1, 0.1}}}}},
-                      {"model", {{"type", "solid"}}},
-                      {"damping", {{"model", "rayleigh"}, {"alpha", 1.0}}},
-                      {"fixed", {{{"where", {{"type", "box"}, {"min", {-1, -1, -1}}, {"max", {0.001, 1, 1}}}}}}},
-                      {"integrator", {{"type", "newton"}, {"step", 0.01}}},
-                      {"duration", 0.02}};
-  CHECK(run_quietly(j, "solid").linear_iterations > 0);
+  // Without rods, by the node count: 4 x 3 x 3 nodes, ldlt's run exactly
+  const RunSummary small = run_tet_beam("auto", {3, 2, 2}, 0.01);
+  CHECK(small.linear_iterations == 0);
+  CHECK(small.kinetic_end == run_tet_beam("ldlt", {3, 2, 2}, 0.01).kinetic_end);
+  CHECK(run_tet_beam("jacobi", {3, 2, 2}, 0.01).linear_iterations > 0);
+  // 31 x 9 x 9 = 2511 nodes: the factor kept across Newton iterations, where CHOLMOD is built
+  if (sewn::physics::solve::available(sewn::physics::solve::Backend::cholmod_pcg)) {
+    const RunSummary mid = run_tet_beam("auto", {30, 8, 8}, 0.01);
+    CHECK(mid.linear_iterations > 0);
+    CHECK(mid.kinetic_end == run_tet_beam("cholmod-pcg", {30, 8, 8}, 0.01).kinetic_end);
+  }
+  // 41 x 16 x 16 = 10 496 nodes: block-Jacobi CG (a short step keeps its iterations few)
+  const RunSummary large = run_tet_beam("auto", {40, 15, 15}, 1e-5);
+  CHECK(large.linear_iterations > 0);
+  CHECK(large.kinetic_end == run_tet_beam("jacobi", {40, 15, 15}, 1e-5).kinetic_end);
 }
 
 }  // namespace mixed_test
