@@ -19,6 +19,7 @@
 #include "sewn/io/geometry.hpp"
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/solve/blas_kernels.hpp"
+#include "sewn/physics/solve/linear_solver.hpp"
 #include "scratch.hpp"
 
 namespace fs = std::filesystem;
@@ -578,6 +579,22 @@ TEST_CASE("sewn run starts again with the CPU's OpenBLAS kernels where OpenBLAS 
   // other commands do not start twice
   REQUIRE(run_binary("--help", err, "OPENBLAS_VERBOSE=2") == 0);
   CHECK(openblas_cores(err).size() == 1);
+}
+
+TEST_CASE("a hypre-pcg run whose MPI solvers module cannot be loaded fails naming the path tried") {
+  if (!sewn::physics::solve::available(sewn::physics::solve::Backend::hypre_pcg)) return;  // not built
+  const fs::path scene = scratch("mpi_module.json");
+  write(scene, R"({"materials": {"m": {"young": 1e6, "density": 1000}},
+    "meshes": [{"type": "hex_grid", "material": "m", "cells": [2, 1, 1], "size": [0.2, 0.1, 0.1]}],
+    "fixed": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [0.001, 1, 1]}}],
+    "integrator": {"type": "implicit", "step": 0.001, "solver": "hypre-pcg"}, "duration": 0.002})");
+  std::string err;
+  const std::string args = "run " + scene.string() + " --quiet --out " + scratch("mpi_module").string();
+  CHECK(run_binary(args, err, "SEWN_MPI_SOLVERS=/nonexistent/libsewn_mpi_solvers.so") == 1);
+  CAPTURE(err);
+  CHECK(err.find("could not be loaded") != std::string::npos);
+  CHECK(err.find("/nonexistent/libsewn_mpi_solvers.so") != std::string::npos);
+  CHECK(run_binary(args, err) == 0);  // where the build put it
 }
 
 }  // namespace test_run

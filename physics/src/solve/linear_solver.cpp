@@ -3,6 +3,7 @@
 #include <string>
 
 #include "backends.hpp"
+#include "mpi_module.hpp"
 #include "sewn/physics/errors.hpp"
 
 namespace sewn::physics::solve {
@@ -122,19 +123,23 @@ std::unique_ptr<LinearSolver> make_solver(Backend b, SolverOptions options, std:
     case Backend::cholmod_pcg: return detail::make_cholmod_pcg(options);
 #endif
 #ifdef SEWN_HAVE_HYPRE
-    case Backend::hypre_pcg: return detail::make_hypre_pcg(options);
+    case Backend::hypre_pcg: return detail::mpi_backends().make_hypre_pcg(options);
 #endif
 #ifdef SEWN_HAVE_PETSC
-    case Backend::petsc: return detail::make_petsc(options);
+    case Backend::petsc: return detail::mpi_backends().make_petsc(options);
 #endif
     case Backend::sa_pcg: return detail::make_sa_pcg(options);
     default: return detail::make_jacobi(options);
   }
 }
 
-#ifndef SEWN_HAVE_MPI
-int solver_ranks() { return 1; }
+int solver_ranks() {
+#ifdef SEWN_HAVE_MPI
+  return detail::mpi_backends().ranks();
+#else
+  return 1;
 #endif
+}
 
 void LinearSolver::restore(const BlockMatrix& /*A*/, const SolverState& s) {
   if (!s.factored.empty())

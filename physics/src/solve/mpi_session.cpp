@@ -8,7 +8,6 @@
 #include <string>
 
 #include "sewn/physics/errors.hpp"
-#include "sewn/physics/solve/linear_solver.hpp"
 
 namespace sewn::physics::solve::detail {
 
@@ -36,15 +35,11 @@ void ensure_mpi() {
   });
 }
 
-}  // namespace sewn::physics::solve::detail
-
-namespace sewn::physics::solve {
-
-int solver_ranks() {
-  detail::ensure_mpi();
+int mpi_ranks() {
+  ensure_mpi();
   int size = 1;
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   return size;
 }
 
-}  // namespace sewn::physics::solve
+}  // namespace sewn::physics::solve::detail

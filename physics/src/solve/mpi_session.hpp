@@ -36,4 +36,7 @@ class LeakCheckPause {
 /// finalised or cannot start. O(1) after the first call (the first costs ~0.5 s with OpenMPI).
 void ensure_mpi();
 
+/// MPI_COMM_WORLD's size, MPI started first if needed (solve::solver_ranks()).
+int mpi_ranks();
+
 }  // namespace sewn::physics::solve::detail
