@@ -19,6 +19,7 @@ using ConstPanel = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
 using Dense = Eigen::Map<Eigen::MatrixXd>;
 using VecX = Eigen::Map<Eigen::VectorXd>;
 using Vec3 = Eigen::Map<Eigen::Vector3d>;
+using Block = Eigen::Map<Eigen::Matrix3d>;
 using ConstBlock = Eigen::Map<const Eigen::Matrix3d>;
 
 using Block3 = Eigen::Map<Eigen::Matrix3d, 0, Eigen::OuterStride<>>;
@@ -26,20 +27,6 @@ using ConstBlock3 = Eigen::Map<const Eigen::Matrix3d, 0, Eigen::OuterStride<>>;
 
 constexpr Index none = invalid_index;
 
-// Where a panel keeps its 3×3 blocks: block (a, b) (block row a, block column b) starts at
-// a·step + 3b·ld, its columns ld apart. A panel one pivot wide stores them one after another
-// (step 9, ld 3), what the fixed-size kernels read fastest; a wider one is column-major
-// (step 3, ld its scalar rows), what the dense kernels take.
-struct Layout {
-  std::size_t step, ld;
-  [[nodiscard]] std::size_t at(std::size_t a, std::size_t b) const { return a * step + 3 * b * ld; }
-  [[nodiscard]] Eigen::OuterStride<> stride() const { return Eigen::OuterStride<>(static_cast<Eigen::Index>(ld)); }
-};
-
-Layout layout(std::size_t width, std::size_t below) {
-  if (width == 1) return {9, 3};
-  return {3, 3 * (width + below)};
-}
 constexpr std::size_t no_supernode = static_cast<std::size_t>(-1);
 
 // Supernodes narrower than this many pivots are factored one pivot at a time with fixed-size
@@ -49,28 +36,36 @@ constexpr std::size_t no_supernode = static_cast<std::size_t>(-1);
 // and 20-50 % zeros) measured no faster on any, slower on the toy ball's and the jellyfish's.
 constexpr Index dense_width = 4;
 
+// The rows of a column-major panel (width pivots, `below` block rows under them) from its
+// block row `from` below the diagonal block on.
+ConstPanel rows_below(const double* panel, std::size_t width, std::size_t below, std::size_t from) {
+  const auto ld = static_cast<Eigen::Index>(3 * (width + below));
+  return {panel + 3 * (width + from), static_cast<Eigen::Index>(3 * (below - from)), static_cast<Eigen::Index>(3 * width), Eigen::OuterStride<>(ld)};
+}
+
 // to(pos(a), pos(b)) -= L(a) L(b)ᵀ for the block rows a ≥ b < n1 of a one-pivot-wide
 // descendant (its blocks `l`, 9 values each; pos(a) = relpos[rows[a]]; b < n1: the rows among
 // the pivots updated): fixed-size 3×3 products, as cheap as they get for a chain or a sparse mesh.
 void subtract_blockwise(const double* l, const Index* rows, std::size_t n, std::size_t n1, const std::size_t* relpos, double* to,
-                        const Layout& lay) {
+                        std::size_t ld) {
   for (std::size_t b = 0; b < n1; ++b) {
     const Eigen::Matrix3d lb_t = ConstBlock(l + 9 * b).transpose();
-    const std::size_t column = lay.at(0, relpos[rows[b]]);
-    for (std::size_t a = b; a < n; ++a) Block3(to + column + lay.at(relpos[rows[a]], 0), lay.stride()).noalias() -= ConstBlock(l + 9 * a) * lb_t;
+    double* column = to + 3 * relpos[rows[b]] * ld;
+    const Eigen::OuterStride<> stride(static_cast<Eigen::Index>(ld));
+    for (std::size_t a = b; a < n; ++a) Block3(column + 3 * relpos[rows[a]], stride).noalias() -= ConstBlock(l + 9 * a) * lb_t;
   }
 }
 
 // to(pos[a], pos[b]) -= c(a, b) for the block rows a ≥ b of a descendant's update c; in a
 // column-major panel, runs of rows consecutive in it one column at a time.
-void scatter_update(const Dense& c, std::span<const std::size_t> pos, double* to, const Layout& lay) {
+void scatter_update(const Dense& c, std::span<const std::size_t> pos, double* to, std::size_t ld) {
   const std::size_t n1 = static_cast<std::size_t>(c.cols()) / 3, ldc = static_cast<std::size_t>(c.rows());
   for (std::size_t b = 0; b < n1; ++b)
     for (std::size_t a = b; a < pos.size();) {
       std::size_t run = 1;
-      while (lay.step == 3 && a + run < pos.size() && pos[a + run] == pos[a] + run) ++run;
+      while (a + run < pos.size() && pos[a + run] == pos[a] + run) ++run;
       for (std::size_t x = 0; x < 3; ++x) {
-        double* into = to + lay.at(pos[a], pos[b]) + x * lay.ld;
+        double* into = to + (3 * pos[b] + x) * ld + 3 * pos[a];
         const double* from = c.data() + (3 * b + x) * ldc + 3 * a;
         for (std::size_t k = 0; k < 3 * run; ++k) into[k] -= from[k];
       }
@@ -248,7 +243,7 @@ void BlockCholesky::symbolic(const BlockMatrix& A) {
     const Index f = sn_first_[s], width = sn_first_[s + 1] - f;
     const auto below = rows_.begin() + static_cast<std::ptrdiff_t>(sn_rows_[s]);
     const auto end = rows_.begin() + static_cast<std::ptrdiff_t>(sn_rows_[s + 1]);
-    const Layout lay = layout(width_of(s), below_of(s));
+    const std::size_t ld = 3 * (width_of(s) + below_of(s));  // the column-major panel's (one pivot wide: unused)
     const Index c = perm_[j];
     for (Index k = rows[c]; k < rows[c + 1]; ++k) {
       const Index i = pinv_[cols[k]];
@@ -256,7 +251,7 @@ void BlockCholesky::symbolic(const BlockMatrix& A) {
       const std::size_t at = i < f + width ? std::size_t{i - f} : width + static_cast<std::size_t>(std::lower_bound(below, end, i) - below);
       a_slot_.push_back(A.find(cols[k], c));  // block (r, c): row r of column c
       a_row_.push_back(i);
-      a_dst_.push_back(sn_val_[s] + lay.at(at, j - f));
+      a_dst_.push_back(sn_val_[s] + 3 * std::size_t{j - f} * ld + 3 * at);
     }
     a_col_.push_back(a_slot_.size());
   }
@@ -296,10 +291,26 @@ void BlockCholesky::partition(const std::vector<Index>& parent, const std::vecto
   lx_.assign(sn_val_.back(), 0.0);
   tmp_.assign(std::max(work, 3 * std::size_t{nb}), 0.0);
   y_.assign(3 * std::size_t{nb}, 0.0);
-  head_.assign(ns, no_supernode);
-  next_.assign(ns, no_supernode);
-  cursor_.assign(ns, 0);
+  // the updates each supernode receives: (d, position in rows_ of d's first row in it), d
+  // ascending; d reaches t when one of its rows is among t's pivots
+  const auto reaches = [this](std::size_t d, std::size_t q) { return q == sn_rows_[d] || sn_of_[rows_[q]] != sn_of_[rows_[q - 1]]; };
+  upd_start_.assign(ns + 1, 0);
+  for (std::size_t d = 0; d < ns; ++d)
+    for (std::size_t q = sn_rows_[d]; q < sn_rows_[d + 1]; ++q)
+      if (reaches(d, q)) ++upd_start_[sn_of_[rows_[q]] + 1];
+  for (std::size_t t = 0; t < ns; ++t) upd_start_[t + 1] += upd_start_[t];
+  upd_from_.resize(upd_start_.back());
+  upd_row_.resize(upd_start_.back());
+  std::vector<std::size_t> fill(upd_start_.begin(), upd_start_.end() - 1);
+  for (std::size_t d = 0; d < ns; ++d)
+    for (std::size_t q = sn_rows_[d]; q < sn_rows_[d + 1]; ++q)
+      if (reaches(d, q)) {
+        const std::size_t at = fill[sn_of_[rows_[q]]]++;
+        upd_from_[at] = d;
+        upd_row_[at] = q;
+      }
   relpos_.assign(nb, 0);
+  w_.assign(9 * std::size_t{nb}, 0.0);
   pos_.assign(nb, 0);
 }
 
@@ -312,21 +323,15 @@ void BlockCholesky::factorize(const BlockMatrix& A, std::span<const double> free
   // whatever thread_count() says: on the frisbee that made a run 15x slower (the team's spins
   // and wake-ups beside the other processes on 2 cores). The products here are small: serial.
   const SerialLibraryRegions serial(max_threads + 1);
-  std::fill(head_.begin(), head_.end(), no_supernode);
   for (std::size_t s = 0; s + 1 < sn_first_.size(); ++s) {
-    scatter_supernode(A, free_dof, s);
-    update_supernode(s);
-    finish_supernode(s, who);
-    if (sn_rows_[s + 1] > sn_rows_[s]) link(s, sn_rows_[s]);
+    if (width_of(s) == 1) {
+      factor_pivot(A, free_dof, s, who);
+    } else {
+      scatter_supernode(A, free_dof, s);
+      update_supernode(s);
+      finish_supernode(s, who);
+    }
   }
-}
-
-// Supernode d's rows from rows_[position] on update the supernode holding that row next.
-void BlockCholesky::link(std::size_t d, std::size_t position) {
-  const std::size_t t = sn_of_[rows_[position]];
-  cursor_[d] = position;
-  next_[d] = head_[t];
-  head_[t] = d;
 }
 
 // Supernode s's panel = its columns of K's lower triangle (permuted): free_r free_c A(r, c),
@@ -334,14 +339,14 @@ void BlockCholesky::link(std::size_t d, std::size_t position) {
 void BlockCholesky::scatter_supernode(const BlockMatrix& A, std::span<const double> free_dof, std::size_t s) {
   const Index f = sn_first_[s], l = sn_first_[s + 1];
   std::fill(lx_.begin() + static_cast<std::ptrdiff_t>(sn_val_[s]), lx_.begin() + static_cast<std::ptrdiff_t>(sn_val_[s + 1]), 0.0);
-  const Layout lay = layout(width_of(s), below_of(s));
+  const auto ld = static_cast<Eigen::Index>(3 * (width_of(s) + below_of(s)));
   for (Index j = f; j < l; ++j) {
     const std::size_t c = perm_[j];
     for (std::size_t e = a_col_[j]; e < a_col_[j + 1]; ++e) {
       const Index i = a_row_[e];
       const std::size_t r = perm_[i];
       const ConstBlock a = A.block(a_slot_[e]);
-      Block3 w(lx_.data() + a_dst_[e], lay.stride());
+      Block3 w(lx_.data() + a_dst_[e], Eigen::OuterStride<>(ld));
       for (int b = 0; b < 3; ++b)
         for (int x = 0; x < 3; ++x) {
           w(x, b) = free_dof[3 * r + static_cast<std::size_t>(x)] * free_dof[3 * c + static_cast<std::size_t>(b)] * a(x, b);
@@ -358,35 +363,30 @@ void BlockCholesky::update_supernode(std::size_t s) {
   const std::size_t width = l - f;
   for (Index j = f; j < l; ++j) relpos_[j] = j - f;
   for (std::size_t q = sn_rows_[s]; q < sn_rows_[s + 1]; ++q) relpos_[rows_[q]] = width + q - sn_rows_[s];
-  const Layout lay = layout(width_of(s), below_of(s));
+  const std::size_t ld = 3 * (width + below_of(s));
   double* to = lx_.data() + sn_val_[s];
-  std::size_t d = head_[s];
-  head_[s] = no_supernode;
-  while (d != no_supernode) {
-    const std::size_t next = next_[d], p = cursor_[d], end = sn_rows_[d + 1];
+  for (std::size_t u = upd_start_[s]; u < upd_start_[s + 1]; ++u) {
+    const std::size_t d = upd_from_[u], p = upd_row_[u], end = sn_rows_[d + 1];
     std::size_t q = p;
     while (q < end && rows_[q] < l) ++q;
     const std::size_t wd = sn_first_[d + 1] - sn_first_[d];
     if (wd == 1) {
-      subtract_blockwise(lx_.data() + sn_val_[d] + 9 * (1 + p - sn_rows_[d]), rows_.data() + p, end - p, q - p, relpos_.data(), to, lay);
+      subtract_blockwise(lx_.data() + sn_val_[d] + 9 * (1 + p - sn_rows_[d]), rows_.data() + p, end - p, q - p, relpos_.data(), to, ld);
     } else {
       const auto m = static_cast<Eigen::Index>(3 * (end - p)), m1 = static_cast<Eigen::Index>(3 * (q - p));
-      const Layout from = layout(width_of(d), below_of(d));
-      const ConstPanel ld_rows(lx_.data() + sn_val_[d] + from.at(wd + p - sn_rows_[d], 0), m, static_cast<Eigen::Index>(3 * wd), from.stride());
+      const ConstPanel ld_rows = rows_below(lx_.data() + sn_val_[d], wd, below_of(d), p - sn_rows_[d]);
       const std::size_t first = relpos_[rows_[p]];
-      if (width > 1 && relpos_[rows_[end - 1]] - first == end - 1 - p) {
+      if (relpos_[rows_[end - 1]] - first == end - 1 - p) {
         // d's rows are consecutive in s's panel: one GEMM into it (the few products above the
         // diagonal land in the diagonal block's upper triangle, which nothing reads)
-        Panel(to + lay.at(first, first), m, m1, lay.stride()).noalias() -= ld_rows * ld_rows.topRows(m1).transpose();
+        Panel(to + 3 * first * (ld + 1), m, m1, Eigen::OuterStride<>(static_cast<Eigen::Index>(ld))).noalias() -= ld_rows * ld_rows.topRows(m1).transpose();
       } else {
         Dense c(tmp_.data(), m, m1);
         c.noalias() = ld_rows * ld_rows.topRows(m1).transpose();
         for (std::size_t k = p; k < end; ++k) pos_[k - p] = relpos_[rows_[k]];
-        scatter_update(c, std::span<const std::size_t>(pos_.data(), end - p), to, lay);
+        scatter_update(c, std::span<const std::size_t>(pos_.data(), end - p), to, ld);
       }
     }
-    if (q < end) link(d, q);
-    d = next;
   }
 }
 
@@ -400,30 +400,68 @@ void BlockCholesky::finish_supernode(std::size_t s, const char* who) {
   const auto ld = static_cast<Eigen::Index>(3 * (std::size_t{l - f} + sn_rows_[s + 1] - sn_rows_[s]));
   Panel panel(lx_.data() + sn_val_[s], ld, n, Eigen::OuterStride<>(ld));
   auto diagonal = panel.topRows(n);
-  if (const Eigen::Index bad = n == 3 ? llt3(Block3(panel.data(), Eigen::OuterStride<>(3))) : dense_llt(diagonal); bad >= 0) {
-    const auto pivot = 3 * std::size_t{f} + static_cast<std::size_t>(bad);
-    throw SolverError(std::string(who) + ": the matrix is not positive definite on the free axes (Cholesky pivot " +
-                          std::to_string(pivot) + " of " + std::to_string(3 * perm_.size()) + " failed at node " +
-                          std::to_string(perm_[pivot / 3]) + ", axis " + "xyz"[pivot % 3] + ")",
-                      0, 0);
-  }
-  if (n == 3) {
-    // one pivot: L(j, j)⁻¹ replaces L(j, j) in the panel (the solves multiply by it)
-    Block3 diagonal3(panel.data(), Eigen::OuterStride<>(3));
-    const Eigen::Matrix3d inverse = lower_inverse3(diagonal3);
-    diagonal3 = inverse;
-    const Eigen::Matrix3d inverse_t = inverse.transpose();
-    for (Eigen::Index a = 9; a < 3 * ld; a += 9) {  // blocks one after another (Layout)
-      Block3 block(panel.data() + a, Eigen::OuterStride<>(3));
-      const Eigen::Matrix3d k = block;
-      block.noalias() = k * inverse_t;
-    }
-    return;
-  }
+  if (const Eigen::Index bad = dense_llt(diagonal); bad >= 0) not_positive_definite(3 * std::size_t{f} + static_cast<std::size_t>(bad), who);
   if (ld == n) return;
   auto below = panel.bottomRows(ld - n);
   diagonal.triangularView<Eigen::Lower>().transpose().solveInPlace<Eigen::OnTheRight>(below);
 }
+
+// A supernode of one pivot j, as the column-at-a-time factorization did it: column j of K and
+// the updates of the earlier supernodes with a block in row j accumulate in w_ (9 per pivot
+// row, no indirection), then the 3×3 LLᵀ of the diagonal block and L(i, j) = w_(i) L(j, j)⁻ᵀ.
+// Its panel keeps L(j, j)⁻¹ (the solves multiply by it) and the blocks below one after another.
+void BlockCholesky::factor_pivot(const BlockMatrix& A, std::span<const double> free_dof, std::size_t s, const char* who) {
+  const Index j = sn_first_[s];
+  const std::size_t c = perm_[j];
+  for (std::size_t e = a_col_[j]; e < a_col_[j + 1]; ++e) {
+    const Index i = a_row_[e];
+    const std::size_t r = perm_[i];
+    const ConstBlock a = A.block(a_slot_[e]);
+    Block w(w_.data() + 9 * std::size_t{i});
+    for (int b = 0; b < 3; ++b)
+      for (int x = 0; x < 3; ++x) {
+        w(x, b) = free_dof[3 * r + static_cast<std::size_t>(x)] * free_dof[3 * c + static_cast<std::size_t>(b)] * a(x, b);
+        if (i == j && x == b && w(x, b) == 0.0) w(x, b) = 1.0;
+      }
+  }
+  for (std::size_t u = upd_start_[s]; u < upd_start_[s + 1]; ++u) {  // row j: the only row of s
+    const std::size_t d = upd_from_[u], p = upd_row_[u], end = sn_rows_[d + 1], wd = width_of(d);
+    if (wd == 1) {
+      const double* l = lx_.data() + sn_val_[d] + 9 * (1 + p - sn_rows_[d]);
+      const Eigen::Matrix3d lj_t = ConstBlock(l).transpose();
+      for (std::size_t a = 0; a < end - p; ++a) Block(w_.data() + 9 * std::size_t{rows_[p + a]}).noalias() -= ConstBlock(l + 9 * a) * lj_t;
+    } else {
+      const ConstPanel ld_rows = rows_below(lx_.data() + sn_val_[d], wd, below_of(d), p - sn_rows_[d]);
+      Dense u(tmp_.data(), ld_rows.rows(), 3);
+      u.noalias() = ld_rows * ld_rows.topRows(3).transpose();
+      for (std::size_t a = 0; a < end - p; ++a) Block(w_.data() + 9 * std::size_t{rows_[p + a]}) -= u.block<3, 3>(static_cast<Eigen::Index>(3 * a), 0);
+    }
+  }
+  Block wj(w_.data() + 9 * std::size_t{j});
+  if (const Eigen::Index bad = llt3(Block3(wj.data(), Eigen::OuterStride<>(3))); bad >= 0) {
+    std::fill(w_.begin(), w_.end(), 0.0);  // zero between pivots, also after a failed one
+    not_positive_definite(3 * std::size_t{j} + static_cast<std::size_t>(bad), who);
+  }
+  const Eigen::Matrix3d inverse = lower_inverse3(Block3(wj.data(), Eigen::OuterStride<>(3)));
+  const Eigen::Matrix3d inverse_t = inverse.transpose();
+  double* panel = lx_.data() + sn_val_[s];
+  Block{panel} = inverse;
+  wj.setZero();
+  for (std::size_t q = sn_rows_[s]; q < sn_rows_[s + 1]; ++q) {
+    Block wi(w_.data() + 9 * std::size_t{rows_[q]});
+    Block(panel + 9 * (1 + q - sn_rows_[s])).noalias() = wi * inverse_t;
+    wi.setZero();
+  }
+}
+
+// Throws the SolverError of a pivot (in the factorization's order) that is not positive.
+void BlockCholesky::not_positive_definite(std::size_t pivot, const char* who) const {
+  throw SolverError(std::string(who) + ": the matrix is not positive definite on the free axes (Cholesky pivot " +
+                        std::to_string(pivot) + " of " + std::to_string(3 * perm_.size()) + " failed at node " +
+                        std::to_string(perm_[pivot / 3]) + ", axis " + "xyz"[pivot % 3] + ")",
+                    0, 0);
+}
+
 
 void BlockCholesky::solve(std::span<const double> rhs, std::span<double> out) {
   const std::size_t nb = perm_.size();

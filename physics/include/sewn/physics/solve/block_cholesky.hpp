@@ -58,7 +58,8 @@ class BlockCholesky {
   void scatter_supernode(const BlockMatrix& A, std::span<const double> free_dof, std::size_t s);
   void update_supernode(std::size_t s);
   void finish_supernode(std::size_t s, const char* who);
-  void link(std::size_t d, std::size_t position);
+  void factor_pivot(const BlockMatrix& A, std::span<const double> free_dof, std::size_t s, const char* who);
+  [[noreturn]] void not_positive_definite(std::size_t pivot, const char* who) const;
   [[nodiscard]] std::size_t width_of(std::size_t s) const { return sn_first_[s + 1] - sn_first_[s]; }
   [[nodiscard]] std::size_t below_of(std::size_t s) const { return sn_rows_[s + 1] - sn_rows_[s]; }
 
@@ -75,11 +76,12 @@ class BlockCholesky {
   std::vector<std::size_t> a_col_, a_dst_;
   std::vector<Index> a_slot_, a_row_;
   AlignedVector<double> lx_;   // the panels
+  AlignedVector<double> w_;    // factor_pivot()'s column: 9 per pivot row, zero between pivots
   AlignedVector<double> tmp_;  // a descendant's update (factorize) or a panel's rows (solve)
   AlignedVector<double> y_;    // the permuted vector of solve()
-  // factorize()'s left-looking bookkeeping: the supernodes still to update supernode s form a
-  // list from head_[s] through next_; each one's first row not yet used is at rows_[cursor_[d]]
-  std::vector<std::size_t> head_, next_, cursor_;
+  // Left-looking: supernode s is updated by the supernodes upd_from_[u] for u in
+  // upd_start_[s] .. upd_start_[s+1), from their rows at rows_[upd_row_[u]] on
+  std::vector<std::size_t> upd_start_, upd_from_, upd_row_;
   std::vector<std::size_t> relpos_;  // pivot row -> its block row within the current panel
   std::vector<std::size_t> pos_;     // the current descendant's rows' relpos_
   double flops_ = 0, entries_ = 0;
