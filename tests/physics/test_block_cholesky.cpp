@@ -76,6 +76,26 @@ Eigen::VectorXd dense_reference(const BlockMatrix& A, const Problem& p) {
   return xt + f.asDiagonal() * llt.solve(rhs);
 }
 
+// x against the sparse reference, its residual, and the fixed axes' prescribed values.
+void check_solution(const BlockMatrix& A, const Problem& p, const std::vector<double>& x) {
+  CHECK(max_difference(x, reference_solve(A, p)) < 1e-12);
+  CHECK(relative_residual(A, p, x) < 1e-13);
+  for (std::size_t k = 0; k < x.size(); ++k)
+    if (p.free_dof[k] == 0.0) REQUIRE(x[k] == p.x0[k]);
+}
+
+// The factorization of A for p is refused as not positive definite at `where` ("node N, axis a").
+void check_refused(solve::BlockCholesky& f, const BlockMatrix& A, const Problem& p, const std::string& where) {
+  try {
+    (void)block_solve(f, A, p);
+    FAIL("a matrix that is not positive definite was factored");
+  } catch (const SolverError& e) {
+    const std::string what = e.what();
+    CHECK(what.find("test: the matrix is not positive definite on the free axes") != std::string::npos);
+    CHECK(what.find("failed at " + where + ")") != std::string::npos);
+  }
+}
+
 // Node pairs: all of nodes [first, first + count) coupled with each other.
 void clique(std::vector<NodePair>& pairs, Index first, Index count) {
   for (Index i = first; i < first + count; ++i)
@@ -107,6 +127,15 @@ void shaped_spd(BlockMatrix& A, Index n, int shape, unsigned seed) {
   random_spd_values(A, rng);
 }
 
+// n nodes all coupled, random SPD values.
+void dense_spd(BlockMatrix& A, Index n, unsigned seed) {
+  std::vector<NodePair> pairs;
+  clique(pairs, 0, n);
+  A.build_pattern(n, pairs);
+  std::mt19937 rng(seed);
+  random_spd_values(A, rng);
+}
+
 }  // namespace
 
 TEST_CASE("block cholesky: supernodes on cliques, chains and random couplings, with fixed axes, solve as Eigen's dense LLᵀ") {
@@ -122,21 +151,14 @@ TEST_CASE("block cholesky: supernodes on cliques, chains and random couplings, w
     const std::vector<double> x = block_solve(f, A, p);
     CHECK(f.supernodes() < A.size());  // some pivots share a dense panel
     CHECK(max_difference(x, dense_reference(A, p)) < 1e-12);
-    CHECK(max_difference(x, reference_solve(A, p)) < 1e-12);
-    CHECK(relative_residual(A, p, x) < 1e-13);
-    for (std::size_t k = 0; k < x.size(); ++k)
-      if (p.free_dof[k] == 0.0) REQUIRE(x[k] == p.x0[k]);
+    check_solution(A, p, x);
   }
 }
 
 TEST_CASE("block cholesky: a clique is one dense panel, with a dense factor's entries and flops") {
   BlockMatrix A;
   const Index n = 12;
-  std::vector<NodePair> pairs;
-  clique(pairs, 0, n);
-  A.build_pattern(n, pairs);
-  std::mt19937 rng(5);
-  random_spd_values(A, rng);
+  dense_spd(A, n, 5);
   solve::BlockCholesky f;
   const Problem p = random_problem(A, nullptr, 0.1, 6);
   CHECK(max_difference(block_solve(f, A, p), dense_reference(A, p)) < 1e-13);
@@ -167,34 +189,17 @@ TEST_CASE("block cholesky: a zero-diagonal free axis inside a dense panel is sol
 
 TEST_CASE("block cholesky: the dense kernel names the indefinite pivot's node and axis; a NaN fails too") {
   BlockMatrix A;
-  const Index n = 16;
-  std::vector<NodePair> pairs;
-  clique(pairs, 0, n);
-  A.build_pattern(n, pairs);
-  std::mt19937 rng(8);
-  random_spd_values(A, rng);
+  dense_spd(A, 16, 8);
   A.block(A.diagonal(9))(2, 2) = -1e4;  // no Schur complement before its pivot makes it positive
   Problem p = random_problem(A, nullptr, 0.0, 9);
   solve::BlockCholesky f;
-  try {
-    (void)block_solve(f, A, p);
-    FAIL("an indefinite matrix was factored");
-  } catch (const SolverError& e) {
-    const std::string what = e.what();
-    CHECK(what.find("test: the matrix is not positive definite on the free axes") != std::string::npos);
-    CHECK(what.find("failed at node 9, axis z") != std::string::npos);
-  }
+  check_refused(f, A, p, "node 9, axis z");
   CHECK(f.supernodes() == 1);
   p.free_dof[3 * 9 + 2] = 0.0;  // that axis fixed: nothing indefinite left
   CHECK(relative_residual(A, p, block_solve(f, A, p)) < 1e-13);
   A.block(A.diagonal(9))(2, 2) = 1e4;
   A.block(A.diagonal(4))(0, 0) = std::nan("");
-  try {
-    (void)block_solve(f, A, random_problem(A, nullptr, 0.0, 10));
-    FAIL("a NaN was factored");
-  } catch (const SolverError& e) {
-    CHECK(std::string(e.what()).find("failed at node 4, axis x") != std::string::npos);
-  }
+  check_refused(f, A, random_problem(A, nullptr, 0.0, 10), "node 4, axis x");
 }
 
 TEST_CASE("block cholesky solves random SPD block matrices with fixed axes as the reference factorization does") {
@@ -207,10 +212,7 @@ TEST_CASE("block cholesky solves random SPD block matrices with fixed axes as th
     CHECK(!f.analysed_for(A));
     const std::vector<double> x = block_solve(f, A, p);
     CHECK(f.analysed_for(A));
-    CHECK(max_difference(x, reference_solve(A, p)) < 1e-12);
-    CHECK(relative_residual(A, p, x) < 1e-13);
-    for (std::size_t k = 0; k < x.size(); ++k)
-      if (p.free_dof[k] == 0.0) REQUIRE(x[k] == p.x0[k]);
+    check_solution(A, p, x);
   }
 }
 
@@ -268,14 +270,7 @@ TEST_CASE("block cholesky refuses an indefinite matrix naming the node and axis,
   A.block(A.diagonal(17))(1, 1) = -2.0;
   Problem p = random_problem(A, nullptr, 0.0, 3);
   solve::BlockCholesky f;
-  try {
-    (void)block_solve(f, A, p);
-    FAIL("an indefinite matrix was factored");
-  } catch (const SolverError& e) {
-    const std::string what = e.what();
-    CHECK(what.find("test: the matrix is not positive definite on the free axes") != std::string::npos);
-    CHECK(what.find("failed at node 17, axis y") != std::string::npos);
-  }
+  check_refused(f, A, p, "node 17, axis y");
   // the same axis fixed: an identity row, nothing indefinite left
   p.free_dof[3 * 17 + 1] = 0.0;
   p.x0[3 * 17 + 1] = 0.5;
