@@ -47,13 +47,13 @@ constexpr double ordering_search_flops = 3e7;
 // Below this many flops the direct backend factors K with BlockCholesky instead of CHOLMOD
 // (block_cholesky.hpp). Its first, 3×3-column version paid below 3e7 flops (whole scenes 0.79x
 // to 0.98x the CPU time, CHOLMOD's supernodes too narrow for BLAS). Its supernodal version
-// (Eigen's AVX-512 kernels; this OpenBLAS falls back to SSE3 kernels on the Xeon model 207)
-// measured, interleaved, against CHOLMOD with its METIS/nested-dissection search: the toy
-// tunnel (5e7 flops) 1.26x faster a frame, bench_solve's 8×8×10 beam at h = 1 ms 2.2x faster a
-// step (factor 6.2-7.8 ms against 10.7-15.9), the N = 8 cantilever's (3.9e6 entries of L)
-// 2.2x (factor 105-118 ms against 245-280), same errors to round-off. No matrix measured
-// favours CHOLMOD's factorization; its analysis still supplies the flop count, and the
-// threshold only keeps factorizations beyond anything measured on CHOLMOD.
+// (Eigen's AVX-512 kernels) measured, interleaved, against CHOLMOD with its METIS/nested-
+// dissection search, with OpenBLAS's AVX-512 kernels (OPENBLAS_CORETYPE=SkylakeX, what sewn run
+// and the benchmarks select on the Xeon model 207) and, in brackets, its SSE3 fallback: the toy
+// tunnel (5e7 flops) 1.03-1.06x a frame (1.26x), bench_solve's 8×8×10 beam at h = 1 ms 1.55x a
+// step (2.2x), the N = 8 cantilever (3.9e6 entries of L) 1.25-1.56x (2.2x), same errors to
+// round-off. No matrix measured favours CHOLMOD's factorization; its analysis still supplies
+// the flop count, and the threshold only keeps factorizations beyond anything measured on CHOLMOD.
 constexpr double block_factor_flops = 1e10;
 
 // One CHOLMOD workspace, the filtered matrix in its upper-triangular CSC form, and its factor.
