@@ -20,20 +20,17 @@ using Dense = Eigen::Map<Eigen::MatrixXd>;
 using VecX = Eigen::Map<Eigen::VectorXd>;
 using Vec3 = Eigen::Map<Eigen::Vector3d>;
 using Block = Eigen::Map<Eigen::Matrix3d>;
+using Block3 = Eigen::Map<Eigen::Matrix3d, 0, Eigen::OuterStride<>>;  // a 3×3 block of a panel
 using ConstBlock = Eigen::Map<const Eigen::Matrix3d>;
-
-using Block3 = Eigen::Map<Eigen::Matrix3d, 0, Eigen::OuterStride<>>;
-using ConstBlock3 = Eigen::Map<const Eigen::Matrix3d, 0, Eigen::OuterStride<>>;
 
 constexpr Index none = invalid_index;
 
-constexpr std::size_t no_supernode = static_cast<std::size_t>(-1);
-
 // Supernodes narrower than this many pivots are factored one pivot at a time with fixed-size
 // 3×3 code: there Eigen's dynamic-size kernels cost more in dispatch than their flops. Measured
-// on the connect scenes' matrices (docs/solvers.md): 4 against 1, 3, 6 and 8 best or equal on
-// every one. Relaxed supernodes (merging pivots at the cost of explicit zeros, up to 4-16 wide
-// and 20-50 % zeros) measured no faster on any, slower on the toy ball's and the jellyfish's.
+// on the connect scenes' matrices (docs/solvers.md): 4 and 8 equal within the noise, 16 slower on
+// the frisbee's (1.22x against 1.47x main's speed), 1 (dense kernels for every supernode)
+// 0.6-0.7x main's on the toy ball's and the jellyfish's. Relaxed supernodes (merging pivots at
+// the cost of explicit zeros, 4-16 wide, 20-50 % zeros) measured no faster on any matrix.
 constexpr Index dense_width = 4;
 
 // The rows of a column-major panel (width pivots, `below` block rows under them) from its
@@ -356,8 +353,9 @@ void BlockCholesky::scatter_supernode(const BlockMatrix& A, std::span<const doub
   }
 }
 
-// Left-looking: every earlier supernode d with rows among s's pivots subtracts its product
-// L(rows ≥ s, d) L(rows in s, d)ᵀ (one GEMM into tmp_), scattered to s's panel by row.
+// Left-looking, for a supernode of dense_width pivots or more: every earlier supernode d with
+// rows among s's pivots subtracts L(rows ≥ s, d) L(rows in s, d)ᵀ: 3×3 blocks from a one-pivot
+// d, else one GEMM, straight into s's panel or through tmp_ scattered by rows.
 void BlockCholesky::update_supernode(std::size_t s) {
   const Index f = sn_first_[s], l = sn_first_[s + 1];
   const std::size_t width = l - f;
@@ -392,8 +390,6 @@ void BlockCholesky::update_supernode(std::size_t s) {
 
 
 // The dense LLᵀ of the diagonal block, then the rows below: L(below, s) = K(below, s) L(s, s)⁻ᵀ.
-// A supernode one pivot wide (most of a chain's or a sparse mesh's) takes fixed-size 3×3 code:
-// Eigen's dynamic-size kernels cost more in dispatch than their few flops.
 void BlockCholesky::finish_supernode(std::size_t s, const char* who) {
   const Index f = sn_first_[s], l = sn_first_[s + 1];
   const auto n = static_cast<Eigen::Index>(3 * (l - f));

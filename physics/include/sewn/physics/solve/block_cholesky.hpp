@@ -1,16 +1,16 @@
 #pragma once
-// BlockCholesky: a sparse supernodal LLᵀ factorization on BlockMatrix's 3×3 blocks, for the
-// small and medium systems where CHOLMOD's analysis, permuted copies and BLAS calls do not pay
-// (the direct backend, cholmod.cpp, uses it below block_factor_flops).
+// BlockCholesky: a sparse supernodal LLᵀ factorization on BlockMatrix's 3×3 blocks (the direct
+// backend, cholmod.cpp, uses it below block_factor_flops: every matrix measured).
 //
 // Why: every entry of the solver layer's matrices belongs to a 3×3 block (a node's axes, or
 // three rod angles), so the symbolic work runs on the block graph, 9× smaller. A first version
 // factored one 3×3 block column at a time (left-looking, fixed-size products): 4x faster than
 // CHOLMOD's simplicial code on the toy ball, but on the frisbee (933 unknowns, 8e6 flops, the
-// trailing columns nearly dense) it ran at ~3.5 GFlop/s. Block columns whose structure below
-// the diagonal nests (a chain in the elimination tree) are merged into supernodes, dense
-// column-major panels factored with Eigen's dense kernels (LLᵀ, triangular solves, GEMM);
-// docs/solvers.md has the measurements.
+// trailing columns nearly dense) it ran at 3.5-9 GFlop/s. Block columns whose structure below
+// the diagonal nests (a chain in the elimination tree) are merged into supernodes: from
+// dense_width pivots on, dense column-major panels factored with Eigen's dense kernels (LLᵀ,
+// triangular solves, GEMM); narrower ones one pivot at a time as before (fixed-size 3×3 code),
+// which is faster on sparse matrices. docs/solvers.md has the measurements.
 //
 // It factors the filtered matrix K = S A S + (I - S) of the solver layer (S the diagonal 0/1
 // mask of free axes; a free axis with a zero diagonal gets 1 too, as CHOLMOD's backends do),
@@ -67,12 +67,13 @@ class BlockCholesky {
   std::vector<Index> perm_, pinv_;  // pivot j is node perm_[j]; node i is pivot pinv_[i]
   // Supernode s: pivots sn_first_[s] .. sn_first_[s+1), the block rows below them
   // rows_[sn_rows_[s] .. sn_rows_[s+1]) (ascending), its panel at lx_[sn_val_[s]]: column-major,
-  // 3 (width + rows below) scalar rows by 3 width columns, the diagonal block on top (in a
-  // supernode one pivot wide, once factored, its inverse: the solves multiply by it).
+  // 3 (width + rows below) scalar rows by 3 width columns, the diagonal block on top; one pivot
+  // wide, its 3×3 blocks one after another, the diagonal one L(j, j)⁻¹ (the solves multiply).
   std::vector<Index> sn_first_, rows_;
   std::vector<std::size_t> sn_of_;  // pivot -> its supernode
   std::vector<std::size_t> sn_rows_, sn_val_;
   // A's blocks scattered into the panels, by pivot column: slot in A, pivot row, offset in lx_
+  // (in a one-pivot supernode unused: factor_pivot() scatters by pivot row)
   std::vector<std::size_t> a_col_, a_dst_;
   std::vector<Index> a_slot_, a_row_;
   AlignedVector<double> lx_;   // the panels
