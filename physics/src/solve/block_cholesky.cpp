@@ -72,7 +72,7 @@ void scatter_update(const Dense& c, std::span<const std::size_t> pos, double* to
 
 // In-place LLᵀ of a 3×3 block's lower triangle; the first pivot that is not positive (or
 // NaN), or -1.
-Eigen::Index llt3(Block3 l) {
+Eigen::Index llt3(Block l) {
   for (int a = 0; a < 3; ++a) {
     double d = l(a, a);
     for (int b = 0; b < a; ++b) d -= l(a, b) * l(a, b);
@@ -88,7 +88,7 @@ Eigen::Index llt3(Block3 l) {
 }
 
 // L⁻¹ of a lower triangular 3×3 block, by forward substitution on the identity.
-Eigen::Matrix3d lower_inverse3(const Block3& l) {
+Eigen::Matrix3d lower_inverse3(const Block& l) {
   Eigen::Matrix3d inv = Eigen::Matrix3d::Zero();
   for (int a = 0; a < 3; ++a) inv(a, a) = 1.0 / l(a, a);
   inv(1, 0) = -l(1, 0) * inv(0, 0) * inv(1, 1);
@@ -434,11 +434,11 @@ void BlockCholesky::factor_pivot(const BlockMatrix& A, std::span<const double> f
     }
   }
   Block wj(w_.data() + 9 * std::size_t{j});
-  if (const Eigen::Index bad = llt3(Block3(wj.data(), Eigen::OuterStride<>(3))); bad >= 0) {
+  if (const Eigen::Index bad = llt3(wj); bad >= 0) {
     std::fill(w_.begin(), w_.end(), 0.0);  // zero between pivots, also after a failed one
     not_positive_definite(3 * std::size_t{j} + static_cast<std::size_t>(bad), who);
   }
-  const Eigen::Matrix3d inverse = lower_inverse3(Block3(wj.data(), Eigen::OuterStride<>(3)));
+  const Eigen::Matrix3d inverse = lower_inverse3(wj);
   const Eigen::Matrix3d inverse_t = inverse.transpose();
   double* panel = lx_.data() + sn_val_[s];
   Block{panel} = inverse;
