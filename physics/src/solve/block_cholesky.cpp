@@ -24,6 +24,7 @@ using Block3 = Eigen::Map<Eigen::Matrix3d, 0, Eigen::OuterStride<>>;  // a 3×3 
 using ConstBlock = Eigen::Map<const Eigen::Matrix3d>;
 
 constexpr Index none = invalid_index;
+constexpr std::size_t wide = static_cast<std::size_t>(-1);  // no one-pivot panel's block
 
 // Supernodes narrower than this many pivots are factored one pivot at a time with fixed-size
 // 3×3 code: there Eigen's dynamic-size kernels cost more in dispatch than their flops. Measured
@@ -298,6 +299,8 @@ void BlockCholesky::partition(const std::vector<Index>& parent, const std::vecto
   for (std::size_t t = 0; t < ns; ++t) upd_start_[t + 1] += upd_start_[t];
   upd_from_.resize(upd_start_.back());
   upd_row_.resize(upd_start_.back());
+  upd_rows_.resize(upd_start_.back());
+  upd_block_.resize(upd_start_.back());
   std::vector<std::size_t> fill(upd_start_.begin(), upd_start_.end() - 1);
   for (std::size_t d = 0; d < ns; ++d)
     for (std::size_t q = sn_rows_[d]; q < sn_rows_[d + 1]; ++q)
@@ -305,6 +308,8 @@ void BlockCholesky::partition(const std::vector<Index>& parent, const std::vecto
         const std::size_t at = fill[sn_of_[rows_[q]]]++;
         upd_from_[at] = d;
         upd_row_[at] = q;
+        upd_rows_[at] = sn_rows_[d + 1] - q;
+        upd_block_[at] = width_of(d) == 1 ? sn_val_[d] + 9 * (1 + q - sn_rows_[d]) : wide;
       }
   relpos_.assign(nb, 0);
   w_.assign(9 * std::size_t{nb}, 0.0);
@@ -421,16 +426,18 @@ void BlockCholesky::factor_pivot(const BlockMatrix& A, std::span<const double> f
       }
   }
   for (std::size_t u = upd_start_[s]; u < upd_start_[s + 1]; ++u) {  // row j: the only row of s
-    const std::size_t d = upd_from_[u], p = upd_row_[u], end = sn_rows_[d + 1], wd = width_of(d);
-    if (wd == 1) {
-      const double* l = lx_.data() + sn_val_[d] + 9 * (1 + p - sn_rows_[d]);
+    const std::size_t p = upd_row_[u], n = upd_rows_[u];
+    const Index* rows = rows_.data() + p;
+    if (const std::size_t at = upd_block_[u]; at != wide) {  // a one-pivot d: its blocks from row j on
+      const double* l = lx_.data() + at;
       const Eigen::Matrix3d lj_t = ConstBlock(l).transpose();
-      for (std::size_t a = 0; a < end - p; ++a) Block(w_.data() + 9 * std::size_t{rows_[p + a]}).noalias() -= ConstBlock(l + 9 * a) * lj_t;
+      for (std::size_t a = 0; a < n; ++a) Block(w_.data() + 9 * std::size_t{rows[a]}).noalias() -= ConstBlock(l + 9 * a) * lj_t;
     } else {
-      const ConstPanel ld_rows = rows_below(lx_.data() + sn_val_[d], wd, below_of(d), p - sn_rows_[d]);
-      Dense u(tmp_.data(), ld_rows.rows(), 3);
-      u.noalias() = ld_rows * ld_rows.topRows(3).transpose();
-      for (std::size_t a = 0; a < end - p; ++a) Block(w_.data() + 9 * std::size_t{rows_[p + a]}) -= u.block<3, 3>(static_cast<Eigen::Index>(3 * a), 0);
+      const std::size_t d = upd_from_[u];
+      const ConstPanel ld_rows = rows_below(lx_.data() + sn_val_[d], width_of(d), below_of(d), p - sn_rows_[d]);
+      Dense update(tmp_.data(), ld_rows.rows(), 3);
+      update.noalias() = ld_rows * ld_rows.topRows(3).transpose();
+      for (std::size_t a = 0; a < n; ++a) Block(w_.data() + 9 * std::size_t{rows[a]}) -= update.block<3, 3>(static_cast<Eigen::Index>(3 * a), 0);
     }
   }
   Block wj(w_.data() + 9 * std::size_t{j});

@@ -81,8 +81,9 @@ class BlockCholesky {
   AlignedVector<double> tmp_;  // a descendant's update (factorize) or a panel's rows (solve)
   AlignedVector<double> y_;    // the permuted vector of solve()
   // Left-looking: supernode s is updated by the supernodes upd_from_[u] for u in
-  // upd_start_[s] .. upd_start_[s+1), from their rows at rows_[upd_row_[u]] on
-  std::vector<std::size_t> upd_start_, upd_from_, upd_row_;
+  // upd_start_[s] .. upd_start_[s+1), from their rows at rows_[upd_row_[u]] on (upd_rows_[u]
+  // of them); from a one-pivot supernode, upd_block_[u] is the first of those blocks in lx_
+  std::vector<std::size_t> upd_start_, upd_from_, upd_row_, upd_rows_, upd_block_;
   std::vector<std::size_t> relpos_;  // pivot row -> its block row within the current panel
   std::vector<std::size_t> pos_;     // the current descendant's rows' relpos_
   double flops_ = 0, entries_ = 0;
