@@ -81,17 +81,10 @@ inline Problem random_problem(const BlockMatrix& A, const NodeTable* nodes, doub
   return p;
 }
 
-// A random symmetric block matrix on a random pattern, SPD by block diagonal dominance.
-inline void random_spd(BlockMatrix& A, Index n, unsigned seed, double diagonal_shift = 1.0) {
-  std::mt19937 rng(seed);
+// Random symmetric values on A's pattern, SPD by block diagonal dominance.
+inline void random_spd_values(BlockMatrix& A, std::mt19937& rng, double diagonal_shift = 1.0) {
+  const Index n = A.size();
   std::uniform_real_distribution<double> u(-1, 1);
-  std::uniform_int_distribution<Index> node(0, n - 1);
-  std::vector<NodePair> pairs;
-  for (Index k = 0; k < 4 * n; ++k) {
-    const Index i = node(rng), j = node(rng);
-    if (i != j) pairs.push_back({i, j});
-  }
-  A.build_pattern(n, pairs);
   std::vector<double> rowsum(3 * std::size_t{n}, 0.0);
   for (Index i = 0; i < n; ++i) {
     const auto rows = A.row_offsets();
@@ -115,6 +108,19 @@ inline void random_spd(BlockMatrix& A, Index n, unsigned seed, double diagonal_s
     for (int a = 0; a < 3; ++a) D(a, a) += rowsum[3 * i + a] + D.row(a).cwiseAbs().sum() + diagonal_shift;
     A.block(A.diagonal(i)) = D;
   }
+}
+
+// A random symmetric block matrix on a random pattern, SPD by block diagonal dominance.
+inline void random_spd(BlockMatrix& A, Index n, unsigned seed, double diagonal_shift = 1.0) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<Index> node(0, n - 1);
+  std::vector<NodePair> pairs;
+  for (Index k = 0; k < 4 * n; ++k) {
+    const Index i = node(rng), j = node(rng);
+    if (i != j) pairs.push_back({i, j});
+  }
+  A.build_pattern(n, pairs);
+  random_spd_values(A, rng, diagonal_shift);
 }
 
 // The SOFA comparison's beam (891 particles), clamped at its base.

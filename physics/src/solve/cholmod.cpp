@@ -45,13 +45,16 @@ constexpr double factor_flop_speedup = 1.0;
 constexpr double ordering_search_flops = 3e7;
 
 // Below this many flops the direct backend factors K with BlockCholesky instead of CHOLMOD
-// (block_cholesky.hpp). Measured whole scenes, CPU time, interleaved, the same Newton
-// iterations: the toy ball (CHOLMOD simplicial, 8.3e5 flops) 0.79x, the jellyfish
-// (simplicial, 2.5e6) 0.77x, and where CHOLMOD is supernodal the sandwich (2.9e6) 0.79x,
-// the anglerfish (2.8e6) 0.85x, the frisbee (8.0e6) 0.91x, the toy tunnel (5.0e7) 0.98x:
-// BLAS-3 supernodes only pay on larger fronts. Above it CHOLMOD also searches METIS and
-// nested dissection orderings (ordering_search_flops), which BlockCholesky's AMD does not.
-constexpr double block_factor_flops = ordering_search_flops;
+// (block_cholesky.hpp). Its first, 3×3-column version paid below 3e7 flops (whole scenes 0.79x
+// to 0.98x the CPU time, CHOLMOD's supernodes too narrow for BLAS). Its supernodal version
+// (Eigen's AVX-512 kernels) measured, interleaved, against CHOLMOD with its METIS/nested-
+// dissection search, with OpenBLAS's AVX-512 kernels (OPENBLAS_CORETYPE=SkylakeX, what sewn run
+// and the benchmarks select on the Xeon model 207) and, in brackets, its SSE3 fallback: the toy
+// tunnel (5e7 flops) 1.03-1.06x a frame (1.26x), bench_solve's 8×8×10 beam at h = 1 ms 1.55x a
+// step (2.2x), the N = 8 cantilever (3.9e6 entries of L) 1.25-1.56x (2.2x), same errors to
+// round-off. No matrix measured favours CHOLMOD's factorization; its analysis still supplies
+// the flop count, and the threshold only keeps factorizations beyond anything measured on CHOLMOD.
+constexpr double block_factor_flops = 1e10;
 
 // One CHOLMOD workspace, the filtered matrix in its upper-triangular CSC form, and its factor.
 class Factorization {
@@ -430,7 +433,7 @@ class CholmodDirect final : public LinearSolver {
   }
 
   Factorization f_{false};  // double solves: the refinement passes need the factor's full precision
-  // Below block_factor_flops, the 3×3-block factorization of the same K (block_cholesky.hpp);
+  // Below block_factor_flops, the supernodal block factorization of the same K (block_cholesky.hpp);
   // CHOLMOD's analysis is kept for its flop count and K's values for factor_matches_values().
   solve::BlockCholesky block_;
   bool blocks_ = false;
