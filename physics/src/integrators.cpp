@@ -303,9 +303,11 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
   const int parts = detail::parts_for(n3, vector_grain);
   detail::run_parts(parts, [&](int t) {
     for (auto i = static_cast<Index>(detail::range_begin(n, parts, t)); i < detail::range_begin(n, parts, t + 1); ++i) {
-      A.block(A.diagonal(i)).diagonal().array() += mass[i];
-      for (std::size_t k = 3 * std::size_t{i}; k < 3 * std::size_t{i} + 3; ++k) {
-        free_[k] = ((fixed[i] >> (k % 3)) & 1u) ? 0.0 : 1.0;
+      double* diagonal = A.block_data(A.diagonal(i));
+      for (unsigned a = 0; a < 3; ++a) {
+        const std::size_t k = 3 * std::size_t{i} + a;
+        diagonal[4 * a] += mass[i];
+        free_[k] = ((fixed[i] >> a) & 1u) ? 0.0 : 1.0;
         mass3_[k] = mass[i];
         b_[k] = h * (f[k] + h * kv_[k]);
         if (!opt_.warm_start || free_[k] == 0.0) dv_[k] = 0.0;

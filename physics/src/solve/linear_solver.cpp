@@ -165,12 +165,15 @@ void check_diagonal(const char* who, const BlockMatrix& A, std::span<const doubl
   std::array<std::size_t, max_threads> first_bad;
   first_bad.fill(3 * n);
   physics::detail::run_parts(parts, [&](int t) {
-    const std::size_t k1 = 3 * physics::detail::range_begin(n, parts, t + 1);
-    for (std::size_t k = 3 * physics::detail::range_begin(n, parts, t); k < k1; ++k)
-      if (free_dof[k] != 0.0 && A.block(A.diagonal(static_cast<Index>(k / 3)))(static_cast<Index>(k % 3), static_cast<Index>(k % 3)) < 0.0) {
-        first_bad[static_cast<std::size_t>(t)] = k;
-        break;
-      }
+    const std::size_t i1 = physics::detail::range_begin(n, parts, t + 1);
+    for (std::size_t i = physics::detail::range_begin(n, parts, t); i < i1 && first_bad[static_cast<std::size_t>(t)] == 3 * n; ++i) {
+      const double* B = A.block(A.diagonal(static_cast<Index>(i))).data();
+      for (std::size_t a = 0; a < 3; ++a)
+        if (free_dof[3 * i + a] != 0.0 && B[4 * a] < 0.0) {
+          first_bad[static_cast<std::size_t>(t)] = 3 * i + a;
+          break;
+        }
+    }
   });
   const std::size_t k = *std::min_element(first_bad.begin(), first_bad.begin() + parts);
   if (k == 3 * n) return;
