@@ -227,29 +227,53 @@ double packed_product(CgWorkspace& ws, const double* __restrict p, double* __res
   return hsum(pq);
 }
 
+// Where thread t's rows stop receiving products of earlier threads' blocks, for `parts` ranges
+// of the packed pattern: ws.spill_end[u] is one past the last row that range u's blocks reach
+// (at least its own end), ws.first_final[t] the first row of range t that no earlier range's
+// block reaches (at most its end). Once per pattern and count.
+void plan_spills(CgWorkspace& ws, std::size_t nodes, int parts) {
+  if (ws.spill_pattern == ws.sym_pattern && ws.spill_parts == parts) return;
+  const auto count = static_cast<std::size_t>(parts);
+  ws.spill_end.assign(count, 0);
+  ws.first_final.assign(count, 0);
+  std::size_t reach = 0;  // one past the last row reached by the ranges before t
+  for (int t = 0; t < parts; ++t) {
+    const std::size_t i0 = range_begin(nodes, parts, t), i1 = range_begin(nodes, parts, t + 1);
+    ws.first_final[static_cast<std::size_t>(t)] = std::clamp(reach, i0, i1);
+    std::size_t end = i1;
+    for (std::size_t i = i0; i < i1; ++i)  // a row's columns ascend: its last block reaches furthest
+      end = std::max(end, std::size_t{ws.sym_col[ws.sym_row[i + 1] - 1]} + 1);
+    ws.spill_end[static_cast<std::size_t>(t)] = end;
+    reach = std::max(reach, end);
+  }
+  ws.spill_pattern = ws.sym_pattern;
+  ws.spill_parts = parts;
+}
+
 // sym_multiply on `parts` threads, thread t owning rows [node(t), node(t + 1)): its blocks
-// add to its own rows in y and to later threads' rows in its spill array; then, after the
-// threads meet, each thread adds the spills of the threads before it to its rows, in thread
-// order, filters them and sums its part of p·y. Deterministic for a given count; equal to one
-// thread's to round-off (a row's terms are grouped by thread). A thread's blocks reach past
-// its range by about the matrix's bandwidth (a grid layer): the spill is used, read and zeroed
-// again only up to the last row it reached, so it is zero between products. The one-thread
-// product fuses both passes (sym_multiply).
+// add to its own rows in y and to later threads' rows in its spill array. A row no earlier
+// thread's block reaches (all but about a grid layer of each range) is complete when its own
+// blocks are done, so it is filtered and summed into p·y there, as in sym_multiply; after the
+// threads meet, each thread adds the spills of the threads before it to its first rows, in
+// thread order, and filters and sums those. Deterministic for a given count; equal to one
+// thread's to round-off (a row's terms and p·y are grouped by thread). The spill is used, read
+// and zeroed again only up to the last row it reaches, so it is zero between products.
 double sym_multiply_parts(CgWorkspace& ws, const double* __restrict p, double* __restrict y, const double* __restrict free4,
                           Index n, int parts) {
   const std::size_t nodes = static_cast<std::size_t>(n);
   if (ws.spill.size() < static_cast<std::size_t>(parts)) ws.spill.resize(static_cast<std::size_t>(parts));
   for (int t = 0; t + 1 < parts; ++t) ws.spill[static_cast<std::size_t>(t)].resize(4 * nodes, 0.0);
-  ws.spill_end.resize(static_cast<std::size_t>(parts));
+  plan_spills(ws, nodes, parts);
   const auto node = [&](int t) { return range_begin(nodes, parts, t); };
   const Index* __restrict row = ws.sym_row.data();
   const Index* __restrict col = ws.sym_col.data();
   const double* __restrict val = ws.sym_val.data();
+  double part_own[max_threads], part_spilled[max_threads];
   const auto own_rows = [&](int t) {
-    const std::size_t i0 = node(t), i1 = node(t + 1);
+    const std::size_t i0 = node(t), i1 = node(t + 1), final0 = ws.first_final[static_cast<std::size_t>(t)];
     double* __restrict spill = t + 1 < parts ? ws.spill[static_cast<std::size_t>(t)].data() : nullptr;
-    std::size_t reached = i1;
     std::fill(y + 4 * i0, y + 4 * i1, 0.0);
+    __m256d pq = _mm256_setzero_pd();
     for (std::size_t i = i0; i < i1; ++i) {
       const double* pi = p + 4 * i;
       const __m256d b0 = _mm256_broadcast_sd(pi), b1 = _mm256_broadcast_sd(pi + 1), b2 = _mm256_broadcast_sd(pi + 2);
@@ -266,36 +290,39 @@ double sym_multiply_parts(CgWorkspace& ws, const double* __restrict p, double* _
         a0 = _mm256_fmadd_pd(c0, _mm256_broadcast_sd(pj), a0);
         a1 = _mm256_fmadd_pd(c1, _mm256_broadcast_sd(pj + 1), a1);
         a2 = _mm256_fmadd_pd(c2, _mm256_broadcast_sd(pj + 2), a2);
-        reached = std::max(reached, j + 1);
         double* yj = (j < i1 ? y : spill) + 4 * j;
         _mm256_store_pd(yj, _mm256_fmadd_pd(c2, b2, _mm256_fmadd_pd(c1, b1, _mm256_fmadd_pd(c0, b0, _mm256_load_pd(yj)))));
       }
-      _mm256_store_pd(y + 4 * i, _mm256_add_pd(_mm256_add_pd(a0, a1), a2));
+      __m256d yi = _mm256_add_pd(_mm256_add_pd(a0, a1), a2);
+      if (i >= final0) {
+        yi = _mm256_mul_pd(yi, _mm256_load_pd(free4 + 4 * i));
+        pq = _mm256_fmadd_pd(yi, _mm256_load_pd(pi), pq);
+      }
+      _mm256_store_pd(y + 4 * i, yi);
     }
-    ws.spill_end[static_cast<std::size_t>(t)] = reached;
+    part_own[t] = hsum(pq);
   };
-  double part[max_threads];
   const auto spilled_rows = [&](int t) {
-    const std::size_t i0 = node(t), i1 = node(t + 1);
+    const std::size_t i0 = node(t), final0 = ws.first_final[static_cast<std::size_t>(t)];
     for (int u = 0; u < t; ++u) {
       double* __restrict spill = ws.spill[static_cast<std::size_t>(u)].data();
-      const std::size_t end = std::min(i1, ws.spill_end[static_cast<std::size_t>(u)]);
+      const std::size_t end = std::min(final0, ws.spill_end[static_cast<std::size_t>(u)]);
       for (std::size_t i = i0; i < end; ++i) {
         _mm256_store_pd(y + 4 * i, _mm256_add_pd(_mm256_load_pd(y + 4 * i), _mm256_load_pd(spill + 4 * i)));
         _mm256_store_pd(spill + 4 * i, _mm256_setzero_pd());
       }
     }
     __m256d pq = _mm256_setzero_pd();
-    for (std::size_t i = i0; i < i1; ++i) {
+    for (std::size_t i = i0; i < final0; ++i) {
       const __m256d yi = _mm256_mul_pd(_mm256_load_pd(y + 4 * i), _mm256_load_pd(free4 + 4 * i));
       _mm256_store_pd(y + 4 * i, yi);
       pq = _mm256_fmadd_pd(yi, _mm256_load_pd(p + 4 * i), pq);
     }
-    part[t] = hsum(pq);
+    part_spilled[t] = hsum(pq);
   };
   run_parts(parts, own_rows, spilled_rows);
   double s = 0;
-  for (int t = 0; t < parts; ++t) s += part[t];
+  for (int t = 0; t < parts; ++t) s += part_spilled[t] + part_own[t];
   return s;
 }
 
