@@ -250,7 +250,8 @@ void plan_spills(CgWorkspace& ws, std::size_t nodes, int parts) {
   ws.spill_parts = parts;
 }
 
-// sym_multiply on `parts` threads, thread t owning rows [node(t), node(t + 1)): its blocks
+// sym_multiply on `parts` threads, after first(t) for every range t (the caller's update of p,
+// in the same region), thread t owning rows [node(t), node(t + 1)): its blocks
 // add to its own rows in y and to later threads' rows in its spill array. A row no earlier
 // thread's block reaches (all but about a grid layer of each range) is complete when its own
 // blocks are done, so it is filtered and summed into p·y there, as in sym_multiply; after the
@@ -258,8 +259,9 @@ void plan_spills(CgWorkspace& ws, std::size_t nodes, int parts) {
 // thread order, and filters and sums those. Deterministic for a given count; equal to one
 // thread's to round-off (a row's terms and p·y are grouped by thread). The spill is used, read
 // and zeroed again only up to the last row it reaches, so it is zero between products.
+template <class First>
 double sym_multiply_parts(CgWorkspace& ws, const double* __restrict p, double* __restrict y, const double* __restrict free4,
-                          Index n, int parts) {
+                          Index n, int parts, const First& first) {
   const std::size_t nodes = static_cast<std::size_t>(n);
   if (ws.spill.size() < static_cast<std::size_t>(parts)) ws.spill.resize(static_cast<std::size_t>(parts));
   for (int t = 0; t + 1 < parts; ++t) ws.spill[static_cast<std::size_t>(t)].resize(4 * nodes, 0.0);
@@ -320,7 +322,7 @@ double sym_multiply_parts(CgWorkspace& ws, const double* __restrict p, double* _
     }
     part_spilled[t] = hsum(pq);
   };
-  run_parts(parts, own_rows, spilled_rows);
+  run_parts(parts, first, own_rows, spilled_rows);
   double s = 0;
   for (int t = 0; t < parts; ++t) s += part_spilled[t] + part_own[t];
   return s;
@@ -335,8 +337,8 @@ inline __m256d precond_row(const double* pre, __m256d r) {
 }
 
 // The solve of filtered_pcg on the packed matrix, with the vector passes of an iteration
-// fused: the product with its filter and p·q, then x, r, the preconditioner, r·r and r·z in one
-// pass, then p. The filter is folded into the preconditioner, S P S, as r and z vanish on fixed
+// fused: p's update (p = z + β p) and the product with its filter and p·q in one region, then
+// x, r, the preconditioner, r·r and r·z in one pass: two forks an iteration. The filter is folded into the preconditioner, S P S, as r and z vanish on fixed
 // axes; its blocks are stored as symmetric ones (P's upper triangle: the inverse of a symmetric
 // block is symmetric up to round-off).
 // With W, the same on the reduced system (packed_product).
@@ -365,8 +367,11 @@ CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<co
     for (int t = 0; t < parts; ++t) total += part[t];
     return total;
   };
-  const auto product = [&](const double* v, double* out) {
-    return parts > 1 ? sym_multiply_parts(ws, v, out, s, nodes, parts) : packed_product(ws, v, out, s, nodes, W);
+  // q = S A v, after first(t) over every range t (on one thread: one range before the product).
+  const auto product = [&](const double* v, double* out, const auto& first) {
+    if (parts > 1) return sym_multiply_parts(ws, v, out, s, nodes, parts, first);
+    first(0);
+    return packed_product(ws, v, out, s, nodes, W);
   };
   run_parts(parts, [&](int t) {
     for (std::size_t i = node(t); i < node(t + 1); ++i) {
@@ -387,7 +392,7 @@ CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<co
       for (double* v : {r, z, p, q}) v[4 * i + 3] = 0.0;
     }
   });
-  (void)product(xv, q);
+  (void)product(xv, q, [](int) {});
   run_parts(parts, [&](int t) {
     __m256d rr_acc = _mm256_setzero_pd(), rz_acc = _mm256_setzero_pd();
     for (std::size_t i = node(t); i < node(t + 1); ++i) {
@@ -407,8 +412,13 @@ CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<co
   double rz = sum(part_b);
   CgResult out;
   int it = 0;
+  __m256d beta = _mm256_setzero_pd();  // p = z + β p: p starts as z (β = 0), then in the product's region
   while (r_norm > stop && it < max_iterations) {
-    const double pq = product(p, q);
+    const double pq = product(p, q, [&](int t) {
+      if (it == 0) return;
+      for (std::size_t o = 4 * node(t); o < 4 * node(t + 1); o += 4)
+        _mm256_store_pd(p + o, _mm256_fmadd_pd(beta, _mm256_load_pd(p + o), _mm256_load_pd(z + o)));
+    });
     if (!(pq > 0.0)) {
       out.breakdown = true;
       break;
@@ -432,12 +442,8 @@ CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<co
     ++it;
     r_norm = std::sqrt(sum(part_a));
     const double rz_new = sum(part_b);
-    const __m256d beta = _mm256_set1_pd(rz_new / rz);
+    beta = _mm256_set1_pd(rz_new / rz);
     rz = rz_new;
-    run_parts(parts, [&](int t) {
-      for (std::size_t o = 4 * node(t); o < 4 * node(t + 1); o += 4)
-        _mm256_store_pd(p + o, _mm256_fmadd_pd(beta, _mm256_load_pd(p + o), _mm256_load_pd(z + o)));
-    });
   }
   run_parts(parts, [&](int t) {
     for (std::size_t i = node(t); i < node(t + 1); ++i)
