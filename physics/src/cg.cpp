@@ -19,7 +19,8 @@ namespace {
 
 using detail::range_begin;
 using detail::run_parts;
-// Nodes per thread below which CG uses fewer threads: an iteration forks four times.
+// Nodes per thread below which CG uses fewer threads: an iteration forks two to four times
+// (the packed path two, the general one four).
 constexpr std::size_t cg_grain = 1024;
 
 double dot(std::span<const double> a, std::span<const double> b) { return detail::dot8(a.data(), b.data(), a.size()); }
