@@ -272,36 +272,43 @@ double sym_multiply_parts(CgWorkspace& ws, const double* __restrict p, double* _
   const Index* __restrict col = ws.sym_col.data();
   const double* __restrict val = ws.sym_val.data();
   double part_own[max_threads], part_spilled[max_threads];
-  const auto own_rows = [&](int t) {
+  const auto own_rows = [&, p, y, free4, row, col, val](int t) {
+    // a lambda's captures lose __restrict: without it every store to y reloads the row's bounds
+    const double* __restrict p_ = p;
+    double* __restrict y_ = y;
+    const double* __restrict free4_ = free4;
+    const Index* __restrict row_ = row;
+    const Index* __restrict col_ = col;
+    const double* __restrict val_ = val;
     const std::size_t i0 = node(t), i1 = node(t + 1), final0 = ws.first_final[static_cast<std::size_t>(t)];
     double* __restrict spill = t + 1 < parts ? ws.spill[static_cast<std::size_t>(t)].data() : nullptr;
-    std::fill(y + 4 * i0, y + 4 * i1, 0.0);
+    std::fill(y_ + 4 * i0, y_ + 4 * i1, 0.0);
     __m256d pq = _mm256_setzero_pd();
     for (std::size_t i = i0; i < i1; ++i) {
-      const double* pi = p + 4 * i;
+      const double* pi = p_ + 4 * i;
       const __m256d b0 = _mm256_broadcast_sd(pi), b1 = _mm256_broadcast_sd(pi + 1), b2 = _mm256_broadcast_sd(pi + 2);
       __m256d c0, c1, c2;
-      Index k = row[i];
-      columns(val + 6 * std::size_t{k}, c0, c1, c2);
-      __m256d a0 = _mm256_fmadd_pd(c0, b0, _mm256_load_pd(y + 4 * i));
+      Index k = row_[i];
+      columns(val_ + 6 * std::size_t{k}, c0, c1, c2);
+      __m256d a0 = _mm256_fmadd_pd(c0, b0, _mm256_load_pd(y_ + 4 * i));
       __m256d a1 = _mm256_mul_pd(c1, b1);
       __m256d a2 = _mm256_mul_pd(c2, b2);
-      for (++k; k < row[i + 1]; ++k) {
-        columns(val + 6 * std::size_t{k}, c0, c1, c2);
-        const std::size_t j = std::size_t{col[k]};
-        const double* pj = p + 4 * j;
+      for (++k; k < row_[i + 1]; ++k) {
+        columns(val_ + 6 * std::size_t{k}, c0, c1, c2);
+        const std::size_t j = std::size_t{col_[k]};
+        const double* pj = p_ + 4 * j;
         a0 = _mm256_fmadd_pd(c0, _mm256_broadcast_sd(pj), a0);
         a1 = _mm256_fmadd_pd(c1, _mm256_broadcast_sd(pj + 1), a1);
         a2 = _mm256_fmadd_pd(c2, _mm256_broadcast_sd(pj + 2), a2);
-        double* yj = (j < i1 ? y : spill) + 4 * j;
+        double* yj = (j < i1 ? y_ : spill) + 4 * j;
         _mm256_store_pd(yj, _mm256_fmadd_pd(c2, b2, _mm256_fmadd_pd(c1, b1, _mm256_fmadd_pd(c0, b0, _mm256_load_pd(yj)))));
       }
       __m256d yi = _mm256_add_pd(_mm256_add_pd(a0, a1), a2);
       if (i >= final0) {
-        yi = _mm256_mul_pd(yi, _mm256_load_pd(free4 + 4 * i));
+        yi = _mm256_mul_pd(yi, _mm256_load_pd(free4_ + 4 * i));
         pq = _mm256_fmadd_pd(yi, _mm256_load_pd(pi), pq);
       }
-      _mm256_store_pd(y + 4 * i, yi);
+      _mm256_store_pd(y_ + 4 * i, yi);
     }
     part_own[t] = hsum(pq);
   };
