@@ -19,7 +19,8 @@ namespace {
 
 using detail::range_begin;
 using detail::run_parts;
-// Nodes per thread below which CG uses fewer threads: an iteration forks four times.
+// Nodes per thread below which CG uses fewer threads: an iteration forks two to four times
+// (the packed path two, the general one four).
 constexpr std::size_t cg_grain = 1024;
 
 double dot(std::span<const double> a, std::span<const double> b) { return detail::dot8(a.data(), b.data(), a.size()); }
@@ -134,20 +135,27 @@ bool pack_symmetric(const BlockMatrix& A, CgWorkspace& ws) {
     ws.sym_val.resize(6 * ws.sym_src.size());
     ws.sym_pattern = A.pattern_version();
   }
-  double* __restrict out = ws.sym_val.data();
-  bool symmetric = true;
-  for (std::size_t b = 0; b < ws.sym_src.size(); ++b) {
-    const double* a = A.block(ws.sym_src[b]).data();  // column-major
-    symmetric &= a[1] == a[3] && a[2] == a[6] && a[5] == a[7];
-    double* o = out + 6 * b;
-    o[0] = a[0];
-    o[1] = a[3];
-    o[2] = a[6];
-    o[3] = a[4];
-    o[4] = a[7];
-    o[5] = a[8];
-  }
-  return symmetric;
+  // Split by rows as CG is (a serial copy of 32³'s upper triangle was 5 % of a 2-thread step).
+  const int parts = detail::parts_for(n, cg_grain);
+  bool symmetric_of[max_threads];
+  run_parts(parts, [&](int t) {
+    double* __restrict out = ws.sym_val.data();
+    bool symmetric = true;
+    const std::size_t b1 = ws.sym_row[range_begin(n, parts, t + 1)];
+    for (std::size_t b = ws.sym_row[range_begin(n, parts, t)]; b < b1; ++b) {
+      const double* a = A.block(ws.sym_src[b]).data();  // column-major
+      symmetric &= a[1] == a[3] && a[2] == a[6] && a[5] == a[7];
+      double* o = out + 6 * b;
+      o[0] = a[0];
+      o[1] = a[3];
+      o[2] = a[6];
+      o[3] = a[4];
+      o[4] = a[7];
+      o[5] = a[8];
+    }
+    symmetric_of[t] = symmetric;
+  });
+  return std::all_of(symmetric_of, symmetric_of + parts, [](bool s) { return s; });
 }
 
 #ifdef SEWN_CG_AVX512
@@ -220,75 +228,111 @@ double packed_product(CgWorkspace& ws, const double* __restrict p, double* __res
   return hsum(pq);
 }
 
-// sym_multiply on `parts` threads, thread t owning rows [node(t), node(t + 1)): its blocks
-// add to its own rows in y and to later threads' rows in its spill array; then, after the
-// threads meet, each thread adds the spills of the threads before it to its rows, in thread
-// order, filters them and sums its part of p·y. Deterministic for a given count; equal to one
-// thread's to round-off (a row's terms are grouped by thread). A thread's blocks reach past
-// its range by about the matrix's bandwidth (a grid layer): the spill is used, read and zeroed
-// again only up to the last row it reached, so it is zero between products. The one-thread
-// product fuses both passes (sym_multiply).
+// Where thread t's rows stop receiving products of earlier threads' blocks, for `parts` ranges
+// of the packed pattern: ws.spill_end[u] is one past the last row that range u's blocks reach
+// (at least its own end), ws.first_final[t] the first row of range t that no earlier range's
+// block reaches (at most its end). Once per pattern and count.
+void plan_spills(CgWorkspace& ws, std::size_t nodes, int parts) {
+  if (ws.spill_pattern == ws.sym_pattern && ws.spill_parts == parts) return;
+  const auto count = static_cast<std::size_t>(parts);
+  ws.spill_end.assign(count, 0);
+  ws.first_final.assign(count, 0);
+  std::size_t reach = 0;  // one past the last row reached by the ranges before t
+  for (int t = 0; t < parts; ++t) {
+    const std::size_t i0 = range_begin(nodes, parts, t), i1 = range_begin(nodes, parts, t + 1);
+    ws.first_final[static_cast<std::size_t>(t)] = std::clamp(reach, i0, i1);
+    std::size_t end = i1;
+    for (std::size_t i = i0; i < i1; ++i)  // a row's columns ascend: its last block reaches furthest
+      end = std::max(end, std::size_t{ws.sym_col[ws.sym_row[i + 1] - 1]} + 1);
+    ws.spill_end[static_cast<std::size_t>(t)] = end;
+    reach = std::max(reach, end);
+  }
+  ws.spill_pattern = ws.sym_pattern;
+  ws.spill_parts = parts;
+}
+
+// sym_multiply on `parts` threads, after first(t) for every range t (the caller's update of p,
+// in the same region), thread t owning rows [node(t), node(t + 1)): its blocks
+// add to its own rows in y and to later threads' rows in its spill array. A row no earlier
+// thread's block reaches (all but about a grid layer of each range) is complete when its own
+// blocks are done, so it is filtered and summed into p·y there, as in sym_multiply; after the
+// threads meet, each thread adds the spills of the threads before it to its first rows, in
+// thread order, and filters and sums those. Deterministic for a given count; equal to one
+// thread's to round-off (a row's terms and p·y are grouped by thread). The spill is used, read
+// and zeroed again only up to the last row it reaches, so it is zero between products.
+template <class First>
 double sym_multiply_parts(CgWorkspace& ws, const double* __restrict p, double* __restrict y, const double* __restrict free4,
-                          Index n, int parts) {
+                          Index n, int parts, const First& first) {
   const std::size_t nodes = static_cast<std::size_t>(n);
   if (ws.spill.size() < static_cast<std::size_t>(parts)) ws.spill.resize(static_cast<std::size_t>(parts));
   for (int t = 0; t + 1 < parts; ++t) ws.spill[static_cast<std::size_t>(t)].resize(4 * nodes, 0.0);
-  ws.spill_end.resize(static_cast<std::size_t>(parts));
+  plan_spills(ws, nodes, parts);
   const auto node = [&](int t) { return range_begin(nodes, parts, t); };
   const Index* __restrict row = ws.sym_row.data();
   const Index* __restrict col = ws.sym_col.data();
   const double* __restrict val = ws.sym_val.data();
-  const auto own_rows = [&](int t) {
-    const std::size_t i0 = node(t), i1 = node(t + 1);
+  double part_own[max_threads], part_spilled[max_threads];
+  const auto own_rows = [&, p, y, free4, row, col, val](int t) {
+    // a lambda's captures lose __restrict: without it every store to y reloads the row's bounds
+    const double* __restrict p_ = p;
+    double* __restrict y_ = y;
+    const double* __restrict free4_ = free4;
+    const Index* __restrict row_ = row;
+    const Index* __restrict col_ = col;
+    const double* __restrict val_ = val;
+    const std::size_t i0 = node(t), i1 = node(t + 1), final0 = ws.first_final[static_cast<std::size_t>(t)];
     double* __restrict spill = t + 1 < parts ? ws.spill[static_cast<std::size_t>(t)].data() : nullptr;
-    std::size_t reached = i1;
-    std::fill(y + 4 * i0, y + 4 * i1, 0.0);
+    std::fill(y_ + 4 * i0, y_ + 4 * i1, 0.0);
+    __m256d pq = _mm256_setzero_pd();
     for (std::size_t i = i0; i < i1; ++i) {
-      const double* pi = p + 4 * i;
+      const double* pi = p_ + 4 * i;
       const __m256d b0 = _mm256_broadcast_sd(pi), b1 = _mm256_broadcast_sd(pi + 1), b2 = _mm256_broadcast_sd(pi + 2);
       __m256d c0, c1, c2;
-      Index k = row[i];
-      columns(val + 6 * std::size_t{k}, c0, c1, c2);
-      __m256d a0 = _mm256_fmadd_pd(c0, b0, _mm256_load_pd(y + 4 * i));
+      Index k = row_[i];
+      columns(val_ + 6 * std::size_t{k}, c0, c1, c2);
+      __m256d a0 = _mm256_fmadd_pd(c0, b0, _mm256_load_pd(y_ + 4 * i));
       __m256d a1 = _mm256_mul_pd(c1, b1);
       __m256d a2 = _mm256_mul_pd(c2, b2);
-      for (++k; k < row[i + 1]; ++k) {
-        columns(val + 6 * std::size_t{k}, c0, c1, c2);
-        const std::size_t j = std::size_t{col[k]};
-        const double* pj = p + 4 * j;
+      for (++k; k < row_[i + 1]; ++k) {
+        columns(val_ + 6 * std::size_t{k}, c0, c1, c2);
+        const std::size_t j = std::size_t{col_[k]};
+        const double* pj = p_ + 4 * j;
         a0 = _mm256_fmadd_pd(c0, _mm256_broadcast_sd(pj), a0);
         a1 = _mm256_fmadd_pd(c1, _mm256_broadcast_sd(pj + 1), a1);
         a2 = _mm256_fmadd_pd(c2, _mm256_broadcast_sd(pj + 2), a2);
-        reached = std::max(reached, j + 1);
-        double* yj = (j < i1 ? y : spill) + 4 * j;
+        double* yj = (j < i1 ? y_ : spill) + 4 * j;
         _mm256_store_pd(yj, _mm256_fmadd_pd(c2, b2, _mm256_fmadd_pd(c1, b1, _mm256_fmadd_pd(c0, b0, _mm256_load_pd(yj)))));
       }
-      _mm256_store_pd(y + 4 * i, _mm256_add_pd(_mm256_add_pd(a0, a1), a2));
+      __m256d yi = _mm256_add_pd(_mm256_add_pd(a0, a1), a2);
+      if (i >= final0) {
+        yi = _mm256_mul_pd(yi, _mm256_load_pd(free4_ + 4 * i));
+        pq = _mm256_fmadd_pd(yi, _mm256_load_pd(pi), pq);
+      }
+      _mm256_store_pd(y_ + 4 * i, yi);
     }
-    ws.spill_end[static_cast<std::size_t>(t)] = reached;
+    part_own[t] = hsum(pq);
   };
-  double part[max_threads];
   const auto spilled_rows = [&](int t) {
-    const std::size_t i0 = node(t), i1 = node(t + 1);
+    const std::size_t i0 = node(t), final0 = ws.first_final[static_cast<std::size_t>(t)];
     for (int u = 0; u < t; ++u) {
       double* __restrict spill = ws.spill[static_cast<std::size_t>(u)].data();
-      const std::size_t end = std::min(i1, ws.spill_end[static_cast<std::size_t>(u)]);
+      const std::size_t end = std::min(final0, ws.spill_end[static_cast<std::size_t>(u)]);
       for (std::size_t i = i0; i < end; ++i) {
         _mm256_store_pd(y + 4 * i, _mm256_add_pd(_mm256_load_pd(y + 4 * i), _mm256_load_pd(spill + 4 * i)));
         _mm256_store_pd(spill + 4 * i, _mm256_setzero_pd());
       }
     }
     __m256d pq = _mm256_setzero_pd();
-    for (std::size_t i = i0; i < i1; ++i) {
+    for (std::size_t i = i0; i < final0; ++i) {
       const __m256d yi = _mm256_mul_pd(_mm256_load_pd(y + 4 * i), _mm256_load_pd(free4 + 4 * i));
       _mm256_store_pd(y + 4 * i, yi);
       pq = _mm256_fmadd_pd(yi, _mm256_load_pd(p + 4 * i), pq);
     }
-    part[t] = hsum(pq);
+    part_spilled[t] = hsum(pq);
   };
-  run_parts(parts, own_rows, spilled_rows);
+  run_parts(parts, first, own_rows, spilled_rows);
   double s = 0;
-  for (int t = 0; t < parts; ++t) s += part[t];
+  for (int t = 0; t < parts; ++t) s += part_spilled[t] + part_own[t];
   return s;
 }
 
@@ -301,8 +345,8 @@ inline __m256d precond_row(const double* pre, __m256d r) {
 }
 
 // The solve of filtered_pcg on the packed matrix, with the vector passes of an iteration
-// fused: the product with its filter and p·q, then x, r, the preconditioner, r·r and r·z in one
-// pass, then p. The filter is folded into the preconditioner, S P S, as r and z vanish on fixed
+// fused: p's update (p = z + β p) and the product with its filter and p·q in one region, then
+// x, r, the preconditioner, r·r and r·z in one pass: two forks an iteration. The filter is folded into the preconditioner, S P S, as r and z vanish on fixed
 // axes; its blocks are stored as symmetric ones (P's upper triangle: the inverse of a symmetric
 // block is symmetric up to round-off).
 // With W, the same on the reduced system (packed_product).
@@ -331,8 +375,11 @@ CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<co
     for (int t = 0; t < parts; ++t) total += part[t];
     return total;
   };
-  const auto product = [&](const double* v, double* out) {
-    return parts > 1 ? sym_multiply_parts(ws, v, out, s, nodes, parts) : packed_product(ws, v, out, s, nodes, W);
+  // q = S A v, after first(t) over every range t (on one thread: one range before the product).
+  const auto product = [&](const double* v, double* out, const auto& first) {
+    if (parts > 1) return sym_multiply_parts(ws, v, out, s, nodes, parts, first);
+    first(0);
+    return packed_product(ws, v, out, s, nodes, W);
   };
   run_parts(parts, [&](int t) {
     for (std::size_t i = node(t); i < node(t + 1); ++i) {
@@ -353,7 +400,7 @@ CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<co
       for (double* v : {r, z, p, q}) v[4 * i + 3] = 0.0;
     }
   });
-  (void)product(xv, q);
+  (void)product(xv, q, [](int) {});
   run_parts(parts, [&](int t) {
     __m256d rr_acc = _mm256_setzero_pd(), rz_acc = _mm256_setzero_pd();
     for (std::size_t i = node(t); i < node(t + 1); ++i) {
@@ -373,8 +420,13 @@ CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<co
   double rz = sum(part_b);
   CgResult out;
   int it = 0;
+  __m256d beta = _mm256_setzero_pd();  // p = z + β p: p starts as z (β = 0), then in the product's region
   while (r_norm > stop && it < max_iterations) {
-    const double pq = product(p, q);
+    const double pq = product(p, q, [&](int t) {
+      if (it == 0) return;
+      for (std::size_t o = 4 * node(t); o < 4 * node(t + 1); o += 4)
+        _mm256_store_pd(p + o, _mm256_fmadd_pd(beta, _mm256_load_pd(p + o), _mm256_load_pd(z + o)));
+    });
     if (!(pq > 0.0)) {
       out.breakdown = true;
       break;
@@ -398,15 +450,13 @@ CgResult pcg_packed(std::span<const double> b, std::span<double> x, std::span<co
     ++it;
     r_norm = std::sqrt(sum(part_a));
     const double rz_new = sum(part_b);
-    const __m256d beta = _mm256_set1_pd(rz_new / rz);
+    beta = _mm256_set1_pd(rz_new / rz);
     rz = rz_new;
-    run_parts(parts, [&](int t) {
-      for (std::size_t o = 4 * node(t); o < 4 * node(t + 1); o += 4)
-        _mm256_store_pd(p + o, _mm256_fmadd_pd(beta, _mm256_load_pd(p + o), _mm256_load_pd(z + o)));
-    });
   }
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t a = 0; a < 3; ++a) x[3 * i + a] = xv[4 * i + a];
+  run_parts(parts, [&](int t) {
+    for (std::size_t i = node(t); i < node(t + 1); ++i)
+      for (std::size_t a = 0; a < 3; ++a) x[3 * i + a] = xv[4 * i + a];
+  });
   out.iterations = it;
   out.relative_residual = r_norm / b_norm;
   out.converged = !out.breakdown && std::isfinite(r_norm) && r_norm <= stop;
@@ -448,8 +498,14 @@ Eigen::Matrix3d filtered_block_inverse(Eigen::Matrix3d B, const double* free_dof
 }  // namespace
 
 void block_jacobi_inverse(const BlockMatrix& A, std::span<const double> free_dof, std::span<double> inverse) {
-  for (Index i = 0; i < A.size(); ++i)
-    Eigen::Map<Eigen::Matrix3d>(inverse.data() + 9 * std::size_t{i}) = filtered_block_inverse(A.block(A.diagonal(i)), free_dof.data() + 3 * std::size_t{i});
+  // Node by node, split as CG is: each block the same at any count.
+  const auto n = static_cast<std::size_t>(A.size());
+  const int parts = detail::parts_for(n, cg_grain);
+  run_parts(parts, [&](int t) {
+    for (auto i = static_cast<Index>(range_begin(n, parts, t)); i < range_begin(n, parts, t + 1); ++i)
+      Eigen::Map<Eigen::Matrix3d>(inverse.data() + 9 * std::size_t{i}) =
+          filtered_block_inverse(A.block(A.diagonal(i)), free_dof.data() + 3 * std::size_t{i});
+  });
 }
 
 void block_jacobi_inverse(std::span<const double> blocks, std::span<const double> free_dof, std::span<double> inverse) {

@@ -53,6 +53,40 @@ bool all_finite(std::span<const double> a, Spans... more) {
   return bad == 0;
 }
 
+// v += dv(k), x += h v over the 3n values, split in ranges at 2+ threads; whether every value
+// stayed finite and the largest speed. Elementwise, with an OR and a max as reductions: bitwise
+// equal at any thread count.
+struct Advanced {
+  bool finite;
+  double max_speed;
+};
+template <class Dv>
+Advanced advance(std::span<double> x_all, std::span<double> v_all, double h, const Dv& dv) {
+  const std::size_t n3 = x_all.size();
+  const int parts = detail::parts_for(n3, vector_grain);
+  std::array<std::uint64_t, max_threads> bad_of{}, speed_of{};
+  detail::run_parts(parts, [&](int t) {
+    double* __restrict x = x_all.data();  // a lambda's captures lose __restrict: the loop would not vectorise
+    double* __restrict v = v_all.data();
+    std::uint64_t bad = 0, speed = 0;
+    const std::size_t k1 = detail::range_begin(n3, parts, t + 1);
+    for (std::size_t k = detail::range_begin(n3, parts, t); k < k1; ++k) {
+      v[k] += dv(k);
+      x[k] += h * v[k];
+      bad |= inf_or_nan(v[k]) | inf_or_nan(x[k]);
+      speed = std::max(speed, abs_bits(v[k]));
+    }
+    bad_of[static_cast<std::size_t>(t)] = bad;
+    speed_of[static_cast<std::size_t>(t)] = speed;
+  });
+  std::uint64_t bad = 0, speed = 0;
+  for (int t = 0; t < parts; ++t) {
+    bad |= bad_of[static_cast<std::size_t>(t)];
+    speed = std::max(speed, speed_of[static_cast<std::size_t>(t)]);
+  }
+  return {bad == 0, std::bit_cast<double>(speed)};
+}
+
 [[noreturn]] void report_nonfinite(const NodeTable& nodes, const char* who, bool with_forces) {
   struct Quantity {
     std::span<const double> values;
@@ -137,38 +171,12 @@ StepReport SymplecticEuler::step(System& sys, double h) {
   SlaveNodes& slaves = sys.slaves();  // T-junctions: forces to their masters, masses lumped there
   if (!slaves.empty()) slaves.pass_forces(nodes.f());
   {
-    const std::size_t n3 = nodes.x().size();
-    double* __restrict x = nodes.x().data();
-    double* __restrict v = nodes.v().data();
     const double* __restrict f = nodes.f().data();
     const double* __restrict im = (slaves.empty() ? nodes.inverse_mass_dof() : slaves.inverse_mass_dof(nodes)).data();
-    // Elementwise, with an OR and a max as reductions: bitwise equal at any thread count.
-    const int parts = detail::parts_for(n3, vector_grain);
-    std::array<std::uint64_t, max_threads> bad_of{}, speed_of{};
-    detail::run_parts(parts, [&](int t) {
-      double* __restrict xt = x;  // a lambda's captures lose __restrict: the loop would not vectorise
-      double* __restrict vt = v;
-      const double* __restrict ft = f;
-      const double* __restrict imt = im;
-      std::uint64_t bad = 0, speed = 0;
-      const std::size_t k1 = detail::range_begin(n3, parts, t + 1);
-      for (std::size_t k = detail::range_begin(n3, parts, t); k < k1; ++k) {
-        vt[k] += h * imt[k] * ft[k];
-        xt[k] += h * vt[k];
-        bad |= inf_or_nan(vt[k]) | inf_or_nan(xt[k]);
-        speed = std::max(speed, abs_bits(vt[k]));
-      }
-      bad_of[static_cast<std::size_t>(t)] = bad;
-      speed_of[static_cast<std::size_t>(t)] = speed;
-    });
-    std::uint64_t bad = 0, speed = 0;
-    for (int t = 0; t < parts; ++t) {
-      bad |= bad_of[static_cast<std::size_t>(t)];
-      speed = std::max(speed, speed_of[static_cast<std::size_t>(t)]);
-    }
-    if (bad == 0) nodes.mark_state_finite();
-    finite = bad == 0;
-    max_speed = std::bit_cast<double>(speed);
+    const Advanced a = advance(nodes.x(), nodes.v(), h, [f, im, h](std::size_t k) { return h * im[k] * f[k]; });
+    if (a.finite) nodes.mark_state_finite();
+    finite = a.finite;
+    max_speed = a.max_speed;
   }
   if (!slaves.empty()) slaves.after_step(nodes);
   ++steps_;
@@ -287,22 +295,25 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
   req.product_out = kv_;
   req.options = opt_.jacobian;
   sys.add_jacobians(req);
+  // 3) b = h (F₀ + h ∂F/∂P V₀); ΔV = 0 on fixed axes (their velocity is prescribed). With the
+  // masses, node by node, split in ranges (elementwise: the same at any count).
   const auto mass = nodes.masses();
   const auto fixed = nodes.fixed_masks();
-  for (Index i = 0; i < n; ++i) {
-    A.block(A.diagonal(i)).diagonal().array() += mass[i];
-    for (int a = 0; a < 3; ++a) {
-      free_[3 * i + a] = ((fixed[i] >> a) & 1u) ? 0.0 : 1.0;
-      mass3_[3 * i + a] = mass[i];
-    }
-  }
-
-  // 3) b = h (F₀ + h ∂F/∂P V₀); ΔV = 0 on fixed axes (their velocity is prescribed)
   const auto f = nodes.f();
-  for (std::size_t k = 0; k < n3; ++k) {
-    b_[k] = h * (f[k] + h * kv_[k]);
-    if (!opt_.warm_start || free_[k] == 0.0) dv_[k] = 0.0;
-  }
+  const int parts = detail::parts_for(n3, vector_grain);
+  detail::run_parts(parts, [&](int t) {
+    for (auto i = static_cast<Index>(detail::range_begin(n, parts, t)); i < detail::range_begin(n, parts, t + 1); ++i) {
+      double* diagonal = A.block_data(A.diagonal(i));
+      for (unsigned a = 0; a < 3; ++a) {
+        const std::size_t k = 3 * std::size_t{i} + a;
+        diagonal[4 * a] += mass[i];
+        free_[k] = ((fixed[i] >> a) & 1u) ? 0.0 : 1.0;
+        mass3_[k] = mass[i];
+        b_[k] = h * (f[k] + h * kv_[k]);
+        if (!opt_.warm_start || free_[k] == 0.0) dv_[k] = 0.0;
+      }
+    }
+  });
   solve::SolveReport sr;
   try {
     if (slaves.reduces()) {
@@ -344,19 +355,11 @@ StepReport LinearlyImplicitEuler::step(System& sys, double h) {
   double max_speed = 0;
   bool finite = true;  // else the next step's check names the value; energies of a NaN state mean nothing
   {
-    double* __restrict x = nodes.x().data();
-    double* __restrict v = nodes.v().data();
     const double* __restrict dv = dv_.data();
-    std::uint64_t bad = 0, speed = 0;
-    for (std::size_t k = 0; k < n3; ++k) {
-      v[k] += dv[k];
-      x[k] += h * v[k];
-      bad |= inf_or_nan(v[k]) | inf_or_nan(x[k]);
-      speed = std::max(speed, abs_bits(v[k]));
-    }
-    if (bad == 0) nodes.mark_state_finite();
-    finite = bad == 0;
-    max_speed = std::bit_cast<double>(speed);
+    const Advanced a = advance(nodes.x(), nodes.v(), h, [dv](std::size_t k) { return dv[k]; });
+    if (a.finite) nodes.mark_state_finite();
+    finite = a.finite;
+    max_speed = a.max_speed;
   }
   if (!slaves.empty()) slaves.after_step(nodes);
   ++steps_;

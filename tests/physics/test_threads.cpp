@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "sewn/physics/cg.hpp"
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/integrators.hpp"
 #include "sewn/physics/mss_model.hpp"
@@ -31,10 +32,10 @@ struct Threads {
   ~Threads() { set_thread_count(previous); }
 };
 
-// 12×12×14 cubes of 5 mm (2535 particles, ~19k springs: every kernel splits in two at 2
-// threads), clamped at x = 0, under gravity, with the paper's material.
-std::unique_ptr<MssModel<3>> block_model() {
-  auto m = std::make_unique<MssModel<3>>(hex_grid(12, 12, 14, {{0.005, 0.005, 0.005}, {}}),
+// 12×12×14 cubes of 5 mm by default (2535 particles, ~19k springs: every kernel splits in two
+// at 2 threads), clamped at x = 0, under gravity, with the paper's material.
+std::unique_ptr<MssModel<3>> block_model(Index nx = 12, Index ny = 12, Index nz = 14) {
+  auto m = std::make_unique<MssModel<3>>(hex_grid(nx, ny, nz, {{0.005, 0.005, 0.005}, {}}),
                                          std::vector<MaterialParams>{{1e6, 0.3, 1000}}, std::vector<std::uint32_t>{});
   for (Index i = 0; i < m->nodes().size(); ++i)
     if (m->rest_position(i).x() <= 1e-12) m->nodes().fix(i);
@@ -43,8 +44,8 @@ std::unique_ptr<MssModel<3>> block_model() {
 
 // The block with every position moved by up to 0.2 mm and random velocities (up to 2 cm/s):
 // springs in every direction, stretched and compressed.
-std::unique_ptr<MssModel<3>> jiggled_block(unsigned seed) {
-  auto m = block_model();
+std::unique_ptr<MssModel<3>> jiggled_block(unsigned seed, Index nx = 12, Index ny = 12, Index nz = 14) {
+  auto m = block_model(nx, ny, nz);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> jitter(-2e-4, 2e-4);
   auto x = m->nodes().x();
@@ -136,7 +137,7 @@ Assembled assemble(System& sys, bool exact, bool matrix) {
   return out;
 }
 
-// Every request of assemble() at 2 and 3 threads against 1 thread's, bitwise.
+// Every request of assemble() at 2 to 4 threads against 1 thread's, bitwise.
 void check_jacobians_bitwise(System& sys) {
   for (const bool exact : {false, true})
     for (const bool matrix : {true, false}) {
@@ -148,7 +149,7 @@ void check_jacobians_bitwise(System& sys) {
         one = assemble(sys, exact, matrix);
       }
       CHECK(std::any_of(one.product.begin(), one.product.end(), [](double a) { return a != 0.0; }));
-      for (const int threads : {2, 3}) {
+      for (const int threads : {2, 3, 4}) {
         CAPTURE(threads);
         Threads scope(threads);
         const Assembled many = assemble(sys, exact, matrix);
@@ -157,6 +158,40 @@ void check_jacobians_bitwise(System& sys) {
         CHECK(many.matvec == one.matvec);
       }
     }
+}
+
+// A = M − h ∂F/∂v − h² ∂F/∂x of `sys` at its state (h = 1 ms), as the implicit step builds it,
+// its block-Jacobi inverse and filter, and a right-hand side of 1 N on every free axis.
+struct LinearSystem {
+  std::vector<double> b, free_dof, precond;
+};
+LinearSystem implicit_system(System& sys) {
+  JacobianRequest req;
+  BlockMatrix& A = sys.matrix();
+  A.set_zero();
+  req.matrix = &A;
+  req.cx = -1e-6;
+  req.cv = -1e-3;
+  sys.add_jacobians(req);
+  const NodeTable& nodes = sys.nodes();
+  LinearSystem out;
+  for (Index i = 0; i < nodes.size(); ++i) {
+    A.block(A.diagonal(i)).diagonal().array() += nodes.mass(i);
+    for (unsigned a = 0; a < 3; ++a) out.free_dof.push_back(((nodes.fixed(i) >> a) & 1u) != 0 ? 0.0 : 1.0);
+  }
+  out.b = out.free_dof;
+  out.precond.resize(9 * std::size_t{nodes.size()});
+  block_jacobi_inverse(A, out.free_dof, out.precond);
+  return out;
+}
+
+// x after `iterations` CG iterations (no tolerance stops them) at `threads` threads.
+std::vector<double> cg_iterates(System& sys, const LinearSystem& ls, int threads, int iterations, CgWorkspace& ws) {
+  Threads scope(threads);
+  std::vector<double> x(ls.b.size(), 0.0);
+  const CgResult r = filtered_pcg(sys.matrix(), ls.b, x, ls.free_dof, ls.precond, 1e-300, iterations, ws);
+  CHECK(r.iterations == iterations);
+  return x;
 }
 
 struct Run {
@@ -239,7 +274,7 @@ TEST_CASE("threads: below the library's team size a library's OpenMP region with
   CHECK(library_team_size(2) == (parallel_build() ? 2 : 1));
 }
 
-TEST_CASE("threads: the block-sparse product and the springs' Jacobian are bitwise equal at 1, 2 and 3 threads") {
+TEST_CASE("threads: the block-sparse product and the springs' Jacobian are bitwise equal at 1 to 4 threads") {
   using threads_test::Threads;
   auto m = threads_test::jiggled_block(7);
   System& sys = m->system();
@@ -366,6 +401,33 @@ TEST_CASE("threads: a slab's forces split only into ranges longer than a seam of
   CHECK(threads_test::max_difference(one, two) <= 1e-13 * scale);
   CHECK(forces(3) == one);
   CHECK(regions == 0);
+}
+
+TEST_CASE("threads: CG's packed product at 1 to 4 threads agrees with one thread's to round-off, before and after a cut") {
+  // 16³ cubes: 4 913 particles, 4 ranges of ~1 230 rows at 4 threads, each longer than the
+  // grid layer (289 rows) earlier ranges' blocks reach; the cut changes the pattern, and with it
+  // where each range's products spill.
+  auto m = threads_test::jiggled_block(17, 16, 16, 16);
+  System& sys = m->system();
+  REQUIRE(m->nodes().size() >= 4 * 1024);
+  CgWorkspace kept;  // one workspace across counts and the cut, as a solver keeps it
+  for (const bool cut : {false, true}) {
+    CAPTURE(cut);
+    if (cut) threads_test::cut_plane(*m);
+    sys.refresh();
+    const threads_test::LinearSystem ls = threads_test::implicit_system(sys);
+    CgWorkspace fresh;
+    const std::vector<double> one = threads_test::cg_iterates(sys, ls, 1, 8, fresh);
+    double scale = 0;
+    for (double v : one) scale = std::max(scale, std::abs(v));
+    REQUIRE(scale > 0);
+    for (const int threads : {1, 2, 3, 4}) {
+      CAPTURE(threads);
+      const std::vector<double> x = threads_test::cg_iterates(sys, ls, threads, 8, kept);
+      CHECK(threads_test::cg_iterates(sys, ls, threads, 8, kept) == x);  // repeats bitwise
+      CHECK(threads_test::max_difference(one, x) <= 1e-12 * scale);
+    }
+  }
 }
 
 TEST_CASE("threads: trajectories repeat bitwise at 2 threads and agree with 1 thread to round-off") {

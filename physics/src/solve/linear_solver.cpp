@@ -1,7 +1,10 @@
 #include "sewn/physics/solve/linear_solver.hpp"
 
+#include <algorithm>
+#include <array>
 #include <string>
 
+#include "../parallel/ranges.hpp"
 #include "backends.hpp"
 #include "mpi_module.hpp"
 #include "sewn/physics/errors.hpp"
@@ -160,14 +163,29 @@ void check_sizes(const char* who, const BlockMatrix& A, std::span<const double> 
 }
 
 void check_diagonal(const char* who, const BlockMatrix& A, std::span<const double> free_dof) {
-  for (Index i = 0; i < A.size(); ++i) {
-    const auto B = A.block(A.diagonal(i));
-    for (int a = 0; a < 3; ++a)
-      if (free_dof[3 * std::size_t{i} + static_cast<std::size_t>(a)] != 0.0 && B(a, a) < 0.0)
-        throw SolverError(std::string(who) + ": the matrix is not positive definite on the free axes (diagonal entry " +
-                              std::to_string(B(a, a)) + " < 0 at node " + std::to_string(i) + ", axis " + "xyz"[a] + ")",
-                          0, 0);
-  }
+  // Split over nodes (a serial pass over 32³'s diagonal cost a 2-thread step ~1 %); each range
+  // keeps its first bad entry and the first range's is named, as a serial pass would.
+  const auto n = static_cast<std::size_t>(A.size());
+  const int parts = physics::detail::parts_for(n, 1024);
+  std::array<std::size_t, max_threads> first_bad;
+  first_bad.fill(3 * n);
+  physics::detail::run_parts(parts, [&](int t) {
+    const std::size_t i1 = physics::detail::range_begin(n, parts, t + 1);
+    for (std::size_t i = physics::detail::range_begin(n, parts, t); i < i1 && first_bad[static_cast<std::size_t>(t)] == 3 * n; ++i) {
+      const double* B = A.block(A.diagonal(static_cast<Index>(i))).data();
+      for (std::size_t a = 0; a < 3; ++a)
+        if (free_dof[3 * i + a] != 0.0 && B[4 * a] < 0.0) {
+          first_bad[static_cast<std::size_t>(t)] = 3 * i + a;
+          break;
+        }
+    }
+  });
+  const std::size_t k = *std::min_element(first_bad.begin(), first_bad.begin() + parts);
+  if (k == 3 * n) return;
+  const double entry = A.block(A.diagonal(static_cast<Index>(k / 3)))(static_cast<Index>(k % 3), static_cast<Index>(k % 3));
+  throw SolverError(std::string(who) + ": the matrix is not positive definite on the free axes (diagonal entry " +
+                        std::to_string(entry) + " < 0 at node " + std::to_string(k / 3) + ", axis " + "xyz"[k % 3] + ")",
+                    0, 0);
 }
 
 double absolute_floor(const SolverOptions& o, std::span<const double> free_dof, std::span<const double> mass_scale) {

@@ -44,7 +44,7 @@ class BlockMatrix {
   [[nodiscard]] double* block_data(Index slot) { return val_.data() + 9 * std::size_t{slot}; }
   [[nodiscard]] std::span<const Index> row_offsets() const { return row_; }
   [[nodiscard]] std::span<const Index> columns() const { return col_; }
-  /// Zeroes every value, keeping the pattern. O(blocks).
+  /// Zeroes every value, keeping the pattern; rows split over threads as in multiply(). O(blocks).
   void set_zero();
   /// y = A x for 3n vectors, rows split over thread_count() threads (threads.hpp); the
   /// result is the same bitwise for every count. O(blocks).

@@ -41,9 +41,12 @@ struct CgWorkspace {
   AlignedVector<double> expanded, ones4;          // a reduced solve's W p, and a filter of ones
   // Several threads: thread t's products into rows past its own range, one array per thread
   // (4 per node, rows [end of t's range, spill_end[t]) used, all zero between products), added
-  // in thread order (deterministic).
+  // in thread order (deterministic); rows from first_final[t] on receive none. Planned per
+  // packed pattern and count.
   std::vector<AlignedVector<double>> spill;
-  std::vector<std::size_t> spill_end;
+  std::vector<std::size_t> spill_end, first_final;
+  std::uint64_t spill_pattern = ~std::uint64_t{0};
+  int spill_parts = 0;
 };
 
 /// The fast path's packed matrix for other solvers (sa-pcg's multigrid and its CG): copies A's
