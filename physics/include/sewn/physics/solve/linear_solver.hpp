@@ -86,6 +86,13 @@ struct SolverOptions {
   /// with a retry, if CG fails with a stale one. A value > 0 also refreshes once a solve needed
   /// more than this many iterations; 0: the cost rule alone.
   int refresh_iterations = 0;
+  /// cholmod, cholmod-pcg: below this many flops of one numeric factorization the factor is
+  /// BlockCholesky's (supernodal on the 3×3 blocks, block_cholesky.hpp), above it CHOLMOD's; 0:
+  /// CHOLMOD's always. The count is the deciding analysis's: cholmod runs CHOLMOD's for it,
+  /// cholmod-pcg BlockCholesky's, which then spares it CHOLMOD's. BlockCholesky measured faster
+  /// on every matrix up to the N = 8 cantilever's 1.5e9 flops (docs/solvers.md); the default
+  /// keeps CHOLMOD only beyond anything measured.
+  double block_factor_flops = 1e10;
 };
 
 /// What one solve cost. Times are wall-clock milliseconds spent inside the solver.
