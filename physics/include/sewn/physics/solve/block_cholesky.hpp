@@ -1,6 +1,7 @@
 #pragma once
 // BlockCholesky: a sparse supernodal LLᵀ factorization on BlockMatrix's 3×3 blocks (the direct
-// backend, cholmod.cpp, uses it below block_factor_flops: every matrix measured).
+// backend and cholmod-pcg's kept factor, cholmod.cpp, use it below block_factor_flops: every
+// matrix measured).
 //
 // Why: every entry of the solver layer's matrices belongs to a 3×3 block (a node's axes, or
 // three rod angles), so the symbolic work runs on the block graph, 9× smaller. A first version

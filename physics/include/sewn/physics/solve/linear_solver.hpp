@@ -15,12 +15,14 @@
 //
 // Backends (which exist in this build: available_backends()):
 //   jacobi       block-Jacobi preconditioned CG, the reference: no set-up, O(iterations · blocks);
-//   cholmod      sparse Cholesky (SuiteSparse CHOLMOD): symbolic analysis once per pattern,
+//   cholmod      sparse Cholesky (BlockCholesky below block_factor_flops, else SuiteSparse
+//                CHOLMOD): symbolic analysis once per pattern,
 //                numeric factorization whenever A's values changed, two triangular solves, and
 //                up to 3 refinement passes (reported as iterations) while the residual misses
 //                the tolerance (ill-conditioned matrices);
-//   cholmod-pcg  CG preconditioned by a CHOLMOD factorization of a recent A, kept across steps
-//                (and Newton iterations) while CG needs few iterations, refreshed when they grow;
+//   cholmod-pcg  CG preconditioned by a factorization of a recent A (BlockCholesky's below
+//                block_factor_flops, else CHOLMOD's; solved in single precision), kept across
+//                steps (and Newton iterations) while CG needs few iterations, refreshed when they grow;
 //   hypre-pcg    the same CG and refresh rule, preconditioned by one V-cycle of hypre's BoomerAMG
 //                (algebraic multigrid) set up on a recent A: set-up and V-cycle cost O(entries);
 //   sa-pcg       the same CG and refresh rule, preconditioned by one V-cycle of our own
