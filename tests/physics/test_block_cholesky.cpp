@@ -155,6 +155,37 @@ TEST_CASE("block cholesky: supernodes on cliques, chains and random couplings, w
   }
 }
 
+TEST_CASE("block cholesky's single-precision solves: within float's rounding of the double ones; double where float cannot hold the factor") {
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    CAPTURE(seed);
+    BlockMatrix A;
+    shaped_spd(A, 30 + 5 * seed, static_cast<int>(seed % 3), seed);  // dense panels and one-pivot ones
+    const Problem p = random_problem(A, nullptr, seed % 2 ? 0.0 : 0.25, seed + 90);
+    solve::BlockCholesky exact, single;
+    single.set_single_solves(true);
+    const std::vector<double> x = block_solve(exact, A, p), y = block_solve(single, A, p);
+    CHECK_FALSE(exact.single_solves());
+    CHECK(single.single_solves());
+    CHECK(x != y);  // the float panels were used
+    // the factor's entries rounded to float (2^-24 relative): a small multiple of that in x
+    CHECK(max_difference(y, reference_solve(A, p)) < 1e-5);
+    for (std::size_t k = 0; k < y.size(); ++k)
+      if (p.free_dof[k] == 0.0) REQUIRE(y[k] == p.x0[k]);
+    // In extreme units (entries ~1e±90, the factor's ~1e±45) float overflows or loses its
+    // normal range: the solves stay in double, exact, not infinite or NaN.
+    for (double scale : {1e90, 1e-90}) {
+      CAPTURE(scale);
+      BlockMatrix B = A;
+      for (Index k = 0; k < B.num_blocks(); ++k) B.block(k) *= scale;
+      Problem q = p;
+      for (double& v : q.b) v *= scale;
+      const std::vector<double> z = block_solve(single, B, q);
+      CHECK_FALSE(single.single_solves());
+      check_solution(B, q, z);
+    }
+  }
+}
+
 TEST_CASE("block cholesky: a clique is one dense panel, with a dense factor's entries and flops") {
   BlockMatrix A;
   const Index n = 12;

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <Eigen/Cholesky>
 #include <Eigen/OrderingMethods>
 
+#include "panel_solve.hpp"
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/threads.hpp"
 
@@ -17,7 +19,6 @@ namespace {
 using Panel = Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
 using ConstPanel = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
 using Dense = Eigen::Map<Eigen::MatrixXd>;
-using VecX = Eigen::Map<Eigen::VectorXd>;
 using Vec3 = Eigen::Map<Eigen::Vector3d>;
 using Block = Eigen::Map<Eigen::Matrix3d>;
 using Block3 = Eigen::Map<Eigen::Matrix3d, 0, Eigen::OuterStride<>>;  // a 3×3 block of a panel
@@ -321,6 +322,7 @@ void BlockCholesky::factorize(const BlockMatrix& A, std::span<const double> free
     throw InputError(std::string(who) + ": " + std::to_string(free_dof.size()) + " free-axis flags for a matrix of " +
                      std::to_string(3 * std::size_t{A.size()}) + " unknowns");
   if (!analysed_for(A)) analyse(A);
+  lf_.clear();
   // Eigen's GEMM forks an OpenMP team of omp_get_max_threads() for products over ~1e5 flops,
   // whatever thread_count() says: on the frisbee that made a run 15x slower (the team's spins
   // and wake-ups beside the other processes on 2 cores). The products here are small: serial.
@@ -334,6 +336,23 @@ void BlockCholesky::factorize(const BlockMatrix& A, std::span<const double> free
       finish_supernode(s, who);
     }
   }
+  if (single_ && !round_panels()) lf_.clear();
+}
+
+// lf_ = lx_ in float; false if a value overflows float or a diagonal entry the solves divide by
+// (multiply by, one pivot wide: L(j, j)⁻¹'s) is not a normal float (a matrix in extreme units).
+bool BlockCholesky::round_panels() {
+  lf_.resize(lx_.size());
+  std::transform(lx_.begin(), lx_.end(), lf_.begin(), [](double v) { return static_cast<float>(v); });
+  float biggest = 0;
+  for (const float v : lf_) biggest = std::max(biggest, std::abs(v));
+  if (!(biggest <= std::numeric_limits<float>::max())) return false;  // inf or NaN
+  for (std::size_t s = 0; s < supernodes(); ++s) {
+    const std::size_t n = 3 * width_of(s), ld = n + 3 * below_of(s), d = width_of(s) == 1 ? 3 : ld;
+    for (std::size_t j = 0; j < n; ++j)
+      if (!(std::abs(lf_[sn_val_[s] + j * d + j]) >= std::numeric_limits<float>::min())) return false;
+  }
+  return true;
 }
 
 // Supernode s's panel = its columns of K's lower triangle (permuted): free_r free_c A(r, c),
@@ -473,52 +492,54 @@ void BlockCholesky::solve(std::span<const double> rhs, std::span<double> out) {
                      " values for a factor of " + std::to_string(3 * nb) + " unknowns");
   for (std::size_t j = 0; j < nb; ++j)
     for (std::size_t a = 0; a < 3; ++a) y_[3 * j + a] = rhs[3 * std::size_t{perm_[j]} + a];
-  const std::size_t ns = supernodes();
-  const auto panel_of = [this](std::size_t s) {
-    const auto n = static_cast<Eigen::Index>(3 * (sn_first_[s + 1] - sn_first_[s]));
-    const auto ld = n + static_cast<Eigen::Index>(3 * (sn_rows_[s + 1] - sn_rows_[s]));
-    return ConstPanel(lx_.data() + sn_val_[s], ld, n, Eigen::OuterStride<>(ld));
-  };
-  for (std::size_t s = 0; s < ns; ++s) {  // L y = P b
-    const ConstPanel panel = panel_of(s);
-    const Eigen::Index n = panel.cols(), below = panel.rows() - n;
-    double* ys = y_.data() + 3 * std::size_t{sn_first_[s]};
-    if (n == 3) {  // one pivot: fixed-size blocks
-      Vec3 yj(ys);
-      yj = ConstBlock(panel.data()) * Eigen::Vector3d(yj);  // L(j, j)⁻¹ yj (its upper triangle zero)
-      for (std::size_t q = sn_rows_[s]; q < sn_rows_[s + 1]; ++q)
-        Vec3(y_.data() + 3 * std::size_t{rows_[q]}).noalias() -= ConstBlock(panel.data() + 9 * (q - sn_rows_[s] + 1)) * yj;
-      continue;
-    }
-    VecX yn(ys, n);
-    panel.topRows(n).triangularView<Eigen::Lower>().solveInPlace(yn);
-    if (below == 0) continue;
-    VecX t(tmp_.data(), below);
-    t.noalias() = panel.bottomRows(below) * yn;
-    for (std::size_t q = sn_rows_[s]; q < sn_rows_[s + 1]; ++q)
-      for (std::size_t a = 0; a < 3; ++a) y_[3 * std::size_t{rows_[q]} + a] -= tmp_[3 * (q - sn_rows_[s]) + a];
-  }
-  for (std::size_t s = ns; s-- > 0;) {  // Lᵀ z = y
-    const ConstPanel panel = panel_of(s);
-    const Eigen::Index n = panel.cols(), below = panel.rows() - n;
-    double* ys = y_.data() + 3 * std::size_t{sn_first_[s]};
-    if (n == 3) {
-      Vec3 yj(ys);
-      for (std::size_t q = sn_rows_[s]; q < sn_rows_[s + 1]; ++q)
-        yj.noalias() -= ConstBlock(panel.data() + 9 * (q - sn_rows_[s] + 1)).transpose() * Vec3(y_.data() + 3 * std::size_t{rows_[q]});
-      yj = ConstBlock(panel.data()).transpose() * Eigen::Vector3d(yj);
-      continue;
-    }
-    if (below > 0) {
-      for (std::size_t q = sn_rows_[s]; q < sn_rows_[s + 1]; ++q)
-        for (std::size_t a = 0; a < 3; ++a) tmp_[3 * (q - sn_rows_[s]) + a] = y_[3 * std::size_t{rows_[q]} + a];
-      VecX(ys, n).noalias() -= panel.bottomRows(below).transpose() * VecX(tmp_.data(), below);
-    }
-    VecX yn(ys, n);
-    panel.topRows(n).transpose().triangularView<Eigen::Upper>().solveInPlace(yn);
-  }
+  if (lf_.empty()) solve_panels(lx_.data());
+  else solve_panels(lf_.data());
   for (std::size_t j = 0; j < nb; ++j)
     for (std::size_t a = 0; a < 3; ++a) out[3 * std::size_t{perm_[j]} + a] = y_[3 * j + a];
+}
+
+// L Lᵀ y_ = y_ on the panels lx (lx_ or its float copy). A one-pivot supernode: fixed-size 3×3
+// blocks, L(j, j)⁻¹ multiplied; a wider one: its rows gathered into tmp_, the panel's
+// triangle and rows below in one pass (panel_solve.hpp), scattered back.
+template <class T>
+void BlockCholesky::solve_panels(const T* lx) {
+  using Block33 = Eigen::Map<const Eigen::Matrix<T, 3, 3>>;
+  const auto block = [lx](std::size_t at) { return Block33(lx + at).template cast<double>(); };
+  const std::size_t ns = supernodes();
+  double* y = y_.data();
+  double* w = tmp_.data();
+  for (std::size_t s = 0; s < ns; ++s) {  // L y = P b
+    const std::size_t n = 3 * width_of(s), nr = n + 3 * below_of(s), r0 = sn_rows_[s];
+    double* ys = y + 3 * std::size_t{sn_first_[s]};
+    if (n == 3) {
+      Vec3 yj(ys);
+      yj = block(sn_val_[s]) * Eigen::Vector3d(yj);  // L(j, j)⁻¹ yj (its upper triangle zero)
+      for (std::size_t q = r0; q < sn_rows_[s + 1]; ++q) Vec3(y + 3 * std::size_t{rows_[q]}).noalias() -= block(sn_val_[s] + 9 * (q - r0 + 1)) * yj;
+      continue;
+    }
+    std::copy_n(ys, n, w);
+    std::fill(w + n, w + nr, 0.0);
+    solve::detail::panel_forward(lx + sn_val_[s], n, nr, w);
+    std::copy_n(w, n, ys);
+    for (std::size_t q = r0; q < sn_rows_[s + 1]; ++q)
+      for (std::size_t a = 0; a < 3; ++a) y[3 * std::size_t{rows_[q]} + a] += w[n + 3 * (q - r0) + a];
+  }
+  for (std::size_t s = ns; s-- > 0;) {  // Lᵀ z = y
+    const std::size_t n = 3 * width_of(s), nr = n + 3 * below_of(s), r0 = sn_rows_[s];
+    double* ys = y + 3 * std::size_t{sn_first_[s]};
+    if (n == 3) {
+      Vec3 yj(ys);
+      for (std::size_t q = r0; q < sn_rows_[s + 1]; ++q)
+        yj.noalias() -= block(sn_val_[s] + 9 * (q - r0 + 1)).transpose() * Vec3(y + 3 * std::size_t{rows_[q]});
+      yj = block(sn_val_[s]).transpose() * Eigen::Vector3d(yj);
+      continue;
+    }
+    std::copy_n(ys, n, w);
+    for (std::size_t q = r0; q < sn_rows_[s + 1]; ++q)
+      for (std::size_t a = 0; a < 3; ++a) w[n + 3 * (q - r0) + a] = y[3 * std::size_t{rows_[q]} + a];
+    solve::detail::panel_backward(lx + sn_val_[s], n, nr, w);
+    std::copy_n(w, n, ys);
+  }
 }
 
 }  // namespace sewn::physics::solve

@@ -44,24 +44,25 @@ constexpr double factor_flop_speedup = 1.0;
 // many flops (a factorization of a few ms with OpenBLAS) the search pays.
 constexpr double ordering_search_flops = 3e7;
 
-// Below this many flops the direct backend factors K with BlockCholesky instead of CHOLMOD
-// (block_cholesky.hpp). Its first, 3×3-column version paid below 3e7 flops (whole scenes 0.79x
-// to 0.98x the CPU time, CHOLMOD's supernodes too narrow for BLAS). Its supernodal version
-// (Eigen's AVX-512 kernels) measured, interleaved, against CHOLMOD with its METIS/nested-
-// dissection search, with OpenBLAS's AVX-512 kernels (OPENBLAS_CORETYPE=SkylakeX, what sewn run
-// and the benchmarks select on the Xeon model 207) and, in brackets, its SSE3 fallback: the toy
-// tunnel (5e7 flops) 1.03-1.06x a frame (1.26x), bench_solve's 8×8×10 beam at h = 1 ms 1.55x a
-// step (2.2x), the N = 8 cantilever (3.9e6 entries of L) 1.25-1.56x (2.2x), same errors to
-// round-off. No matrix measured favours CHOLMOD's factorization; its analysis still supplies
-// the flop count, and the threshold only keeps factorizations beyond anything measured on CHOLMOD.
-constexpr double block_factor_flops = 1e10;
 
-// One CHOLMOD workspace, the filtered matrix in its upper-triangular CSC form, and its factor.
+// The same for BlockCholesky's factorization against its float solves (the refresh rule's set-up
+// cost). Measured on bench_solve: 1.45 on the 8×8×10 beam (9.0e7 flops, ~9.6 ms against ~0.25 ms
+// a solve: narrow supernodes), 6.7 on the N = 8 cantilever (1.5e9 flops, ~100 ms against ~8 ms
+// an iteration). 4, as for CHOLMOD, sets up as often as before there (set-up costs 13.9 and 21.4
+// iterations against CHOLMOD's 11.6 and 21.6; 0.01 and 0.15 factorizations a step both).
+constexpr double block_flop_speedup = 4.0;
+
+// One CHOLMOD workspace, the filtered matrix in its upper-triangular CSC form, and its factor:
+// CHOLMOD's, or for a kept factor below SolverOptions::block_factor_flops BlockCholesky's of the
+// same matrix.
+// K's CSC values are the factored values either way (state(): one format for both engines).
 class Factorization {
  public:
   /// single_solves: after each numeric factorization of a supernodal analysis, solve on a copy
   /// of the factor in single precision (see factorize()); for a factor kept as a preconditioner.
-  explicit Factorization(bool single_solves = true) : single_solves_(single_solves) {
+  /// blocks: factor with BlockCholesky below configure()'s flops (cholmod-pcg's kept factor).
+  explicit Factorization(bool single_solves = true, bool blocks = true) : single_solves_(single_solves), may_block_(blocks) {
+    block_.set_single_solves(single_solves);
     cholmod_start(&c_);
     c_.print = 0;  // failures are reported by our exceptions, not on stderr
     // LLᵀ: a simplicial LDLᵀ would succeed on an indefinite matrix (only a zero pivot stops
@@ -79,6 +80,9 @@ class Factorization {
   Factorization(const Factorization&) = delete;
   Factorization& operator=(const Factorization&) = delete;
 
+  /// The solver's options: block_factor_flops decides the engine at the next analyse(). O(1).
+  void configure(const SolverOptions& o) { block_flops_ = o.block_factor_flops; }
+
   /// Rebuilds K's pattern if A's changed; returns true then (the analysis is stale). O(blocks · log).
   bool sync_pattern(const BlockMatrix& A) {
     if (K_ && pattern_ == A.pattern_version()) return false;
@@ -90,6 +94,7 @@ class Factorization {
     const auto cols = A.columns();
     std::vector<int> p(n + 1, 0), i;
     src_.clear();
+    mirror_.clear();
     i.reserve(9 * std::size_t{A.num_blocks()} / 2 + n);
     src_.reserve(i.capacity());
     // Column 3bj+c holds rows 3bi+a for the blocks (bi, bj), bi ≤ bj, ascending; the value
@@ -99,10 +104,12 @@ class Factorization {
         for (Index k = rows[bj]; k < rows[bj + 1]; ++k) {
           const Index bi = cols[k];
           if (bi > bj) break;
-          const Index slot = A.find(bi, bj);
+          const Index slot = A.find(bi, bj), twin = A.find(bj, bi);
           for (int a = 0; a < 3 && (bi < bj || a <= c); ++a) {
+            const auto ua = static_cast<std::size_t>(a), uc = static_cast<std::size_t>(c);
             i.push_back(static_cast<int>(3 * bi + static_cast<Index>(a)));
-            src_.push_back(9 * std::size_t{slot} + 3 * static_cast<std::size_t>(c) + static_cast<std::size_t>(a));
+            src_.push_back(9 * std::size_t{slot} + 3 * uc + ua);
+            if (may_block_) mirror_.push_back(9 * std::size_t{twin} + 3 * ua + uc);  // (bj, bi)(c, a)
           }
         }
         p[3 * std::size_t{bj} + static_cast<std::size_t>(c) + 1] = static_cast<int>(i.size());
@@ -115,6 +122,10 @@ class Factorization {
     col_of_.resize(i.size());
     for (std::size_t col = 0; col < n; ++col)
       for (int e = p[col]; e < p[col + 1]; ++e) col_of_[static_cast<std::size_t>(e)] = static_cast<int>(col);
+    if (may_block_) {
+      kb_ = A;  // K's values go in at each factorization
+      ones_.assign(n, 1.0);
+    }
     pattern_ = A.pattern_version();
     return true;
   }
@@ -141,10 +152,19 @@ class Factorization {
            std::equal(factored_.begin(), factored_.end(), static_cast<const double*>(K_->x));
   }
 
-  /// Symbolic analysis (fill-reducing ordering, elimination tree). Milliseconds.
+  /// Symbolic analysis (fill-reducing ordering, elimination tree), BlockCholesky's first if
+  /// the blocks may be used: below configure()'s flops CHOLMOD's is skipped. Milliseconds.
   void analyse() {
     const SerialLibraryRegions serial;
     free_factor();
+    if (may_block_ && block_flops_ > 0) {
+      block_.analyse(kb_);
+      blocks_ = block_.flops() < block_flops_;
+      if (blocks_) {
+        setup_cost_ = block_.flops() / iteration_flops(block_.factor_entries()) / block_flop_speedup;
+        return;
+      }
+    }
     L_ = analyse_with({CHOLMOD_AMD});
     if (!L_) throw SolverError("cholmod: symbolic analysis failed (status " + std::to_string(c_.status) + ")", 0, 0);
     if (c_.fl >= ordering_search_flops) {
@@ -155,10 +175,7 @@ class Factorization {
       L_ = best;
     }
     if (L_->is_super) build_permuted();
-    // One PCG iteration: two triangular solves (2 flops per entry of L each), the product with
-    // A (2 per stored scalar, both triangles) and the vector passes (~10 per unknown).
-    const double n = static_cast<double>(L_->n), upper = static_cast<double>(src_.size());
-    setup_cost_ = c_.fl / (4.0 * c_.lnz + 2.0 * (2.0 * upper - n) + 10.0 * n) / factor_flop_speedup;
+    setup_cost_ = c_.fl / iteration_flops(c_.lnz) / factor_flop_speedup;
   }
 
   /// A numeric factorization's cost in PCG iterations (flop counts of the analysis; measured
@@ -169,6 +186,10 @@ class Factorization {
   /// where a pivot was not positive.
   void factorize(const char* who, bool keep_values) {
     valid_ = false;
+    if (blocks_) {
+      factorize_blocks(who, keep_values);
+      return;
+    }
     bool ok = false;
     {
       const SerialLibraryRegions serial;  // one thread means one: CHOLMOD's own regions too
@@ -213,8 +234,10 @@ class Factorization {
     factored_.assign(static_cast<const double*>(K_->x), static_cast<const double*>(K_->x) + src_.size());
     valid_ = true;
   }
-  /// The analysis's flop count of one numeric factorization. O(1).
+  /// The analysis's flop count of one numeric factorization (CHOLMOD's). O(1).
   [[nodiscard]] double flops() const { return c_.fl; }
+  /// True if the factor is BlockCholesky's (analyse()). O(1).
+  [[nodiscard]] bool blocks() const { return blocks_; }
 
   /// K's values when last factored (kept if factorize() was asked to). O(1).
   [[nodiscard]] const std::vector<double>& factored_values() const { return factored_; }
@@ -233,7 +256,7 @@ class Factorization {
 
   [[nodiscard]] bool valid() const { return valid_; }
   /// True once analyse() ran on the current pattern (sync_pattern() drops it).
-  [[nodiscard]] bool analysed() const { return L_ != nullptr; }
+  [[nodiscard]] bool analysed() const { return L_ != nullptr || (blocks_ && block_.analysed_for(kb_)); }
   void invalidate() { valid_ = false; }
   void forget() {
     free_factor();
@@ -243,6 +266,10 @@ class Factorization {
 
   /// out = K⁻¹ rhs (3n values each; may alias). Two triangular solves, no allocation once sized.
   void solve(std::span<const double> rhs, std::span<double> out) {
+    if (blocks_) {
+      block_.solve(rhs, out);
+      return;
+    }
     if (!single_.empty()) {
       single_.solve(rhs, out);
       return;
@@ -262,6 +289,23 @@ class Factorization {
   }
 
  private:
+  // One PCG iteration's flops with a factor of `entries` scalars: two triangular solves (2 flops
+  // per entry each), the product with A (2 per stored scalar, both triangles) and the vector
+  // passes (~10 per unknown).
+  [[nodiscard]] double iteration_flops(double entries) const {
+    const double n = static_cast<double>(3 * std::size_t{kb_.size()}), upper = static_cast<double>(src_.size());
+    return 4.0 * entries + 2.0 * (2.0 * upper - n) + 10.0 * n;
+  }
+  // factorize() with BlockCholesky: K's values into both triangles of kb_, factored as they are
+  // (all axes free: K's fixed rows are already identity rows).
+  void factorize_blocks(const char* who, bool keep_values) {
+    const auto* kx = static_cast<const double*>(K_->x);
+    double* kv = kb_.num_blocks() ? kb_.block_data(0) : nullptr;
+    for (std::size_t e = 0; e < src_.size(); ++e) kv[src_[e]] = kv[mirror_[e]] = kx[e];
+    block_.factorize(kb_, ones_, who);
+    if (keep_values) factored_.assign(kx, kx + src_.size());
+    valid_ = true;
+  }
   // A simplicial LDLᵀ factor (if CHOLMOD left one despite final_ll) with a pivot d_j ≤ 0: j, else n.
   [[nodiscard]] std::size_t nonpositive_pivot() const {
     if (L_->is_super || L_->is_ll) return L_->n;
@@ -310,6 +354,7 @@ class Factorization {
     for (std::size_t c = 0; c < n; ++c) sp[c + 1] += sp[c];
   }
   void free_factor() {
+    blocks_ = false;
     if (S_) cholmod_free_sparse(&S_, &c_);
     if (L_) cholmod_free_factor(&L_, &c_);
     single_.clear();
@@ -330,6 +375,13 @@ class Factorization {
   bool single_solves_;
   FloatSupernodalFactor single_;  // L_'s values in single precision, when single_solves_ and L_ is supernodal
   double setup_cost_ = 0;
+  bool may_block_;                 // BlockCholesky may factor (below block_flops_)
+  double block_flops_ = SolverOptions{}.block_factor_flops;
+  bool blocks_ = false;            // it does, for the current analysis
+  solve::BlockCholesky block_;
+  BlockMatrix kb_;                 // K on A's pattern, both triangles, for block_
+  std::vector<std::size_t> mirror_;  // per entry of K: its transpose's index in kb_'s values
+  std::vector<double> ones_;       // block_'s free-axis mask: K is already filtered
 };
 
 // r = S(b - A x̃), x̃ = x on the fixed axes and 0 on the free ones: what the free axes must solve.
@@ -363,6 +415,16 @@ std::pair<double, double> residual(const BlockMatrix& A, std::span<const double>
   return {std::sqrt(rr), std::sqrt(bb)};
 }
 
+// Below SolverOptions::block_factor_flops both backends factor K with BlockCholesky instead of
+// CHOLMOD (block_cholesky.hpp). Its first, 3×3-column version paid below 3e7 flops (whole scenes
+// 0.79x to 0.98x the CPU time, CHOLMOD's supernodes too narrow for BLAS). Its supernodal version
+// (Eigen's AVX-512 kernels) measured, interleaved, against CHOLMOD with its METIS/nested-
+// dissection search, with OpenBLAS's AVX-512 kernels (OPENBLAS_CORETYPE=SkylakeX, what sewn run
+// and the benchmarks select on the Xeon model 207) and, in brackets, its SSE3 fallback: the toy
+// tunnel (5e7 flops) 1.03-1.06x a frame (1.26x), bench_solve's 8×8×10 beam at h = 1 ms 1.55x a
+// step (2.2x), the N = 8 cantilever (3.9e6 entries of L) 1.25-1.56x (2.2x), same errors to
+// round-off. The direct backend still runs CHOLMOD's analysis for the flop count; cholmod-pcg
+// (docs/solvers.md) decides on BlockCholesky's analysis and skips CHOLMOD's.
 class CholmodDirect final : public LinearSolver {
  public:
   static constexpr int max_refinements = 3;
@@ -385,7 +447,7 @@ class CholmodDirect final : public LinearSolver {
       t = Clock::now();
     }
     if (!f_.factor_matches_values()) {
-      blocks_ = f_.flops() < block_factor_flops;
+      blocks_ = f_.flops() < opt_.block_factor_flops;
       if (blocks_) {
         f_.invalidate();
         block_.factorize(A, free_dof, "cholmod solve");
@@ -432,8 +494,9 @@ class CholmodDirect final : public LinearSolver {
     else f_.solve(r, r);
   }
 
-  Factorization f_{false};  // double solves: the refinement passes need the factor's full precision
-  // Below block_factor_flops, the supernodal block factorization of the same K (block_cholesky.hpp);
+  // double solves: the refinement passes need the factor's full precision; CHOLMOD's own
+  Factorization f_{false, false};
+  // Below opt_.block_factor_flops, the supernodal block factorization of the same K (block_cholesky.hpp);
   // CHOLMOD's analysis is kept for its flop count and K's values for factor_matches_values().
   solve::BlockCholesky block_;
   bool blocks_ = false;

@@ -11,11 +11,9 @@
 #include <cmath>
 #include <limits>
 
-#include "../dot8.hpp"
+#include "panel_solve.hpp"
 
 namespace sewn::physics::solve::detail {
-
-using physics::detail::dot8;
 
 bool FloatSupernodalFactor::assign(const cholmod_factor& L) {
   const std::size_t ns = L.nsuper;
@@ -69,12 +67,7 @@ void FloatSupernodalFactor::solve(std::span<const double> rhs, std::span<double>
     const float* blk = x_.data() + px_[k];
     std::copy_n(y + c0, nc, w);
     std::fill(w + nc, w + nr, 0.0);
-    for (std::size_t j = 0; j < nc; ++j) {
-      const float* col = blk + j * nr;
-      const double wj = w[j] / static_cast<double>(col[j]);
-      w[j] = wj;
-      for (std::size_t i = j + 1; i < nr; ++i) w[i] -= static_cast<double>(col[i]) * wj;
-    }
+    panel_forward(blk, nc, nr, w);
     std::copy_n(w, nc, y + c0);
     for (std::size_t i = nc; i < nr; ++i) y[rows[i]] += w[i];
   }
@@ -86,10 +79,7 @@ void FloatSupernodalFactor::solve(std::span<const double> rhs, std::span<double>
     const float* blk = x_.data() + px_[k];
     std::copy_n(y + c0, nc, w);
     for (std::size_t i = nc; i < nr; ++i) w[i] = y[rows[i]];
-    for (std::size_t j = nc; j-- > 0;) {
-      const float* col = blk + j * nr;
-      w[j] = (w[j] - dot8(col + j + 1, w + j + 1, nr - j - 1)) / static_cast<double>(col[j]);
-    }
+    panel_backward(blk, nc, nr, w);
     std::copy_n(w, nc, y + c0);
   }
   for (std::size_t k = 0; k < n; ++k) out[static_cast<std::size_t>(perm_[k])] = y[k];

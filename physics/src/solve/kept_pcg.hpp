@@ -52,6 +52,7 @@ PcgOutcome pcg_padded(FineLevel& fine, std::span<const double> b, std::span<doub
 ///   bool valid(); const std::vector<double>& factored_values()
 ///   void factor_values(A, values, who); void forget(); void solve(r, z)
 /// and may offer (SaPreconditioner in sa_pcg.cpp):
+///   void configure(options)         the solver's options, before a set-up
 ///   void set_coordinates(xyz)       the nodes' positions, for the next set-up
 ///   void bind(A, free_dof)          the matrix of the solve about to run
 ///   FineLevel& fine(); void solve4(r4, z4)  that matrix and P⁻¹ on padded vectors: CG runs
@@ -76,6 +77,7 @@ class KeptPcg final : public LinearSolver {
   }
   void restore(const BlockMatrix& A, const SolverState& s) override {
     p_.forget();
+    configure();
     if (!s.factored.empty()) p_.factor_values(A, s.factored, (who_ + " restore").c_str());
     stale_ = s.refresh_due;
     cycle_solves_ = s.cycle_solves;
@@ -91,6 +93,7 @@ class KeptPcg final : public LinearSolver {
     SolveReport rep;
     rep.backend = tag_;
     const double floor = absolute_floor(opt_, free_dof, mass_scale);
+    configure();
     if (p_.sync_pattern(A) || !p_.valid() || stale_) refresh(A, free_dof, rep);
     if constexpr (requires { p_.bind(A, free_dof); }) p_.bind(A, free_dof);  // a preconditioner that also uses A itself
     x0_.assign(x.begin(), x.end());
@@ -120,6 +123,9 @@ class KeptPcg final : public LinearSolver {
   }
 
  private:
+  void configure() {
+    if constexpr (requires { p_.configure(opt_); }) p_.configure(opt_);
+  }
   PcgOutcome run(const BlockMatrix& A, std::span<const double> b, std::span<double> x, std::span<const double> free_dof,
                  double floor) {
     if constexpr (requires { p_.fine(); })

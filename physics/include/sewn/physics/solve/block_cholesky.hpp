@@ -1,6 +1,7 @@
 #pragma once
 // BlockCholesky: a sparse supernodal LLᵀ factorization on BlockMatrix's 3×3 blocks (the direct
-// backend, cholmod.cpp, uses it below block_factor_flops: every matrix measured).
+// backend and cholmod-pcg's kept factor, cholmod.cpp, use it below block_factor_flops: every
+// matrix measured).
 //
 // Why: every entry of the solver layer's matrices belongs to a 3×3 block (a node's axes, or
 // three rod angles), so the symbolic work runs on the block graph, 9× smaller. A first version
@@ -49,6 +50,13 @@ class BlockCholesky {
   void factorize(const BlockMatrix& A, std::span<const double> free_dof, const char* who);
   /// out = K⁻¹ rhs (3n values each; may alias) with the last factor. O(stored entries).
   void solve(std::span<const double> rhs, std::span<double> out);
+  /// After each factorization, also round the panels to float and solve on them (arithmetic
+  /// in double): for a factor kept as a preconditioner, whose solves are memory bound, half the
+  /// bytes (cholmod-pcg; float_factor.hpp has the why). A factor whose values float cannot hold
+  /// keeps the double solves. Off by default. O(1).
+  void set_single_solves(bool on) { single_ = on; }
+  /// True if solve() runs on the float panels. O(1).
+  [[nodiscard]] bool single_solves() const { return !lf_.empty(); }
 
  private:
   void order(const BlockMatrix& A);
@@ -60,6 +68,9 @@ class BlockCholesky {
   void finish_supernode(std::size_t s, const char* who);
   void factor_pivot(const BlockMatrix& A, std::span<const double> free_dof, std::size_t s, const char* who);
   [[noreturn]] void not_positive_definite(std::size_t pivot, const char* who) const;
+  [[nodiscard]] bool round_panels();
+  template <class T>
+  void solve_panels(const T* lx);
   [[nodiscard]] std::size_t width_of(std::size_t s) const { return sn_first_[s + 1] - sn_first_[s]; }
   [[nodiscard]] std::size_t below_of(std::size_t s) const { return sn_rows_[s + 1] - sn_rows_[s]; }
 
@@ -77,6 +88,8 @@ class BlockCholesky {
   std::vector<std::size_t> a_col_, a_dst_;
   std::vector<Index> a_slot_, a_row_;
   AlignedVector<double> lx_;   // the panels
+  AlignedVector<float> lf_;    // lx_ rounded to float (set_single_solves), else empty
+  bool single_ = false;
   AlignedVector<double> w_;    // factor_pivot()'s column: 9 per pivot row, zero between pivots
   AlignedVector<double> tmp_;  // a descendant's update (factorize) or a panel's rows (solve)
   AlignedVector<double> y_;    // the permuted vector of solve()

@@ -15,12 +15,14 @@
 //
 // Backends (which exist in this build: available_backends()):
 //   jacobi       block-Jacobi preconditioned CG, the reference: no set-up, O(iterations · blocks);
-//   cholmod      sparse Cholesky (SuiteSparse CHOLMOD): symbolic analysis once per pattern,
+//   cholmod      sparse Cholesky (BlockCholesky below block_factor_flops, else SuiteSparse
+//                CHOLMOD): symbolic analysis once per pattern,
 //                numeric factorization whenever A's values changed, two triangular solves, and
 //                up to 3 refinement passes (reported as iterations) while the residual misses
 //                the tolerance (ill-conditioned matrices);
-//   cholmod-pcg  CG preconditioned by a CHOLMOD factorization of a recent A, kept across steps
-//                (and Newton iterations) while CG needs few iterations, refreshed when they grow;
+//   cholmod-pcg  CG preconditioned by a factorization of a recent A (BlockCholesky's below
+//                block_factor_flops, else CHOLMOD's; solved in single precision), kept across
+//                steps (and Newton iterations) while CG needs few iterations, refreshed when they grow;
 //   hypre-pcg    the same CG and refresh rule, preconditioned by one V-cycle of hypre's BoomerAMG
 //                (algebraic multigrid) set up on a recent A: set-up and V-cycle cost O(entries);
 //   sa-pcg       the same CG and refresh rule, preconditioned by one V-cycle of our own
@@ -86,6 +88,13 @@ struct SolverOptions {
   /// with a retry, if CG fails with a stale one. A value > 0 also refreshes once a solve needed
   /// more than this many iterations; 0: the cost rule alone.
   int refresh_iterations = 0;
+  /// cholmod, cholmod-pcg: below this many flops of one numeric factorization the factor is
+  /// BlockCholesky's (supernodal on the 3×3 blocks, block_cholesky.hpp), above it CHOLMOD's; 0:
+  /// CHOLMOD's always. The count is the deciding analysis's: cholmod runs CHOLMOD's for it,
+  /// cholmod-pcg BlockCholesky's, which then spares it CHOLMOD's. BlockCholesky measured faster
+  /// on every matrix up to the N = 8 cantilever's 1.5e9 flops (docs/solvers.md); the default
+  /// keeps CHOLMOD only beyond anything measured.
+  double block_factor_flops = 1e10;
 };
 
 /// What one solve cost. Times are wall-clock milliseconds spent inside the solver.
