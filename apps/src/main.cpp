@@ -257,6 +257,7 @@ int cmd_check(const std::vector<std::string>& args) {
   const auto by_dim = read.count_by_dimension();
   std::fprintf(out, "%s: %u points, %u cells (%u volumes, %u surface cells, %u segments)\n", path.c_str(), read.num_points(),
               read.num_cells(), by_dim[3], by_dim[2], by_dim[1]);
+  for (const auto& w : file.warnings) std::fprintf(out, "warning: %s\n", w.c_str());
   // what `sewn run` refuses, refused here with the same reason
   if (read.num_cells() == 0) {
     std::fprintf(stderr, "sewn: bad mesh: %s: the mesh has no cell\n", path.c_str());

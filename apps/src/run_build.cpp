@@ -93,6 +93,7 @@ IndexedMesh generate(const MeshSpec& spec, const std::string& file, const std::s
     transform(m, spec.scale, spec.translate);
   } else if (spec.type == "file") {
     io::MeshFile read = io::read_mesh_file(spec.path);
+    for (const auto& w : read.warnings) std::fprintf(stderr, "sewn: warning: %s\n", w.c_str());
     names.format = io::to_string(read.format);
     names.names = std::move(read.tag_names);
     m = std::move(read.mesh);
