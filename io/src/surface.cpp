@@ -28,9 +28,16 @@ Point3 finite_point(Cursor& c, std::uint64_t index) {
   return p;
 }
 
+// A triangle that uses one vertex twice (an STL facet with two equal corners, a polygon that
+// repeats a vertex) bounds nothing: it is left out, or its edge would count as used 4 times
+// and the surface as not closed.
+void add_triangle(Surface& s, const std::array<std::uint32_t, 3>& t) {
+  if (t[0] != t[1] && t[1] != t[2] && t[2] != t[0]) s.triangles.push_back(t);
+}
+
 // A polygon fanned into triangles from its first vertex.
 void add_polygon(Surface& s, const std::vector<std::uint32_t>& v) {
-  for (std::size_t i = 1; i + 1 < v.size(); ++i) s.triangles.push_back({v[0], v[i], v[i + 1]});
+  for (std::size_t i = 1; i + 1 < v.size(); ++i) add_triangle(s, {v[0], v[i], v[i + 1]});
 }
 
 // The OFF header keyword: [ST][C][N][4][n]OFF (Princeton/Geomview). ST, C and N add texture
@@ -158,7 +165,7 @@ void parse_stl_solid(Cursor& c, StlBuilder& b) {
     }
     c.expect("endloop");
     c.expect("endfacet");
-    b.s.triangles.push_back(t);
+    add_triangle(b.s, t);
   }
   (void)c.rest_of_line();  // the solid's name
 }
@@ -191,7 +198,7 @@ Surface parse_stl_binary(std::string_view bytes, const std::string& source) {
       }
       t[static_cast<std::size_t>(v)] = b.vertex(p);
     }
-    b.s.triangles.push_back(t);
+    add_triangle(b.s, t);
   }
   return b.s;
 }

@@ -241,8 +241,9 @@ TEST_CASE("surface files: OBJ and STL (ASCII, binary) of the same box voxelize t
 
 // OFF variants of other tools (CGAL's data: COFF with vertex colours, NOFF with normals), an
 // ASCII STL of several solids, and a binary STL whose 80-byte comment starts "solid" and says
-// "facet": all the same tetrahedron. Before, COFF and NOFF were refused, every solid after the
-// first dropped without a word, and the binary file misread as ASCII.
+// "facet", and files with zero-area facets (a corner repeated): all the same tetrahedron.
+// Before, COFF and NOFF were refused, every solid after the first dropped without a word, the
+// binary file misread as ASCII, and a repeated corner made the surface "not closed".
 TEST_CASE("surface files: OFF variants, STL of several solids, binary STL that starts with solid") {
   TempDir dir("surface_variants");
   const std::string faces = "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
@@ -272,7 +273,14 @@ TEST_CASE("surface files: OFF variants, STL of several solids, binary STL that s
       }
     binary.append(2, '\0');
   }
+  // facets with a repeated corner (zero area, common in STL exports) bound nothing
+  std::string degenerate_off = off("OFF", "");
+  degenerate_off.replace(degenerate_off.find("4 4 0"), 5, "4 6 0");
+  degenerate_off += "3 0 0 1\n4 2 2 3 3\n";
+  std::string degenerate_stl = multi;
+  degenerate_stl.insert(degenerate_stl.find("endsolid part0"), "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 0 0\nvertex 1 0 0\nendloop\nendfacet\n");
   const std::vector<std::pair<std::string, std::string>> files{
+      {"degenerate.off", degenerate_off}, {"degenerate.stl", degenerate_stl},
       {"plain.off", off("OFF", "")},          {"colour.off", off("COFF", " 255 0 0 255")}, {"normal.off", off("NOFF", " 0 0 1")},
       {"both.off", off("CNOFF", " 1 0 0 0 0 1")}, {"texture.off", off("STOFF", " 0.5 0.5")}, {"solids.stl", multi},
       {"binary.stl", binary}};
