@@ -201,6 +201,10 @@ TEST_CASE("read_mesh: missing, empty, directory, unknown content; dispatch by co
   message_of<ParseError>([&] { read_mesh(dir.write("blank.vtk", "  \n\n")); });
   message_of<UnsupportedError>([&] { read_mesh(dir.write("what.txt", "solid cube\nfacet normal 0 0 1\n")); });
   message_of<UnsupportedError>([&] { read_mesh(dir.write("bin.meshb", "\x01\x00\x00\x00")); });
+  // other tools' files brought as meshes: what to do with them
+  CHECK(message_of<UnsupportedError>([&] { read_mesh(dir.write("part.stl", "solid part\nfacet normal 0 0 1\n")); })
+            .find("a scene's mesh of type \"surface\" voxelizes") != std::string::npos);
+  CHECK(message_of<UnsupportedError>([&] { read_mesh(dir.write("part.1.ele", "4 4 0\n")); }).find("tetgen with -g") != std::string::npos);
   // the content decides, whatever the extension says
   const auto p = dir.write("really_gmsh.vtk", test::read_text(test::data("two_tets.msh")));
   CHECK(read_mesh_file(p).format == MeshFormat::gmsh);
