@@ -72,7 +72,7 @@ int exact_sign(const std::array<double, N>& terms) {
 }
 
 // Sign of the orientation (b - a) x (q - a) of three points of the y-z plane, exact: the
-// rounded value when it is far from 0, else its 32 exact product terms summed exactly.
+// rounded value when it is far from 0, else its 16 exact product terms summed exactly.
 int orientation(const Point3& a, const Point3& b, double qy, double qz) {
   const double ey = b[1] - a[1], ez = b[2] - a[2], dy = qy - a[1], dz = qz - a[2];
   const double left = ey * dz, right = ez * dy, det = left - right;
@@ -81,7 +81,7 @@ int orientation(const Point3& a, const Point3& b, double qy, double qz) {
   if (det < -bound) return -1;
   // each difference exactly as hi + lo, each product of two such as 4 exact products
   const Two y = two_sum(b[1], -a[1]), z = two_sum(b[2], -a[2]), qy2 = two_sum(qy, -a[1]), qz2 = two_sum(qz, -a[2]);
-  std::array<double, 32> t{};
+  std::array<double, 16> t{};
   std::size_t n = 0;
   auto add = [&](double u, double v, double sign) {
     const Two p = two_product(u, v);
