@@ -84,8 +84,9 @@ Loads MESH (Gmsh .msh 2.2 or 4.1, ASCII or binary, MEDIT .mesh, legacy VTK .vtk)
 what `sewn run` would simulate: triangles that are faces of volumes and segments that are edges of
 higher-dimensional cells (tetgen's face list, Gmsh's boundary groups) are labels, listed by tag,
 and the rest is the simulated complex (cells per dimension, components: cells sharing a point).
-On that complex it lists every geometric problem (non-finite coordinates, inverted or degenerate
-cells), builds the combinatorial map
+It lists every geometric problem `sewn run` refuses (non-finite coordinates, inverted, degenerate
+or duplicate cells; cells numbered from 0 in file order, labels included); on the simulated
+complex it builds the combinatorial map
 and prints its validation report, cell counts, components and boundary, then the topology of
 the mesh's cell complex (cells identified by their points; meshes of volumes only or of surface
 cells only): per component its cell counts, χ, Betti numbers over Z/2, orientability and (for
@@ -256,6 +257,7 @@ int cmd_check(const std::vector<std::string>& args) {
   const auto by_dim = read.count_by_dimension();
   std::fprintf(out, "%s: %u points, %u cells (%u volumes, %u surface cells, %u segments)\n", path.c_str(), read.num_points(),
               read.num_cells(), by_dim[3], by_dim[2], by_dim[1]);
+  for (const auto& w : file.warnings) std::fprintf(out, "warning: %s\n", w.c_str());
   // what `sewn run` refuses, refused here with the same reason
   if (read.num_cells() == 0) {
     std::fprintf(stderr, "sewn: bad mesh: %s: the mesh has no cell\n", path.c_str());
@@ -271,12 +273,19 @@ int cmd_check(const std::vector<std::string>& args) {
   print_connections(connections, out);
   const sewn::IndexedMesh mesh = simulated_cells(read, models);
   bool sound = true;
-  const auto issues = sewn::io::find_geometry_issues(mesh, path);
+  // The geometry as `sewn run` checks it (run_build.cpp), so that both name a bad cell alike:
+  // every cell, labels too, numbered as in the file, points no cell uses dropped first.
+  sewn::IndexedMesh used = read;
+  sewn::io::drop_unused_points(used);
+  const auto issues = sewn::io::find_geometry_issues(used, path);
   for (const auto& issue : issues) std::fprintf(out, "  geometry: %s\n", issue.message.c_str());
   if (!issues.empty()) sound = false;
-  // the map builder would only restate a duplicate as a clash of orientations
-  if (std::any_of(issues.begin(), issues.end(), [](const auto& i) { return i.kind == sewn::io::GeometryProblem::duplicate; })) {
-    std::printf("map: not built (duplicate cells)\n");
+  // the map builder would only restate a duplicate or an inverted cell as a clash of
+  // orientations, naming it by its place among the simulated cells
+  if (std::any_of(issues.begin(), issues.end(), [](const auto& i) {
+        return i.kind == sewn::io::GeometryProblem::duplicate || i.kind == sewn::io::GeometryProblem::inverted;
+      })) {
+    std::printf("map: not built (duplicate or inverted cells)\n");
     return bad_input;
   }
   sewn::CMap<3, std::uint32_t> map;

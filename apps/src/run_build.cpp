@@ -93,6 +93,7 @@ IndexedMesh generate(const MeshSpec& spec, const std::string& file, const std::s
     transform(m, spec.scale, spec.translate);
   } else if (spec.type == "file") {
     io::MeshFile read = io::read_mesh_file(spec.path);
+    for (const auto& w : read.warnings) std::fprintf(stderr, "sewn: warning: %s\n", w.c_str());
     names.format = io::to_string(read.format);
     names.names = std::move(read.tag_names);
     m = std::move(read.mesh);
@@ -209,9 +210,19 @@ Assembly assemble(const Scene& scene) {
       throw SceneError(scene.file, path, whole.num_cells() == 0 ? "the mesh has no cell" : "every cell of the mesh is a label: nothing to simulate");
     a.first_cell.push_back(a.mesh.num_cells());
     std::vector<std::uint32_t> mat(piece.num_cells(), material_index(spec.material));
-    for (const auto& [where, name] : spec.regions)
+    for (std::size_t k = 0; k < spec.regions.size(); ++k) {
+      const Selector& where = spec.regions[k].first;
+      bool any = false;
       for (std::uint32_t c = 0; c < piece.num_cells(); ++c)
-        if (selects_cell(where, piece, c)) mat[c] = material_index(name);
+        if (selects_cell(where, piece, c)) mat[c] = material_index(spec.regions[k].second), any = true;
+      // a region that assigns nothing leaves its cells in the mesh's material without a word
+      if (!any)
+        throw SceneError(scene.file, path + ".regions[" + std::to_string(k) + "].where",
+                         std::string("selects no simulated cell of this mesh") +
+                             (where.type == Selector::Type::tag
+                                  ? " (a Gmsh cell carries the tag of the first physical group that holds it: one in two groups is in the first only)"
+                                  : ""));
+    }
     const std::uint32_t first_point = append(a.mesh, piece);
     for (std::uint32_t c = 0; c < labels.num_cells(); ++c) {
       std::vector<std::uint32_t> v(labels.cell(c).begin(), labels.cell(c).end());

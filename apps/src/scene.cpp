@@ -67,7 +67,7 @@ Field build_schema() {
   mesh.doc("One body. Procedural meshes are generated; `file` meshes are read from Gmsh .msh (2.2, 4.1, ASCII or binary), MEDIT .mesh or legacy VTK .vtk files.")
       .select_by("type");
   Field region = field("region", Kind::object);
-  region.doc("A material assignment for the cells whose centroid lies in `where` (later entries win).")
+  region.doc("A material assignment for the cells whose centroid lies in `where` (later entries win); one that selects no simulated cell of its mesh is refused. A Gmsh cell carries the tag of the first physical group that holds it.")
       .members({selector_schema("where", "Cells to assign.").required(),
                 field("material", Kind::string).required().doc("Name of a material in `materials`.")});
   mesh.members({

@@ -168,6 +168,7 @@ class GmshReader {
     if (!have_nodes_) in_.fail_expected("a $Nodes section", "");
     if (!have_elements_) in_.fail_expected("an $Elements section", "");
     if (!v4_) merge_group_repeats();
+    if (have_entities_) warn_unsaved_entities();
     return std::move(out_);
   }
 
@@ -241,6 +242,31 @@ class GmshReader {
       t.name = std::string(rest.substr(a + 1, b - a - 1));
       out_.tag_names.push_back(std::move(t));
     }
+  }
+
+  // Once a physical group is defined, Gmsh saves only the elements of physical groups (unless
+  // Mesh.SaveAll = 1): a volume left out of every Physical Volume vanishes from the file, and a
+  // solid meshed with -3 but given only boundary groups arrives as a few loose surfaces. The
+  // entities of the top dimension that are in no group and have no elements say so.
+  void warn_unsaved_entities() {
+    const bool grouped = std::any_of(entity_phys_.begin(), entity_phys_.end(), [](const auto& e) { return e.second != 0; });
+    int top = -1;
+    for (const auto& e : entity_phys_) top = std::max(top, e.first.first);
+    if (!grouped || top < 1) return;
+    std::vector<std::int64_t> unsaved;
+    for (const auto& e : entity_phys_)
+      if (e.first.first == top && e.second == 0 && !entity_with_elements_.count(e.first)) unsaved.push_back(e.first.second);
+    if (unsaved.empty()) return;
+    static const char* kinds[] = {"", "curve", "surface", "volume"};
+    static const char* groups[] = {"", "Physical Curve", "Physical Surface", "Physical Volume"};
+    const bool one = unsaved.size() == 1;
+    std::string list;
+    for (std::size_t i = 0; i < unsaved.size() && i < 5; ++i) list += (i > 0 ? ", " : "") + std::to_string(unsaved[i]);
+    if (unsaved.size() > 5) list += ", ...";
+    out_.warnings.push_back(in_.source() + ": Gmsh saved only the elements of physical groups, and " + kinds[top] + (one ? " " : "s ") +
+                            list + " of the geometry " + (one ? "belongs to none: its elements, if it was" : "belong to none: their elements, if they were") +
+                            " meshed, are not in the file. Add " + (one ? "it" : "them") + " to a " + groups[top] +
+                            ", or save with Mesh.SaveAll = 1");
   }
 
   // Physical tags per entity, so that 4.1 element blocks can be tagged.
@@ -458,6 +484,7 @@ class GmshReader {
                             std::to_string(dim) + ", which $Entities does not declare");
         phys = it->second;
       }
+      if (m > 0) entity_with_elements_.insert({static_cast<int>(dim), entity});
       if (seen + m > n)
         in_.fail_semantic("element blocks hold more elements than the " + std::to_string(n) +
                           " the $Elements header declares");
@@ -521,7 +548,8 @@ class GmshReader {
   bool have_elements_ = false;
   bool have_entities_ = false;
   std::unordered_map<std::int64_t, std::uint32_t> node_index_;
-  std::map<std::pair<int, std::int64_t>, std::int32_t> entity_phys_;
+  std::map<std::pair<int, std::int64_t>, std::int32_t> entity_phys_;  // 0: in no physical group
+  std::set<std::pair<int, std::int64_t>> entity_with_elements_;
   std::vector<std::pair<int, std::int64_t>> entity_;  // per cell: (dimension, entity tag)
 };
 

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cctype>
+#include <string>
 
 #include "cursor.hpp"
 #include "read_common.hpp"
@@ -40,6 +41,16 @@ std::string first_word(std::string_view bytes) {
   return lower(bytes.substr(p, std::min<std::size_t>(e - p, 64)));
 }
 
+// What to do with the files of other tools that users bring as meshes.
+std::string format_hint(const std::string& ext) {
+  if (ext == ".node" || ext == ".ele" || ext == ".face" || ext == ".smesh" || ext == ".poly")
+    return " (tetgen's own format: run tetgen with -g to write a MEDIT .mesh)";
+  if (ext == ".off" || ext == ".obj" || ext == ".stl" || ext == ".ply")
+    return " (a surface: a scene's mesh of type \"surface\" voxelizes a closed OFF, OBJ or STL surface, or mesh its "
+           "inside with gmsh or tetgen)";
+  return "";
+}
+
 }  // namespace
 
 MeshFile read_mesh_file(const std::filesystem::path& path, const ReadOptions& opt) {
@@ -57,7 +68,7 @@ MeshFile read_mesh_file(const std::filesystem::path& path, const ReadOptions& op
   if (ext == ".meshb") throw UnsupportedError(name, 0, "binary MEDIT (.meshb) files are not supported");
   throw UnsupportedError(name, 0,
                          "not a recognised mesh file: expected a Gmsh .msh, MEDIT .mesh or legacy VTK .vtk file, found '" +
-                             detail::printable(w) + "' at its start");
+                             detail::printable(w) + "' at its start" + format_hint(ext));
 }
 
 IndexedMesh read_mesh(const std::filesystem::path& path, const ReadOptions& opt) {

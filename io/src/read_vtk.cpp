@@ -403,14 +403,41 @@ class VtkReader {
       if (name == "NULL_ARRAY") continue;
       const std::uint64_t comps = in_.count("the number of components of " + name, 1u << 16);
       const std::uint64_t tuples = in_.count("the number of tuples of " + name, std::uint64_t{1} << 40);
-      const DType d = read_dtype(name);
       if (tuples != 0 && comps > (std::uint64_t{1} << 48) / tuples) in_.fail_semantic(name + " is too large");
-      const Values v = read_values(comps * tuples, d, name);
-      if (cell_data && comps == 1 && tuples == cells) consider_tag(name, v);
+      if (const auto t = in_.peek(); t && (lower(*t) == "string" || lower(*t) == "utf8_string")) {
+        (void)in_.token("the data type of " + name);
+        skip_strings(comps * tuples, name);
+      } else {
+        const DType d = read_dtype(name);
+        const Values v = read_values(comps * tuples, d, name);
+        if (cell_data && comps == 1 && tuples == cells) consider_tag(name, v);
+      }
       if (const auto t = in_.peek(); t && lower(*t) == "metadata") {
         (void)in_.token("METADATA");
         skip_metadata();
       }
+    }
+  }
+
+  // A string array (VTK writes them in FIELD data: a file's notes, ParaView's names). ASCII: one
+  // percent-encoded string per line, possibly empty. BINARY: each string's length in 1, 2, 4 or
+  // 8 big-endian bytes whose top two bits say which (11, 10, 01, 00), then its bytes.
+  void skip_strings(std::uint64_t n, const std::string& name) {
+    in_.end_line(name + "'s header");
+    for (std::uint64_t i = 0; i < n; ++i) {
+      if (in_.remaining() == 0) in_.fail_expected_here("string " + std::to_string(i) + " of " + std::to_string(n) + " of " + name);
+      if (!binary_) {
+        (void)in_.rest_of_line();
+        continue;
+      }
+      const auto first = static_cast<unsigned char>(in_.raw(1, "the length of a string of " + name)[0]);
+      const std::size_t bytes = std::size_t{1} << (3 - (first >> 6));  // 11: 1, 10: 2, 01: 4, 00: 8
+      std::uint64_t length = first & 0x3fu;
+      if (bytes > 1)
+        for (const char c : in_.raw(bytes - 1, "the length of a string of " + name)) length = (length << 8) | static_cast<unsigned char>(c);
+      if (length > in_.remaining())
+        in_.fail_semantic("string " + std::to_string(i) + " of " + name + " is " + std::to_string(length) + " bytes long, past the end of the file");
+      (void)in_.raw(static_cast<std::size_t>(length), "a string of " + name);
     }
   }
 

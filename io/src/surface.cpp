@@ -28,20 +28,57 @@ Point3 finite_point(Cursor& c, std::uint64_t index) {
   return p;
 }
 
+// A triangle that uses one vertex twice (an STL facet with two equal corners, a polygon that
+// repeats a vertex) bounds nothing: it is left out, or its edge would count as used 4 times
+// and the surface as not closed.
+void add_triangle(Surface& s, const std::array<std::uint32_t, 3>& t) {
+  if (t[0] != t[1] && t[1] != t[2] && t[2] != t[0]) s.triangles.push_back(t);
+}
+
 // A polygon fanned into triangles from its first vertex.
 void add_polygon(Surface& s, const std::vector<std::uint32_t>& v) {
-  for (std::size_t i = 1; i + 1 < v.size(); ++i) s.triangles.push_back({v[0], v[i], v[i + 1]});
+  for (std::size_t i = 1; i + 1 < v.size(); ++i) add_triangle(s, {v[0], v[i], v[i + 1]});
+}
+
+// The OFF header keyword: [ST][C][N][4][n]OFF (Princeton/Geomview). ST, C and N add texture
+// coordinates, a colour and a normal after each vertex's x y z, which are read past; 4 and n
+// change what a vertex is, and BINARY the encoding: those are refused rather than misread.
+struct OffHeader {
+  bool vertex_extras = false;  // values after x y z on a vertex line
+};
+
+OffHeader off_header(Cursor& c) {
+  const std::string_view head = c.token("the OFF header");
+  if (head.size() < 3 || head.substr(head.size() - 3) != "OFF") c.fail_expected("the header OFF (or COFF, NOFF, STOFF, ...)", head);
+  std::string_view prefix = head.substr(0, head.size() - 3);
+  OffHeader h;
+  for (std::string_view p : {"ST", "C", "N"})
+    if (prefix.substr(0, p.size()) == p) prefix.remove_prefix(p.size()), h.vertex_extras = true;
+  if (prefix == "4" || prefix == "n" || prefix == "4n") {
+    std::string reason(head);  // appended to, not prepended: g++ 12 warns (-Wrestrict) on "'" + string
+    reason += " files (homogeneous or n-dimensional vertices) are not supported; write 3D OFF";
+    c.fail_unsupported(reason);
+  }
+  if (!prefix.empty()) c.fail_expected("the header OFF (or COFF, NOFF, STOFF, ...)", head);
+  if (const auto t = c.peek_on_line(); t && *t == "BINARY") c.fail_unsupported("binary OFF files are not supported; write ASCII OFF");
+  return h;
 }
 
 Surface parse_off(std::string_view text, const std::string& source) {
   Cursor c(text, source, '#');
-  const std::string_view head = c.token("the OFF header");
-  if (head != "OFF") c.fail_expected("the header OFF", head);
+  const OffHeader h = off_header(c);
   const std::uint64_t nv = c.count("the vertex count"), nf = c.count("the face count");
   (void)c.count("the edge count");
   Surface s;
   s.points.reserve(std::min<std::uint64_t>(nv, text.size() / 6));
-  for (std::uint64_t i = 0; i < nv; ++i) s.points.push_back(finite_point(c, i));
+  for (std::uint64_t i = 0; i < nv; ++i) {
+    s.points.push_back(finite_point(c, i));
+    // a vertex is a line: extra values are the header's extras, or a wrong count to report
+    if (h.vertex_extras)
+      (void)c.rest_of_line();
+    else
+      c.end_line("vertex " + std::to_string(i) + "'s x y z (a vertex line of an OFF file holds 3 numbers; COFF, NOFF, STOFF hold more)");
+  }
   std::vector<std::uint32_t> poly;
   for (std::uint64_t f = 0; f < nf; ++f) {
     const std::uint64_t n = c.count("a face's vertex count", 1u << 16);
@@ -55,6 +92,9 @@ Surface parse_off(std::string_view text, const std::string& source) {
     add_polygon(s, poly);
     (void)c.rest_of_line();  // colours may follow
   }
+  // Data past the declared faces means the counts are wrong: reading on would drop faces silently.
+  if (!c.at_end())
+    c.fail_expected("the end of the file after the " + std::to_string(nf) + " faces the header declares", c.token("the end"));
   return s;
 }
 
@@ -106,11 +146,10 @@ struct StlBuilder {
   }
 };
 
-Surface parse_stl_ascii(std::string_view text, const std::string& source) {
-  Cursor c(text, source);
+// One solid ... endsolid block; a file may hold several, one after the other.
+void parse_stl_solid(Cursor& c, StlBuilder& b) {
   c.expect("solid");
   (void)c.rest_of_line();
-  StlBuilder b;
   while (true) {
     const std::string_view key = c.token("facet or endsolid");
     if (key == "endsolid") break;
@@ -126,8 +165,16 @@ Surface parse_stl_ascii(std::string_view text, const std::string& source) {
     }
     c.expect("endloop");
     c.expect("endfacet");
-    b.s.triangles.push_back(t);
+    add_triangle(b.s, t);
   }
+  (void)c.rest_of_line();  // the solid's name
+}
+
+Surface parse_stl_ascii(std::string_view text, const std::string& source) {
+  Cursor c(text, source);
+  StlBuilder b;
+  do parse_stl_solid(c, b);
+  while (!c.at_end());
   return b.s;
 }
 
@@ -151,7 +198,7 @@ Surface parse_stl_binary(std::string_view bytes, const std::string& source) {
       }
       t[static_cast<std::size_t>(v)] = b.vertex(p);
     }
-    b.s.triangles.push_back(t);
+    add_triangle(b.s, t);
   }
   return b.s;
 }
@@ -162,6 +209,23 @@ bool starts_with_word(std::string_view text, std::string_view word) {
   return text.substr(i, word.size()) == word;
 }
 
+// An OFF header of any variant (OFF, COFF, NOFF, STOFF, ...) as the first word.
+bool starts_with_off_header(std::string_view text) {
+  const std::size_t b = std::min(text.size(), text.find_first_not_of(" \t\r\n"));
+  const std::size_t e = std::min(text.size(), text.find_first_of(" \t\r\n", b));
+  const std::string_view w = text.substr(b, e - b);
+  return w.size() >= 3 && w.size() <= 8 && w.substr(w.size() - 3) == "OFF";
+}
+
+// A binary STL is its 84-byte header and 50 bytes per declared triangle, exactly. Many
+// exporters start the 80-byte comment with "solid" too: the size tells them from ASCII.
+bool is_binary_stl(std::string_view bytes) {
+  if (bytes.size() < 84) return false;
+  std::uint32_t n = 0;
+  std::memcpy(&n, bytes.data() + 80, 4);
+  return bytes.size() - 84 == 50 * static_cast<std::uint64_t>(n);
+}
+
 }  // namespace
 
 Surface read_surface(const std::filesystem::path& path) {
@@ -169,9 +233,9 @@ Surface read_surface(const std::filesystem::path& path) {
   const std::string data = detail::slurp(path);
   const std::string ext = lower(path.extension().string());
   Surface s;
-  if (starts_with_word(data, "OFF")) {
+  if (starts_with_off_header(data)) {
     s = parse_off(data, name);
-  } else if (starts_with_word(data, "solid") && data.find("facet") != std::string::npos) {
+  } else if (starts_with_word(data, "solid") && !is_binary_stl(data) && data.find("facet") != std::string::npos) {
     s = parse_stl_ascii(data, name);
   } else if (ext == ".stl") {
     s = parse_stl_binary(data, name);

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <string>
 #include <utility>
@@ -33,19 +34,77 @@ void require_closed(const Surface& s, const std::string& source) {
                                          " triangles (2 needed to voxelize)");
 }
 
+// Exact arithmetic on doubles (Shewchuk 1997, "Adaptive precision floating-point arithmetic"):
+// a + b and a * b as an unevaluated sum hi + lo of two doubles, with no rounding error.
+// std::fma is exact on every platform, so the product's tail does not depend on whether the
+// compiler contracts a * b - c * d (it does with -march=native, differently at each inlined
+// call: the edge signs of two triangles sharing an edge then disagree and a closed surface
+// is crossed an odd number of times, as CGAL's mpi.off was at every resolution).
+struct Two {
+  double hi, lo;
+};
+Two two_sum(double a, double b) {
+  const double x = a + b, bv = x - a, av = x - bv;
+  return {x, (a - av) + (b - bv)};
+}
+Two two_product(double a, double b) {
+  const double x = a * b;
+  return {x, std::fma(a, b, -x)};
+}
+
+// Sign of the sum of the terms, exactly: they are added into a non-overlapping expansion
+// (Grow-Expansion), whose largest non-zero component has the sign of the sum.
+template <std::size_t N>
+int exact_sign(const std::array<double, N>& terms) {
+  std::array<double, N> e{};
+  std::size_t n = 0;
+  for (double q : terms) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const Two s = two_sum(q, e[i]);
+      e[i] = s.lo;
+      q = s.hi;
+    }
+    e[n++] = q;
+  }
+  for (std::size_t i = n; i-- > 0;)
+    if (e[i] != 0) return e[i] > 0 ? 1 : -1;
+  return 0;
+}
+
+// Sign of the orientation (b - a) x (q - a) of three points of the y-z plane, exact: the
+// rounded value when it is far from 0, else its 16 exact product terms summed exactly.
+int orientation(const Point3& a, const Point3& b, double qy, double qz) {
+  const double ey = b[1] - a[1], ez = b[2] - a[2], dy = qy - a[1], dz = qz - a[2];
+  const double left = ey * dz, right = ez * dy, det = left - right;
+  const double bound = 4 * std::numeric_limits<double>::epsilon() * (std::abs(left) + std::abs(right));
+  if (det > bound) return 1;
+  if (det < -bound) return -1;
+  // each difference exactly as hi + lo, each product of two such as 4 exact products
+  const Two y = two_sum(b[1], -a[1]), z = two_sum(b[2], -a[2]), qy2 = two_sum(qy, -a[1]), qz2 = two_sum(qz, -a[2]);
+  std::array<double, 16> t{};
+  std::size_t n = 0;
+  auto add = [&](double u, double v, double sign) {
+    const Two p = two_product(u, v);
+    t[n++] = sign * p.hi;
+    t[n++] = sign * p.lo;
+  };
+  for (double u : {y.hi, y.lo})
+    for (double v : {qz2.hi, qz2.lo}) add(u, v, 1);
+  for (double u : {z.hi, z.lo})
+    for (double v : {qy2.hi, qy2.lo}) add(u, v, -1);
+  return exact_sign(t);
+}
+
 // Sign of the edge function of edge a -> b (points in the y-z plane) at q, q perturbed by
-// (eps, eps^2): +1 or -1, never 0 for a non-degenerate edge. Computed with the edge oriented
-// from its lower vertex index, then flipped, so two triangles sharing an edge see bitwise
-// opposite values and a point on it falls in exactly one of them.
+// (eps, eps^2): +1 or -1, never 0 for a non-degenerate edge. Exact, so two triangles sharing
+// an edge see opposite signs and a point on it falls in exactly one of them.
 int edge_sign(const Surface& s, std::uint32_t ia, std::uint32_t ib, double qy, double qz) {
-  const bool flip = ib < ia;
-  if (flip) std::swap(ia, ib);
   const Point3& a = s.points[ia];
   const Point3& b = s.points[ib];
+  if (const int o = orientation(a, b, qy, qz); o != 0) return o;
+  // on the edge's line: the perturbation decides, w(q + (eps, eps^2)) = ey eps^2 - ez eps
   const double ey = b[1] - a[1], ez = b[2] - a[2];
-  const double w = ey * (qz - a[2]) - ez * (qy - a[1]);
-  int sign = w > 0 ? 1 : w < 0 ? -1 : (ez != 0 ? (ez > 0 ? -1 : 1) : (ey > 0 ? 1 : -1));
-  return flip ? -sign : sign;
+  return ez != 0 ? (ez > 0 ? -1 : 1) : (ey > 0 ? 1 : -1);
 }
 
 }  // namespace
@@ -77,8 +136,8 @@ IndexedMesh voxelize(const Surface& s, std::uint32_t cells, const std::string& s
   };
   for (const auto& t : s.triangles) {
     const Point3 &p0 = s.points[t[0]], &p1 = s.points[t[1]], &p2 = s.points[t[2]];
-    const double area = (p1[1] - p0[1]) * (p2[2] - p0[2]) - (p1[2] - p0[2]) * (p2[1] - p0[1]);
-    if (area == 0) continue;  // parallel to the rays: the perturbed rays never cross it
+    // A triangle parallel to the rays (zero area seen along x) needs no test: its three
+    // exact perturbed edge signs never agree, so the rays never cross it.
     const double ylo = std::min({p0[1], p1[1], p2[1]}), yhi = std::max({p0[1], p1[1], p2[1]});
     const double zlo = std::min({p0[2], p1[2], p2[2]}), zhi = std::max({p0[2], p1[2], p2[2]});
     for (int k = first_row(2, zlo); k <= last_row(2, zhi); ++k)
@@ -89,8 +148,9 @@ IndexedMesh voxelize(const Surface& s, std::uint32_t cells, const std::string& s
         // barycentric weights from the unperturbed edge functions (the crossing's x)
         auto w = [&](const Point3& u, const Point3& v) { return (v[1] - u[1]) * (qz - u[2]) - (v[2] - u[2]) * (qy - u[1]); };
         const double w0 = w(p1, p2), w1 = w(p2, p0), w2 = w(p0, p1), sum = w0 + w1 + w2;
-        hits[static_cast<std::size_t>(j) + static_cast<std::size_t>(n[1]) * static_cast<std::size_t>(k)].push_back(
-            (w0 * p0[0] + w1 * p1[0] + w2 * p2[0]) / sum);
+        // a sliver seen edge-on (rounded weights summing to 0): its vertices' mean x
+        const double x = sum != 0 ? (w0 * p0[0] + w1 * p1[0] + w2 * p2[0]) / sum : (p0[0] + p1[0] + p2[0]) / 3;
+        hits[static_cast<std::size_t>(j) + static_cast<std::size_t>(n[1]) * static_cast<std::size_t>(k)].push_back(x);
       }
   }
 

@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -233,6 +234,27 @@ TEST_CASE("a mass that underflows to zero is refused when the model is built") {
   opt.quiet = true;
   opt.out = scratch_file("x", "").parent_path() / "mass_ok";
   CHECK_NOTHROW(run(parse_scene(j, "light.json"), opt));
+}
+
+TEST_CASE("a material region that selects no cell is refused, not ignored") {
+  // It left every cell in the mesh's material and the run went on: a Gmsh volume in two
+  // physical groups carries the first one's tag only, so a region by the second group's tag
+  // made a soft part as stiff as the rest without a word.
+  json j = minimal();
+  j["materials"]["rubber"] = {{"young", 1e6}, {"density", 1000}};
+  j["meshes"][0]["regions"] = json::array({{{"where", {{"type", "box"}, {"min", {0, 0, 0}}, {"max", {0.3, 1, 1}}}}, {"material", "rubber"}},
+                                           {{"where", {{"type", "tag"}, {"tag", 3}}}, {"material", "rubber"}}});
+  try {
+    (void)assemble(parse_scene(j, "regions.json"));
+    FAIL("accepted a region that selects nothing");
+  } catch (const SceneError& e) {
+    CHECK(e.path() == "meshes[0].regions[1].where");
+    CHECK(e.reason().find("selects no simulated cell of this mesh") == 0);
+    CHECK(e.reason().find("first physical group") != std::string::npos);
+  }
+  j["meshes"][0]["regions"].erase(1);  // the box region selects the first cell: accepted
+  const Assembly a = assemble(parse_scene(j, "regions.json"));
+  CHECK(std::count(a.material_of_cell.begin(), a.material_of_cell.end(), a.material_of_cell[0]) == 1);
 }
 
 }  // namespace test_scene_robustness

@@ -131,7 +131,7 @@ TEST_CASE("past a file size limit the run is exit 1 naming the file, and what it
   CHECK(read(out2 / "pic.pvd").find("frame_00001.vtu") != std::string::npos);
 }
 
-TEST_CASE("sewn check and sewn run agree on duplicate cells and meshes without cells") {
+TEST_CASE("sewn check and sewn run agree on duplicate, inverted, degenerate cells and meshes without cells") {
   struct Case {
     const char* name;
     std::vector<std::string> elements;
@@ -144,6 +144,10 @@ TEST_CASE("sewn check and sewn run agree on duplicate cells and meshes without c
       {"dup_segment", {"1 2 0 0 1 2", "1 2 0 0 2 1"}, "cell 1 (segment) repeats cell 0"},
       {"no_cells", {}, "the mesh has no cell"},
       {"points_only", {"15 2 0 0 1"}, "the mesh has no cell"},
+      // a label (a face of the tetrahedron) first: check numbered the cells it simulates, run
+      // the file's, so that the two named one bad cell differently
+      {"label_then_inverted", {"2 2 0 0 1 2 4", "4 2 0 0 1 4 2 5"}, "cell 1 (tetrahedron) is inverted"},
+      {"label_then_flat", {"2 2 0 0 1 2 5", "4 2 0 0 1 2 5 6"}, "cell 1 (tetrahedron) is degenerate"},
   };
   for (const auto& c : cases) {
     CAPTURE(c.name);

@@ -80,6 +80,28 @@ TEST_CASE("gmsh 4.1: parametric node blocks carry extra coordinates, which are s
   CHECK(f.mesh.types[0] == CellType::triangle);
 }
 
+// A tetrahedron's solid (volume 1) and one face (surface 1), as Gmsh 4.1 saves them once a
+// physical group exists: only the elements of grouped entities. With only the face grouped the
+// solid is silently missing, which the reader says in a warning; grouped, or with no group at
+// all (everything saved), nothing is said.
+TEST_CASE("gmsh 4.1: a volume in no physical group, whose elements Gmsh did not save, is warned about") {
+  auto file = [](const std::string& surface_groups, const std::string& volume_groups, bool with_tet) {
+    return "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 1 1\n"
+           "1 0 0 0 1 1 0 " + surface_groups + " 0\n1 0 0 0 1 1 1 " + volume_groups + " 1 1\n$EndEntities\n"
+           "$Nodes\n2 4 1 4\n2 1 0 3\n1\n2\n3\n0 0 0\n1 0 0\n0 1 0\n3 1 0 1\n4\n0 0 1\n$EndNodes\n" +
+           std::string(with_tet ? "$Elements\n2 2 1 2\n2 1 2 1\n1 1 2 3\n3 1 4 1\n2 1 2 3 4\n$EndElements\n"
+                                : "$Elements\n1 1 1 1\n2 1 2 1\n1 1 2 3\n$EndElements\n");
+  };
+  const MeshFile lost = parse(file("1 5", "0", false));
+  CHECK(lost.mesh.num_cells() == 1);
+  REQUIRE(lost.warnings.size() == 1);
+  CHECK(lost.warnings[0].find("bad.msh: Gmsh saved only the elements of physical groups, and volume 1 of the geometry belongs to none") == 0);
+  CHECK(lost.warnings[0].find("Add it to a Physical Volume, or save with Mesh.SaveAll = 1") != std::string::npos);
+  CHECK(parse(file("1 5", "1 7", true)).warnings.empty());  // both grouped and saved
+  CHECK(parse(file("0", "0", true)).warnings.empty());      // no group: Gmsh saved everything
+  CHECK(parse(file("1 5", "0", true)).warnings.empty());    // SaveAll: the ungrouped volume's tetrahedron is there
+}
+
 TEST_CASE("gmsh bad input: each problem throws its own exception naming file and line") {
   SUBCASE("empty file") {
     const auto m = message_of<ParseError>([] { parse(""); });
@@ -179,6 +201,10 @@ TEST_CASE("read_mesh: missing, empty, directory, unknown content; dispatch by co
   message_of<ParseError>([&] { read_mesh(dir.write("blank.vtk", "  \n\n")); });
   message_of<UnsupportedError>([&] { read_mesh(dir.write("what.txt", "solid cube\nfacet normal 0 0 1\n")); });
   message_of<UnsupportedError>([&] { read_mesh(dir.write("bin.meshb", "\x01\x00\x00\x00")); });
+  // other tools' files brought as meshes: what to do with them
+  CHECK(message_of<UnsupportedError>([&] { read_mesh(dir.write("part.stl", "solid part\nfacet normal 0 0 1\n")); })
+            .find("a scene's mesh of type \"surface\" voxelizes") != std::string::npos);
+  CHECK(message_of<UnsupportedError>([&] { read_mesh(dir.write("part.1.ele", "4 4 0\n")); }).find("tetgen with -g") != std::string::npos);
   // the content decides, whatever the extension says
   const auto p = dir.write("really_gmsh.vtk", test::read_text(test::data("two_tets.msh")));
   CHECK(read_mesh_file(p).format == MeshFormat::gmsh);

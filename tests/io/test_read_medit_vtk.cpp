@@ -142,6 +142,12 @@ TEST_CASE("legacy vtk bad input") {
   message_of<SemanticError>(
       [&] { vtk(h5 + "CELLS 3 4\nOFFSETS vtktypeint64\n0 4 2\nCONNECTIVITY vtktypeint64\n0 1 2 3\n"); });
   message_of<ParseError>([&] { vtk(h5 + "CELLS 2 4\nOFFSETS double\n0 4\n"); });
+  // string arrays cut short: ASCII lines missing, a BINARY length past the end
+  CHECK(message_of<ParseError>([&] { vtk(vtk_head + "FIELD f 1\nnote 1 3 string\na\nb\n"); }).find("string 2 of 3 of note") !=
+        std::string::npos);
+  const std::string bin_head = "# vtk DataFile Version 4.2\ntitle\nBINARY\nDATASET UNSTRUCTURED_GRID\n";
+  CHECK(message_of<SemanticError>([&] { vtk(bin_head + "FIELD f 1\nnote 1 1 string\n\xc9" + "abc\n"); }).find("9 bytes long") !=
+        std::string::npos);
 }
 
 TEST_CASE("legacy vtk binary: truncated data and huge declared counts fail before allocating") {

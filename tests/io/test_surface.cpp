@@ -2,9 +2,12 @@
 // is known in closed form, every format giving the same cells, bad files refused by name.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <map>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -54,6 +57,54 @@ Point3 cell_centre(const IndexedMesh& m, std::uint32_t c) {
   return s;
 }
 
+// A subdivided octahedron (8 * 4^levels triangles) around the origin, oriented outward.
+Surface subdivided_octahedron(int levels) {
+  Surface s = octahedron();
+  for (auto& t : s.triangles)
+    if (s.points[t[0]][0] * s.points[t[1]][1] * s.points[t[2]][2] + s.points[t[0]][1] * s.points[t[1]][2] * s.points[t[2]][0] +
+            s.points[t[0]][2] * s.points[t[1]][0] * s.points[t[2]][1] <
+        0)
+      std::swap(t[1], t[2]);
+  for (int l = 0; l < levels; ++l) {
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> mids;
+    auto mid = [&](std::uint32_t a, std::uint32_t b) {
+      const auto key = std::make_pair(std::min(a, b), std::max(a, b));
+      if (const auto it = mids.find(key); it != mids.end()) return it->second;
+      Point3 m{};
+      for (std::size_t k = 0; k < 3; ++k) m[k] = (s.points[a][k] + s.points[b][k]) / 2;
+      s.points.push_back(m);
+      return mids[key] = static_cast<std::uint32_t>(s.points.size() - 1);
+    };
+    std::vector<std::array<std::uint32_t, 3>> finer;
+    for (const auto& t : s.triangles) {
+      const std::uint32_t a = mid(t[0], t[1]), b = mid(t[1], t[2]), c = mid(t[2], t[0]);
+      finer.insert(finer.end(), {{t[0], a, c}, {t[1], b, a}, {t[2], c, b}, {a, b, c}});
+    }
+    s.triangles = std::move(finer);
+  }
+  return s;
+}
+
+// The winding number of a closed oriented surface around q (van Oosterom and Strackee's solid
+// angle of each triangle): a whole number off the surface (0 outside; odd where a ray from q
+// crosses it an odd number of times), in between only on it.
+double winding_number(const Surface& s, const Point3& q) {
+  double sum = 0;
+  for (const auto& t : s.triangles) {
+    std::array<Point3, 3> v{};
+    std::array<double, 3> len{};
+    for (std::size_t i = 0; i < 3; ++i) {
+      for (std::size_t k = 0; k < 3; ++k) v[i][k] = s.points[t[i]][k] - q[k];
+      len[i] = std::sqrt(v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2]);
+    }
+    auto dot = [&](std::size_t i, std::size_t j) { return v[i][0] * v[j][0] + v[i][1] * v[j][1] + v[i][2] * v[j][2]; };
+    const double det = v[0][0] * (v[1][1] * v[2][2] - v[1][2] * v[2][1]) - v[0][1] * (v[1][0] * v[2][2] - v[1][2] * v[2][0]) +
+                       v[0][2] * (v[1][0] * v[2][1] - v[1][1] * v[2][0]);
+    sum += 2 * std::atan2(det, len[0] * len[1] * len[2] + dot(0, 1) * len[2] + dot(0, 2) * len[1] + dot(1, 2) * len[0]);
+  }
+  return sum / (4 * std::acos(-1.0));
+}
+
 }  // namespace surface_test
 
 using namespace surface_test;
@@ -94,6 +145,65 @@ TEST_CASE("voxelize: the octahedron's cells are exactly those whose centre is in
   }
 }
 
+// Vertices in the plane y = z with equal lower bounds in y and z put the rays of rows j == k in
+// the plane of many faces and on many edges. Edge signs computed in rounded arithmetic, which
+// -march=native contracts into FMAs differently at each call, disagreed between the two
+// triangles of an edge: odd crossings refused a closed surface (CGAL's mpi.off) or, with an
+// even count, rows silently wrong. Exact signs: every row even, the cells those inside.
+TEST_CASE("voxelize: rays in the plane of faces and along edges cross a closed surface an even number of times") {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> radius(0.6, 1.4), shift(-0.003, 0.003);
+  for (int shape = 0; shape < 6; ++shape) {
+    Surface s = subdivided_octahedron(2);
+    std::vector<bool> on_plane;
+    for (Point3& p : s.points) {
+      const double r = 7 * radius(rng);
+      for (double& x : p) x *= r;
+      if (std::abs(p[1] - p[2]) < 2) p[2] = p[1];  // onto the plane y = z
+      p[0] += shift(rng);
+      on_plane.push_back(p[1] == p[2]);
+    }
+    // the same lower bound in y and z: row j of y and row j of z have the same centre
+    double ylo = INFINITY, zlo = INFINITY;
+    for (const Point3& p : s.points) ylo = std::min(ylo, p[1]), zlo = std::min(zlo, p[2]);
+    for (std::size_t i = 0; i < s.points.size(); ++i) s.points[i][2] = on_plane[i] ? s.points[i][1] : s.points[i][2] + (ylo - zlo);
+    for (std::uint32_t cells : {5u, 6u, 7u, 9u}) {
+      CAPTURE(shape);
+      CAPTURE(cells);
+      IndexedMesh m;
+      REQUIRE_NOTHROW(m = voxelize(s, cells, "star"));
+      Point3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+      for (const Point3& p : s.points)
+        for (std::size_t k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+      const double a = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}) / cells;
+      // inside: an odd winding number just off q the way the voxelizer's rays are (y + eps,
+      // z + eps^2: many centres lie on faces, some where two sheets meet and cancel); on the
+      // surface (a winding number not whole): either way
+      auto inside_by_winding = [&](const Point3& q) {
+        const double eps = 1e-6 * a;
+        const double w = winding_number(s, {q[0], q[1] + eps, q[2] + eps * eps}), whole = std::round(w);
+        return std::abs(w - whole) > 0.1 ? -1 : static_cast<int>(std::abs(whole)) % 2;
+      };
+      std::size_t outside_cells = 0, inside_cells = 0;
+      for (std::uint32_t c = 0; c < m.num_cells(); ++c) {
+        const int in = inside_by_winding(cell_centre(m, c));
+        outside_cells += in == 0;
+        inside_cells += in == 1;
+      }
+      CHECK(outside_cells == 0);
+      // every grid centre inside is a cell
+      std::size_t inside = 0;
+      auto centre = [&](std::size_t k, int i) { return lo[k] + (i + 0.5) * a; };
+      for (int i = 0; centre(0, i) < hi[0]; ++i)
+        for (int j = 0; centre(1, j) < hi[1]; ++j)
+          for (int k = 0; centre(2, k) < hi[2]; ++k) {
+            inside += inside_by_winding({centre(0, i), centre(1, j), centre(2, k)}) == 1;
+          }
+      CHECK(inside_cells == inside);
+    }
+  }
+}
+
 TEST_CASE("surface files: OBJ and STL (ASCII, binary) of the same box voxelize the same") {
   TempDir dir("surface_formats");
   std::string obj = "# a box\no box\n";
@@ -129,6 +239,61 @@ TEST_CASE("surface files: OBJ and STL (ASCII, binary) of the same box voxelize t
   }
 }
 
+// OFF variants of other tools (CGAL's data: COFF with vertex colours, NOFF with normals), an
+// ASCII STL of several solids, and a binary STL whose 80-byte comment starts "solid" and says
+// "facet", and files with zero-area facets (a corner repeated): all the same tetrahedron.
+// Before, COFF and NOFF were refused, every solid after the first dropped without a word, the
+// binary file misread as ASCII, and a repeated corner made the surface "not closed".
+TEST_CASE("surface files: OFF variants, STL of several solids, binary STL that starts with solid") {
+  TempDir dir("surface_variants");
+  const std::string faces = "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  const std::vector<std::string> corners{"0 0 0", "1 0 0", "0 1 0", "0 0 1"};
+  auto off = [&](const std::string& header, const std::string& extra) {
+    std::string t = header + "\n4 4 0\n";
+    for (const auto& c : corners) t += c + extra + "\n";
+    return t + faces;
+  };
+  std::string multi;
+  const std::array<std::array<int, 3>, 4> tris{{{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
+  for (std::size_t f = 0; f < tris.size(); ++f) {
+    multi += "solid part" + std::to_string(f) + "\nfacet normal 0 0 0\nouter loop\n";
+    for (int v : tris[f]) multi += "vertex " + corners[static_cast<std::size_t>(v)] + "\n";
+    multi += "endloop\nendfacet\nendsolid part" + std::to_string(f) + "\n";
+  }
+  std::string binary = "solid exported by a CAD tool, facet normals included";
+  binary.resize(80, ' ');
+  const std::uint32_t n = 4;
+  binary.append(reinterpret_cast<const char*>(&n), 4);
+  for (const auto& t : tris) {
+    binary.append(12, '\0');
+    for (int v : t)
+      for (int k = 0; k < 3; ++k) {
+        const float x = k == v - 1 ? 1.0f : 0.0f;  // corner v: the unit vector e_{v-1}, or 0
+        binary.append(reinterpret_cast<const char*>(&x), 4);
+      }
+    binary.append(2, '\0');
+  }
+  // facets with a repeated corner (zero area, common in STL exports) bound nothing
+  std::string degenerate_off = off("OFF", "");
+  degenerate_off.replace(degenerate_off.find("4 4 0"), 5, "4 6 0");
+  degenerate_off += "3 0 0 1\n4 2 2 3 3\n";
+  std::string degenerate_stl = multi;
+  degenerate_stl.insert(degenerate_stl.find("endsolid part0"), "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 0 0\nvertex 1 0 0\nendloop\nendfacet\n");
+  const std::vector<std::pair<std::string, std::string>> files{
+      {"degenerate.off", degenerate_off}, {"degenerate.stl", degenerate_stl},
+      {"plain.off", off("OFF", "")},          {"colour.off", off("COFF", " 255 0 0 255")}, {"normal.off", off("NOFF", " 0 0 1")},
+      {"both.off", off("CNOFF", " 1 0 0 0 0 1")}, {"texture.off", off("STOFF", " 0.5 0.5")}, {"solids.stl", multi},
+      {"binary.stl", binary}};
+  for (const auto& file : files) {
+    const std::string name = file.first;
+    CAPTURE(name);
+    const Surface s = read_surface(dir.write(name, file.second));
+    CHECK(s.points.size() == 4);
+    CHECK(s.triangles.size() == 4);
+    CHECK(voxelize(s, 4, name).num_cells() == 10);  // centres (i + 1/2)/4 with i + j + k <= 2
+  }
+}
+
 TEST_CASE("surface files and voxelization: bad input named") {
   TempDir dir("surface_bad");
   CHECK(message_of<FileError>([&] { (void)read_surface(dir.path() / "none.off"); }).find("no such file") != std::string::npos);
@@ -142,6 +307,15 @@ TEST_CASE("surface files and voxelization: bad input named") {
   CHECK(message_of<SemanticError>([&] { (void)read_surface(dir.write("far.obj", "v 0 0 0\nf 1 2 3\n")); }).find("vertex 2 with 1 vertices") != std::string::npos);
   CHECK(message_of<ParseError>([&] { (void)read_surface(dir.write("short.stl", "abc")); }).find("84-byte") != std::string::npos);
   CHECK(message_of<UnsupportedError>([&] { (void)read_surface(dir.write("x.ply", "ply\n")); }).find("OFF, OBJ or STL") != std::string::npos);
+  // counts that do not match the data: a vertex line with a 4th number, a face past the count
+  CHECK(message_of<ParseError>([&] { (void)read_surface(dir.write("v4.off", "OFF\n3 1 0\n0 0 0 1\n1 0 0\n0 1 0\n3 0 1 2\n")); })
+            .find("v4.off:3: expected the end of the line after vertex 0's x y z") != std::string::npos);
+  CHECK(message_of<ParseError>([&] { (void)read_surface(dir.write("f2.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 1\n")); })
+            .find("f2.off:7: expected the end of the file after the 1 faces the header declares") != std::string::npos);
+  CHECK(message_of<UnsupportedError>([&] { (void)read_surface(dir.write("h.off", "4OFF\n1 1 0\n0 0 0 1\n")); }).find("4OFF files") !=
+        std::string::npos);
+  CHECK(message_of<UnsupportedError>([&] { (void)read_surface(dir.write("b.off", "OFF BINARY\n")); }).find("binary OFF") != std::string::npos);
+  CHECK(message_of<ParseError>([&] { (void)read_surface(dir.write("x.off", "XOFF\n")); }).find("found 'XOFF'") != std::string::npos);
   Surface open = octahedron();
   open.triangles.pop_back();
   CHECK(message_of<SemanticError>([&] { (void)voxelize(open, 8, "open"); }).find("not closed") != std::string::npos);

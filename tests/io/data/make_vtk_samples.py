@@ -37,6 +37,18 @@ temp.SetName("temperature")
 for i in range(len(points)):
     temp.InsertNextValue(0.5 * i)
 grid.GetPointData().SetScalars(temp)
+# string arrays, as ParaView and VTK users attach notes: one with a space (percent-encoded in
+# ASCII), an empty one, and one of 70 bytes (a 2-byte length in BINARY)
+note = vtk.vtkStringArray()
+note.SetName("note")
+for text in ["made by make_vtk_samples.py", "", "x" * 70]:
+    note.InsertNextValue(text)
+grid.GetFieldData().AddArray(note)
+part = vtk.vtkStringArray()
+part.SetName("part")
+for i in range(len(cells)):
+    part.InsertNextValue("cell %d" % i)
+grid.GetCellData().AddArray(part)
 
 for name, version, binary in [("sample42_ascii.vtk", 42, False), ("sample51_ascii.vtk", 51, False),
                               ("sample42_binary.vtk", 42, True), ("sample51_binary.vtk", 51, True)]:

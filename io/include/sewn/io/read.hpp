@@ -52,6 +52,9 @@ struct MeshFile {
   std::vector<TagName> tag_names;      ///< Gmsh $PhysicalNames, in file order
   std::size_t skipped_points = 0;      ///< 0D elements left out (Gmsh type 15, VTK vertex / poly-vertex)
   std::size_t file_elements = 0;       ///< elements the file declared, skipped ones included
+  /// What the file most likely leaves out that its writer meant in (each a full sentence naming
+  /// the file): Gmsh saves only the elements of physical groups once any is defined.
+  std::vector<std::string> warnings;
 };
 
 /// Reads a Gmsh .msh file, version 2.x or 4.1, ASCII or binary (either byte order). Throws IoError subclasses (see errors.hpp).

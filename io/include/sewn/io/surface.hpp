@@ -5,8 +5,9 @@
 //   sewn::io::Surface s = sewn::io::read_surface("bunny00.off");
 //   sewn::IndexedMesh hexes = sewn::io::voxelize(s, 32);   // 32 cells along the longest side
 //
-// Formats: OFF (ASCII), Wavefront OBJ (v and f records; other records ignored) and STL (ASCII
-// or binary, vertices merged when bitwise equal). Polygons are fanned into triangles. Every
+// Formats: OFF (ASCII; COFF, NOFF, STOFF and their combinations too, the per-vertex extras
+// ignored), Wavefront OBJ (v and f records; other records ignored) and STL (ASCII, one solid or
+// several, or binary; vertices merged when bitwise equal). Polygons are fanned into triangles. Every
 // problem throws an IoError subclass naming the file (and line, for text formats).
 
 #include <array>
