@@ -5,6 +5,8 @@
 #include <numeric>
 #include <string>
 
+#include "sewn/io/cleanup.hpp"
+
 namespace sewn::app {
 
 namespace {
@@ -79,13 +81,28 @@ GroupMatch match_groups(const IndexedMesh& mesh, const MeshNames& names, const S
   return out;
 }
 
-std::vector<CellModel> cell_models(const IndexedMesh& mesh, const std::vector<bool>& embedded, const Scene& scene,
-                                   const std::string& path) {
-  return cell_models(mesh, embedded, scene, path, match_groups(mesh, MeshNames{}, scene).of_cell);
+std::string MeshSource::cell(std::uint32_t c) const {
+  return "cell " + std::to_string(c) + (element_tags.empty() ? "" : " (Gmsh element " + std::to_string(element_tags[c]) + ")") +
+         (file.empty() ? "" : " of " + file);
+}
+
+IndexedMesh used_part(const io::MeshFile& file, io::GeometryOptions& numbering) {
+  IndexedMesh m = file.mesh;
+  const std::vector<std::uint32_t> new_index = io::drop_unused_points(m);
+  numbering.point_numbers.assign(m.num_points(), 0);
+  for (std::uint32_t p = 0; p < new_index.size(); ++p)
+    if (new_index[p] != 0xffffffffu) numbering.point_numbers[new_index[p]] = file.point_number(p);
+  numbering.element_tags = file.element_tags;
+  return m;
 }
 
 std::vector<CellModel> cell_models(const IndexedMesh& mesh, const std::vector<bool>& embedded, const Scene& scene,
-                                   const std::string& path, const std::vector<int>& groups) {
+                                   const std::string& path) {
+  return cell_models(mesh, embedded, scene, MeshSource{path, "", {}}, match_groups(mesh, MeshNames{}, scene).of_cell);
+}
+
+std::vector<CellModel> cell_models(const IndexedMesh& mesh, const std::vector<bool>& embedded, const Scene& scene,
+                                   const MeshSource& source, const std::vector<int>& groups) {
   std::vector<CellModel> out(mesh.num_cells());
   for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
     const CellType t = mesh.types[c];
@@ -96,7 +113,7 @@ std::vector<CellModel> cell_models(const IndexedMesh& mesh, const std::vector<bo
                                       : default_model(scene.model, t);
     out[c] = m;
     if (m == CellModel::label || m == CellModel::mass_spring || t == cell_type_of(m)) continue;
-    const std::string where = path + " cell " + std::to_string(c) + " (tag " + std::to_string(mesh.tags[c]) + ") is a " + to_string(t);
+    const std::string where = source.key + " " + source.cell(c) + ", of tag " + std::to_string(mesh.tags[c]) + ", is a " + to_string(t);
     if (by_group)
       throw SceneError(scene.file, "model.groups[" + std::to_string(group) + "].as",
                        "\"" + std::string(to_string(m)) + "\" takes " + plural(cell_type_of(m)) + " only, but " + where);

@@ -274,10 +274,10 @@ int cmd_check(const std::vector<std::string>& args) {
   const sewn::IndexedMesh mesh = simulated_cells(read, models);
   bool sound = true;
   // The geometry as `sewn run` checks it (run_build.cpp), so that both name a bad cell alike:
-  // every cell, labels too, numbered as in the file, points no cell uses dropped first.
-  sewn::IndexedMesh used = read;
-  sewn::io::drop_unused_points(used);
-  const auto issues = sewn::io::find_geometry_issues(used, path);
+  // every cell, labels too, points no cell uses dropped first; cells and points numbered as in the file.
+  sewn::io::GeometryOptions numbering;
+  const sewn::IndexedMesh used = sewn::app::used_part(file, numbering);
+  const auto issues = sewn::io::find_geometry_issues(used, path, numbering);
   for (const auto& issue : issues) std::fprintf(out, "  geometry: %s\n", issue.message.c_str());
   if (!issues.empty()) sound = false;
   // the map builder would only restate a duplicate or an inverted cell as a clash of

@@ -46,10 +46,11 @@ using physics::Index;
 using Vec3d = Eigen::Vector3d;
 
 
-// The mesh of `spec`, and in `names` what its file says of its tags.
-IndexedMesh generate(const MeshSpec& spec, const std::string& file, const std::string& path, MeshNames& names) {
+// The mesh of `spec`, in `names` what its file says of its tags and in `source` how it numbers its cells.
+IndexedMesh generate(const MeshSpec& spec, const std::string& file, const std::string& path, MeshNames& names, MeshSource& source) {
   IndexedMesh m;
   names.path = path;
+  source.key = path;
   if (spec.type == "hex_grid" || spec.type == "tet_grid") {
     GridSpec g;
     for (int k = 0; k < 3; ++k) {
@@ -95,11 +96,13 @@ IndexedMesh generate(const MeshSpec& spec, const std::string& file, const std::s
     io::MeshFile read = io::read_mesh_file(spec.path);
     for (const auto& w : read.warnings) std::fprintf(stderr, "sewn: warning: %s\n", w.c_str());
     names.format = io::to_string(read.format);
-    names.names = std::move(read.tag_names);
-    m = std::move(read.mesh);
-    io::drop_unused_points(m);
+    names.names = read.tag_names;
+    io::GeometryOptions numbering;
+    m = used_part(read, numbering);
+    source.file = spec.path;
+    source.element_tags = numbering.element_tags;
     transform(m, spec.scale, spec.translate);
-    io::check_mesh_geometry(m, spec.path);
+    io::check_mesh_geometry(m, spec.path, numbering);
   }
   return m;
 }
@@ -152,7 +155,9 @@ void split_elongated(const Scene& scene, Assembly& a) {
   std::vector<std::uint32_t> material(split.source_cell.size());
   std::vector<CellModel> model(split.source_cell.size());
   std::vector<int> group(split.source_cell.size());
+  std::vector<std::uint32_t> file_cell(split.source_cell.size());
   for (std::size_t c = 0; c < material.size(); ++c) {
+    file_cell[c] = a.file_cell[split.source_cell[c]];
     material[c] = a.material_of_cell[split.source_cell[c]];
     model[c] = a.model_of_cell[split.source_cell[c]];
     group[c] = a.group_of_cell[split.source_cell[c]];
@@ -164,6 +169,7 @@ void split_elongated(const Scene& scene, Assembly& a) {
   a.material_of_cell = std::move(material);
   a.model_of_cell = std::move(model);
   a.group_of_cell = std::move(group);
+  a.file_cell = std::move(file_cell);
   a.split_asked = split.asked;
   a.split_cells = split.split;
 }
@@ -177,6 +183,15 @@ std::string connections_line(const Assembly& a) {
 
 }  // namespace
 
+std::size_t Assembly::mesh_of_cell(std::uint32_t c) const {
+  return static_cast<std::size_t>(std::upper_bound(first_cell.begin(), first_cell.end(), c) - first_cell.begin()) - 1;
+}
+
+physics::InputError Assembly::in_file(const std::string& scene_file, const physics::CellInputError& e) const {
+  const MeshSource& source = sources[mesh_of_cell(e.cell())];
+  return physics::InputError(scene_file + ": " + source.key + ": " + source.cell(file_cell[e.cell()]) + " " + e.detail());
+}
+
 Assembly assemble(const Scene& scene) {
   Assembly a;
   for (const auto& [name, _] : scene.materials) a.material_names.push_back(name);
@@ -188,9 +203,10 @@ Assembly assemble(const Scene& scene) {
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     const MeshSpec& spec = scene.meshes[i];
     const std::string path = "meshes[" + std::to_string(i) + "]";
-    const IndexedMesh whole = generate(spec, scene.file, path, mesh_names[i]);
+    a.sources.emplace_back();
+    const IndexedMesh whole = generate(spec, scene.file, path, mesh_names[i], a.sources.back());
     const GroupMatch groups = match_groups(whole, mesh_names[i], scene);
-    const std::vector<CellModel> models = cell_models(whole, io::embedded_cells(whole), scene, path, groups.of_cell);
+    const std::vector<CellModel> models = cell_models(whole, io::embedded_cells(whole), scene, a.sources.back(), groups.of_cell);
     for (std::size_t k = 0; k < group_used.size(); ++k) group_used[k] = group_used[k] || groups.named_a_cell[k];
     // the simulated cells and the labels, on the same points
     IndexedMesh piece, labels;
@@ -202,6 +218,7 @@ Assembly assemble(const Scene& scene) {
         labels.add_cell(whole.types[c], whole.cell(c), whole.tags[c]);
       } else {
         piece.add_cell(whole.types[c], whole.cell(c), whole.tags[c]);
+        a.file_cell.push_back(c);
         piece_models.push_back(models[c]);
         piece_groups.push_back(groups.of_cell[c]);
       }
@@ -362,7 +379,11 @@ Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum) {
   if (scene.model == "mixed") sum.connections = connections_line(assembly);
   std::vector<physics::MaterialParams> materials = material_params(scene, assembly);
   apply_rod_sections(scene, assembly.mesh, assembly.model_of_cell, assembly.group_of_cell, materials, assembly.material_of_cell);
-  b.model = std::make_unique<physics::MssModel<3>>(assembly.mesh, materials, assembly.material_of_cell, model_options(scene));
+  try {
+    b.model = std::make_unique<physics::MssModel<3>>(assembly.mesh, materials, assembly.material_of_cell, model_options(scene));
+  } catch (const physics::CellInputError& e) {
+    throw assembly.in_file(scene.file, e);
+  }
   physics::MssModel<3>& model = *b.model;
   add_obstacles(model.system(), scene.obstacles);
   sum.clamped_cells = static_cast<std::uint64_t>(

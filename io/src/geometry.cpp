@@ -91,17 +91,26 @@ std::string fmt(double x) {
   return buf;
 }
 
-std::string describe_points(const IndexedMesh& m, std::span<const std::uint32_t> pts) {
+// Point `p` as the options number it (the file's number when given).
+std::string point_number(const GeometryOptions& opt, std::uint32_t p) {
+  return std::to_string(opt.point_numbers.empty() ? std::int64_t{p} : opt.point_numbers[p]);
+}
+
+std::string describe_points(const IndexedMesh& m, std::span<const std::uint32_t> pts, const GeometryOptions& opt) {
   std::string s = "points";
   for (std::size_t k = 0; k < pts.size(); ++k) {
     const auto& p = m.points[pts[k]];
-    s += (k ? ", " : " ") + std::to_string(pts[k]) + " (" + fmt(p[0]) + ", " + fmt(p[1]) + ", " + fmt(p[2]) + ")";
+    s += (k ? ", " : " ") + point_number(opt, pts[k]) + " (" + fmt(p[0]) + ", " + fmt(p[1]) + ", " + fmt(p[2]) + ")";
   }
   return s;
 }
 
-std::string cell_name(const IndexedMesh& m, std::uint32_t c) {
-  return "cell " + std::to_string(c) + " (" + to_string(m.types[c]) + ")";
+std::string element_tag(const GeometryOptions& opt, std::uint32_t c) {
+  return opt.element_tags.empty() ? "" : "Gmsh element " + std::to_string(opt.element_tags[c]) + ", ";
+}
+
+std::string cell_name(const IndexedMesh& m, std::uint32_t c, const GeometryOptions& opt) {
+  return "cell " + std::to_string(c) + " (" + element_tag(opt, c) + to_string(m.types[c]) + ")";
 }
 
 double bbox_diagonal(const IndexedMesh& m) {
@@ -164,12 +173,12 @@ std::vector<GeometryIssue> find_geometry_issues(const IndexedMesh& mesh, const s
     all_finite = false;
     const std::uint32_t c = first_user[p];
     GeometryIssue is{GeometryProblem::non_finite_point, c, {}, {}};
-    is.message = source + ": point " + std::to_string(p) + " has a non-finite coordinate (" + fmt(x[0]) + ", " +
+    is.message = source + ": point " + point_number(opt, p) + " has a non-finite coordinate (" + fmt(x[0]) + ", " +
                  fmt(x[1]) + ", " + fmt(x[2]) + ")";
     if (c != GeometryError::no_cell) {
       const auto v = mesh.cell(c);
       is.points.assign(v.begin(), v.end());
-      is.message += "; it is used by " + cell_name(mesh, c) + " with " + describe_points(mesh, v);
+      is.message += "; it is used by " + cell_name(mesh, c, opt) + " with " + describe_points(mesh, v, opt);
     } else {
       is.points = {p};
     }
@@ -208,7 +217,7 @@ std::vector<GeometryIssue> find_geometry_issues(const IndexedMesh& mesh, const s
     }
     if (reason.empty()) continue;
     issues.push_back({kind, c, std::vector<std::uint32_t>(v.begin(), v.end()),
-                      source + ": " + cell_name(mesh, c) + " " + reason + "; " + describe_points(mesh, v)});
+                      source + ": " + cell_name(mesh, c, opt) + " " + reason + "; " + describe_points(mesh, v, opt)});
   }
   // A cell given twice (same type, same points in any order) would double its mass and stiffness
   // silently in 2D and 1D, and make the map builder fail in 3D. Sorted keys of fixed size: one
@@ -238,8 +247,9 @@ std::vector<GeometryIssue> find_geometry_issues(const IndexedMesh& mesh, const s
     if (full()) break;
     const auto v = mesh.cell(c);
     issues.push_back({GeometryProblem::duplicate, c, std::vector<std::uint32_t>(v.begin(), v.end()),
-                      source + ": " + cell_name(mesh, c) + " repeats cell " + std::to_string(original) +
-                          " (the same points): a duplicate cell; " + describe_points(mesh, v)});
+                      source + ": " + cell_name(mesh, c, opt) + " repeats cell " + std::to_string(original) +
+                          (opt.element_tags.empty() ? "" : " (Gmsh element " + std::to_string(opt.element_tags[original]) + ")") +
+                          " (the same points): a duplicate cell; " + describe_points(mesh, v, opt)});
   }
   return issues;
 }

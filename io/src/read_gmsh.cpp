@@ -307,6 +307,7 @@ class GmshReader {
       const std::string name = "node " + std::to_string(tag);
       if (!node_index_.emplace(tag, out_.mesh.num_points()).second) in_.fail_semantic(name + " is defined twice");
       out_.mesh.points.push_back(detail::read_point(data_, 3, name));
+      out_.node_tags.push_back(tag);
       data_.end_line(name + "'s coordinates");
     }
     expect_end("$EndNodes", std::to_string(n) + " nodes");
@@ -345,6 +346,7 @@ class GmshReader {
         const std::string name = "node " + std::to_string(tag);
         if (!node_index_.emplace(tag, out_.mesh.num_points()).second) in_.fail_semantic(name + " is defined twice");
         out_.mesh.points.push_back(detail::read_point(data_, 3, name));
+        out_.node_tags.push_back(tag);
         for (std::int64_t k = 0; k < dim * parametric; ++k) (void)data_.real("a parametric coordinate of " + name);
         data_.end_line(name + "'s coordinates");
       }
@@ -381,6 +383,7 @@ class GmshReader {
     }
     out_.mesh.add_cell(gt->type, std::span<const std::uint32_t>(v.data(), static_cast<std::size_t>(gt->nodes)), tag);
     entity_.push_back({dim, entity});
+    out_.element_tags.push_back(id);
   }
 
   void check_type(std::int64_t type, const std::string& name) {
@@ -528,6 +531,7 @@ class GmshReader {
     std::map<std::tuple<int, std::int64_t, CellType, std::vector<std::uint32_t>>, std::uint32_t> first;
     IndexedMesh kept;
     kept.points = std::move(m.points);
+    std::vector<std::int64_t> kept_tags;
     for (std::uint32_t c = 0; c < m.num_cells(); ++c) {
       const auto v = m.cell(c);
       if (repeated.count(entity_[c])) {
@@ -536,8 +540,10 @@ class GmshReader {
         if (!first.emplace(key, c).second) continue;
       }
       kept.add_cell(m.types[c], v, m.tags[c]);
+      kept_tags.push_back(out_.element_tags[c]);
     }
     m = std::move(kept);
+    out_.element_tags = std::move(kept_tags);
   }
 
   Cursor in_;

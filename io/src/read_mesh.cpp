@@ -71,6 +71,17 @@ MeshFile read_mesh_file(const std::filesystem::path& path, const ReadOptions& op
                              detail::printable(w) + "' at its start" + format_hint(ext));
 }
 
+std::int64_t MeshFile::point_number(std::uint32_t p) const {
+  if (!node_tags.empty()) return node_tags[p];
+  return format == MeshFormat::medit ? std::int64_t{p} + 1 : std::int64_t{p};
+}
+
+std::vector<std::int64_t> MeshFile::point_numbers() const {
+  std::vector<std::int64_t> out(mesh.num_points());
+  for (std::uint32_t p = 0; p < mesh.num_points(); ++p) out[p] = point_number(p);
+  return out;
+}
+
 IndexedMesh read_mesh(const std::filesystem::path& path, const ReadOptions& opt) {
   return read_mesh_file(path, opt).mesh;
 }

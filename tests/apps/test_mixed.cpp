@@ -112,7 +112,7 @@ TEST_CASE("cell models: faces and edges of higher cells are labels unless a grou
 
   s.model_groups = {{1, "", "shell", {}}};
   const std::string wrong = reason_of([&] { (void)cell_models(m, embedded, s, "meshes[0]"); });
-  CHECK(wrong.find("model.groups[0].as: \"shell\" takes triangles only, but meshes[0] cell 0 (tag 1) is a tetrahedron") == 0);
+  CHECK(wrong.find("model.groups[0].as: \"shell\" takes triangles only, but meshes[0] cell 0, of tag 1, is a tetrahedron") == 0);
   s.model = "solid";
   s.model_groups = {};
   CHECK(reason_of([&] { (void)cell_models(m, embedded, s, "meshes[0]"); }).find("model.type: \"solid\" needs tetrahedra only") == 0);

@@ -46,15 +46,33 @@ const std::string tiny_scene = R"({"materials": {"m": {"young": 1e6, "density": 
   "meshes": [{"type": "hex_grid", "material": "m", "cells": [1, 1, 1], "size": [0.1, 0.1, 0.1]}],
   "integrator": {"step": 0.001}, "duration": 0.2, "output": {"frames": 200}})";
 
-// A Gmsh 2.2 file of the unit cube's 8 points and the given elements ("type tags... nodes").
-std::string cube_msh(const std::vector<std::string>& elements) {
-  std::string s = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n8\n";
-  const char* nodes[] = {"0 0 0", "1 0 0", "1 1 0", "0 1 0", "0 0 1", "1 0 1", "1 1 1", "0 1 1"};
-  for (int i = 0; i < 8; ++i) s += std::to_string(i + 1) + " " + nodes[i] + "\n";
+// A Gmsh 2.2 file of the given nodes ("tag x y z") and elements ("tag type tags... nodes").
+std::string msh(const std::vector<std::string>& nodes, const std::vector<std::string>& elements) {
+  std::string s = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n" + std::to_string(nodes.size()) + "\n";
+  for (const auto& n : nodes) s += n + "\n";
   s += "$EndNodes\n$Elements\n" + std::to_string(elements.size()) + "\n";
-  for (std::size_t i = 0; i < elements.size(); ++i) s += std::to_string(i + 1) + " " + elements[i] + "\n";
+  for (const auto& e : elements) s += e + "\n";
   return s + "$EndElements\n";
 }
+
+// The unit cube's 8 points (tags 1..8) and the given elements ("type tags... nodes"), tagged 1..n.
+std::string cube_msh(const std::vector<std::string>& elements) {
+  const char* corners[] = {"0 0 0", "1 0 0", "1 1 0", "0 1 0", "0 0 1", "1 0 1", "1 1 1", "0 1 1"};
+  std::vector<std::string> nodes, numbered;
+  for (int i = 0; i < 8; ++i) nodes.push_back(std::to_string(i + 1) + " " + corners[i]);
+  for (std::size_t i = 0; i < elements.size(); ++i) numbered.push_back(std::to_string(i + 1) + " " + elements[i]);
+  return msh(nodes, numbered);
+}
+
+// A scene of `meshes` (JSON objects) with model.type `model` and model.groups `groups` (a JSON list).
+std::string file_scene(const std::string& model, const std::vector<std::string>& meshes, const std::string& groups = "[]") {
+  std::string list;
+  for (const auto& m : meshes) list += (list.empty() ? "" : ", ") + m;
+  return R"({"materials": {"m": {"young": 1e6, "density": 1000}}, "model": {"type": ")" + model + R"(", "groups": )" + groups + R"(},
+      "meshes": [)" + list + R"(], "duration": 0.01})";
+}
+
+std::string file_mesh(const fs::path& p) { return R"({"type": "file", "path": ")" + p.string() + R"(", "material": "m"})"; }
 
 }  // namespace
 
@@ -138,16 +156,16 @@ TEST_CASE("sewn check and sewn run agree on duplicate, inverted, degenerate cell
     const char* reason;
   };
   const Case cases[] = {
-      {"dup_hex", {"5 2 0 0 1 2 3 4 5 6 7 8", "5 2 0 0 2 3 4 1 6 7 8 5"}, "cell 1 (hexahedron) repeats cell 0"},
-      {"dup_tet", {"4 2 0 0 1 2 4 5", "4 2 0 0 1 2 4 5"}, "cell 1 (tetrahedron) repeats cell 0"},
-      {"dup_quad", {"3 2 0 0 1 2 3 4", "3 2 0 0 3 4 1 2"}, "cell 1 (quad) repeats cell 0"},
-      {"dup_segment", {"1 2 0 0 1 2", "1 2 0 0 2 1"}, "cell 1 (segment) repeats cell 0"},
+      {"dup_hex", {"5 2 0 0 1 2 3 4 5 6 7 8", "5 2 0 0 2 3 4 1 6 7 8 5"}, "cell 1 (Gmsh element 2, hexahedron) repeats cell 0 (Gmsh element 1)"},
+      {"dup_tet", {"4 2 0 0 1 2 4 5", "4 2 0 0 1 2 4 5"}, "cell 1 (Gmsh element 2, tetrahedron) repeats cell 0 (Gmsh element 1)"},
+      {"dup_quad", {"3 2 0 0 1 2 3 4", "3 2 0 0 3 4 1 2"}, "cell 1 (Gmsh element 2, quad) repeats cell 0 (Gmsh element 1)"},
+      {"dup_segment", {"1 2 0 0 1 2", "1 2 0 0 2 1"}, "cell 1 (Gmsh element 2, segment) repeats cell 0 (Gmsh element 1)"},
       {"no_cells", {}, "the mesh has no cell"},
       {"points_only", {"15 2 0 0 1"}, "the mesh has no cell"},
       // a label (a face of the tetrahedron) first: check numbered the cells it simulates, run
       // the file's, so that the two named one bad cell differently
-      {"label_then_inverted", {"2 2 0 0 1 2 4", "4 2 0 0 1 4 2 5"}, "cell 1 (tetrahedron) is inverted"},
-      {"label_then_flat", {"2 2 0 0 1 2 5", "4 2 0 0 1 2 5 6"}, "cell 1 (tetrahedron) is degenerate"},
+      {"label_then_inverted", {"2 2 0 0 1 2 4", "4 2 0 0 1 4 2 5"}, "cell 1 (Gmsh element 2, tetrahedron) is inverted"},
+      {"label_then_flat", {"2 2 0 0 1 2 5", "4 2 0 0 1 2 5 6"}, "cell 1 (Gmsh element 2, tetrahedron) is degenerate"},
   };
   for (const auto& c : cases) {
     CAPTURE(c.name);
@@ -162,6 +180,56 @@ TEST_CASE("sewn check and sewn run agree on duplicate, inverted, degenerate cell
     CHECK_MESSAGE(check_err.find(c.reason) != std::string::npos, check_err);
     CHECK_MESSAGE(run_err.find(c.reason) != std::string::npos, run_err);
   }
+}
+
+TEST_CASE("check and run name a bad cell and its points as the file numbers them: sparse node tags, labels first") {
+  // node 100 is used by no cell; a label triangle (element 7) comes before the inverted tetrahedron (element 9)
+  const fs::path mesh = tool_write("sparse.msh", msh({"100 5 5 5", "10 0 0 0", "20 1 0 0", "30 0 1 0", "40 0 0 1"},
+                                                     {"7 2 2 0 0 10 20 30", "9 4 2 0 0 10 30 20 40"}));
+  const fs::path scene = tool_write("sparse.json", file_scene("mass-spring", {file_mesh(mesh)}));
+  std::string check_err, run_err;
+  CHECK(run_sewn("check " + mesh.string(), check_err) == 2);
+  CHECK(run_sewn("run --quiet --out " + tool_scratch("sparse").string() + " " + scene.string(), run_err) == 2);
+  const std::string reason = "cell 1 (Gmsh element 9, tetrahedron) is inverted";
+  const std::string points = "points 10 (0, 0, 0), 30 (0, 1, 0), 20 (1, 0, 0), 40 (0, 0, 1)";
+  for (const std::string* err : {&check_err, &run_err}) {
+    CHECK_MESSAGE(err->find(reason) != std::string::npos, *err);
+    CHECK_MESSAGE(err->find(points) != std::string::npos, *err);
+  }
+}
+
+TEST_CASE("a cell no model takes is named by its scene mesh, its file and its place there, for every model") {
+  // the second mesh: a label triangle (element 11, the prism's bottom face) before a prism
+  // (element 12, tag 5); "rod" is the mixed model with tag 5 as rods
+  const fs::path prism = tool_write("prism.msh", msh({"1 0 0 0", "2 1 0 0", "3 0 1 0", "4 0 0 1", "5 1 0 1", "6 0 1 1"},
+                                                     {"11 2 2 0 0 1 2 3", "12 6 2 5 0 1 2 3 4 5 6"}));
+  // a first mesh the model takes
+  const std::string tets = R"({"type": "tet_grid", "material": "m", "cells": [1, 1, 1], "size": [1, 1, 1], "origin": [5, 0, 0]})";
+  const std::string triangles = R"({"type": "tri_grid", "material": "m", "cells": [1, 1], "size": [1, 1], "origin": [5, 0, 0]})";
+  const std::string segments = R"({"type": "polyline", "material": "m", "points": [[5, 0, 0], [6, 0, 0]]})";
+  const std::string cell = "cell 1 (Gmsh element 12) of " + prism.string();
+  for (const std::string model : {"mass-spring", "solid", "shell", "rod", "mixed"}) {
+    CAPTURE(model);
+    const std::string& first = model == "shell" ? triangles : model == "rod" ? segments : tets;
+    const fs::path scene = tool_write("prism_" + model + ".json", model == "rod" ? file_scene("mixed", {first, file_mesh(prism)}, R"([{"tag": 5, "as": "rod"}])")
+                                                                               : file_scene(model, {first, file_mesh(prism)}));
+    std::string err;
+    CHECK(run_sewn("run --quiet --out " + tool_scratch("prism").string() + " " + scene.string(), err) == 2);
+    CHECK_MESSAGE(err.find("meshes[1]") != std::string::npos, err);
+    CHECK_MESSAGE(err.find(cell) != std::string::npos, err);
+    CHECK_MESSAGE(err.find("prism") != std::string::npos, err);
+  }
+}
+
+TEST_CASE("a cell the mass-spring model refuses is named as its file numbers it, not as the assembled mesh does") {
+  // a 10:1 box (element 5) after a label quad (element 4, its first face), in the second mesh
+  const fs::path box = tool_write("long_box.msh", msh({"1 0 0 0", "2 10 0 0", "3 10 1 0", "4 0 1 0", "5 0 0 1", "6 10 0 1", "7 10 1 1", "8 0 1 1"},
+                                                      {"4 3 2 0 0 1 2 3 4", "5 5 2 0 0 1 2 3 4 5 6 7 8"}));
+  const std::string grid = R"({"type": "hex_grid", "material": "m", "cells": [2, 1, 1], "size": [2, 1, 1], "origin": [0, 5, 0]})";
+  const fs::path scene = tool_write("long_box.json", file_scene("mass-spring", {grid, file_mesh(box)}));
+  std::string err;
+  CHECK(run_sewn("run --quiet --out " + tool_scratch("long_box").string() + " " + scene.string(), err) == 2);
+  CHECK_MESSAGE(err.find("meshes[1]: cell 1 (Gmsh element 5) of " + box.string() + " (hexahedron): too elongated") != std::string::npos, err);
 }
 
 TEST_CASE("the stable-step refusal names the scene keys, not the library option") {

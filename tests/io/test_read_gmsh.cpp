@@ -60,6 +60,26 @@ TEST_CASE("gmsh 2.2: an element repeated for each of its physical groups is read
   const MeshFile f = parse(text);
   REQUIRE(f.mesh.num_cells() == 2);
   CHECK(f.mesh.tags == std::vector<std::int32_t>{3, 7});
+  // the element tags follow the cells kept: a message names the second cell element 2
+  CHECK(f.element_tags == std::vector<std::int64_t>{1, 2});
+}
+
+TEST_CASE("gmsh: each point keeps its node tag and each cell its element tag, for messages") {
+  const std::string text = header22 + "$Nodes\n4\n40 0 0 0\n7 1 0 0\n300 0 1 0\n8 0 0 1\n$EndNodes\n" +
+                           "$Elements\n2\n90 15 2 0 0 7\n12 4 2 0 0 40 300 7 8\n$EndElements\n";
+  const MeshFile f = parse(text);
+  CHECK(f.node_tags == std::vector<std::int64_t>{40, 7, 300, 8});
+  CHECK(f.point_numbers() == std::vector<std::int64_t>{40, 7, 300, 8});
+  CHECK(f.element_tags == std::vector<std::int64_t>{12});  // the point element 90 is skipped
+  // the inverted tetrahedron, named as the file numbers it
+  GeometryOptions numbering;
+  numbering.point_numbers = f.point_numbers();
+  numbering.element_tags = f.element_tags;
+  const std::string msg = message_of<InvertedCellError>([&] { check_mesh_geometry(f.mesh, "t.msh", numbering); });
+  CHECK(msg.find("t.msh: cell 0 (Gmsh element 12, tetrahedron) is inverted") == 0);
+  CHECK(msg.find("points 40 (0, 0, 0), 300 (0, 1, 0), 7 (1, 0, 0), 8 (0, 0, 1)") != std::string::npos);
+  // without numbering: indices, as for an API user's mesh
+  CHECK(message_of<InvertedCellError>([&] { check_mesh_geometry(f.mesh, "t.msh"); }).find("points 0 (0, 0, 0), 2 (0, 1, 0), 1 (1, 0, 0)") != std::string::npos);
 }
 
 TEST_CASE("gmsh: unknown sections are skipped; without physical groups the tag is 0") {

@@ -43,6 +43,14 @@ TEST_CASE("medit: vertices, edges, quadrilaterals and a hexahedron with referenc
   CHECK_NOTHROW(check_mesh_geometry(f.mesh, "cube.mesh"));
 }
 
+TEST_CASE("medit numbers its vertices from 1, legacy VTK its points from 0") {
+  const MeshFile m = medit("MeshVersionFormatted 1\nDimension 2\nVertices 3\n0 0 0\n1 0 0\n0 2 0\nTriangles 1\n1 2 3 4\nEnd\n");
+  CHECK(m.point_numbers() == std::vector<std::int64_t>{1, 2, 3});
+  CHECK(m.element_tags.empty());
+  const MeshFile v = vtk(vtk_head + vtk_points + "CELLS 1 5\n4 0 1 2 3\nCELL_TYPES 1\n10\n");
+  CHECK(v.point_numbers() == std::vector<std::int64_t>{0, 1, 2, 3});
+}
+
 TEST_CASE("medit: 2D files get z = 0") {
   const MeshFile f = medit("MeshVersionFormatted 1\nDimension 2\nVertices 3\n0 0 0\n1 0 0\n0 2 0\nTriangles 1\n1 2 3 4\nEnd\n");
   REQUIRE(f.mesh.num_cells() == 1);

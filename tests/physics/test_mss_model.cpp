@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "helpers.hpp"
+#include "sewn/physics/cell_input_error.hpp"
 #include "sewn/physics/lattice.hpp"
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/stiffness.hpp"
@@ -144,6 +145,15 @@ TEST_CASE("bad input is refused with the element or material named") {
   const IndexedMesh long_boxes = hex_grid(2, 1, 1, {{0.3, 0.1, 0.1}, {}});
   CHECK_THROWS_WITH_AS(MssModel<3>(long_boxes, {paper_material}, {}), doctest::Contains("cell 0 (hexahedron)"), InputError);
   CHECK_THROWS_WITH_AS(MssModel<3>(long_boxes, {paper_material}, {}), doctest::Contains("elongated"), InputError);
+  // the cell and the problem apart, for a caller that names the cell as its file does
+  try {
+    (void)MssModel<3>(long_boxes, {paper_material}, {});
+    FAIL("no error");
+  } catch (const CellInputError& e) {
+    CHECK(e.cell() == 0);
+    CHECK(e.detail().rfind("(hexahedron): too elongated", 0) == 0);
+    CHECK(std::string(e.what()).find(e.detail()) != std::string::npos);
+  }
   MaterialParams clamped = paper_material;
   clamped.elongated = ElongatedPolicy::clamp;
   MssModel<3> m(long_boxes, {clamped}, {});

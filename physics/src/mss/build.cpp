@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 
+#include "sewn/physics/cell_input_error.hpp"
 #include "sewn/physics/stiffness.hpp"
 
 namespace sewn::physics {
@@ -63,7 +64,6 @@ Element MssModel<D>::make_element(const IndexedMesh& mesh, std::uint32_t c, std:
   el.material = material;
   el.mesh_cell = c;
   el.dart = dart;
-  const std::string name = options_.source + ": cell " + std::to_string(c);
   // A rest state must be the right way out: inversion is measured against it (solids/inversion.hpp).
   static const std::string mirrored =
       "is inside out (a mirror image): its vertex order gives a negative volume; list its vertices in VTK "
@@ -142,7 +142,7 @@ Element MssModel<D>::make_element(const IndexedMesh& mesh, std::uint32_t c, std:
                          " has no mass-spring model (hexahedra, tetrahedra, quads, triangles and segments do)");
     }
   } catch (const InputError& e) {
-    throw InputError(name + " (" + to_string(mesh.types[c]) + "): " + e.what());
+    throw CellInputError(options_.source, c, "(" + std::string(to_string(mesh.types[c])) + "): " + e.what());
   }
   return el;
 }
@@ -173,7 +173,7 @@ void MssModel<D>::build_elements(const IndexedMesh& mesh, const BuildResult& bui
   for (std::uint32_t q = 0; q < mesh.num_points(); ++q) {
     if (cell_of_point[q] == mss_detail::no_cell || std::isnormal(point_mass[q])) continue;
     const std::uint32_t c = cell_of_point[q];
-    throw InputError(options_.source + ": cell " + std::to_string(c) + " (" + to_string(mesh.types[c]) + ", material " +
+    throw CellInputError(options_.source, c, "(" + std::string(to_string(mesh.types[c])) + ", material " +
                      std::to_string(elements_[c].material) + "): its point " + std::to_string(q) + " gets a mass of " +
                      mss_detail::sci(point_mass[q]) + " kg (density " + mss_detail::sci(materials_[elements_[c].material].density) +
                      " kg/m³), which " + (std::isinf(point_mass[q]) ? "overflows" : "underflows") +

@@ -18,6 +18,7 @@
 #include "sewn/apps/scene.hpp"
 #include "sewn/cmap/mesh.hpp"
 #include "sewn/connect/detect.hpp"
+#include "sewn/io/geometry.hpp"
 #include "sewn/io/read.hpp"
 
 namespace sewn::app {
@@ -48,15 +49,32 @@ struct GroupMatch {
 /// O(cells · groups + groups · names).
 GroupMatch match_groups(const IndexedMesh& mesh, const MeshNames& names, const Scene& scene);
 
-/// Per cell of `mesh` (one scene mesh, `path` its key path): the model.groups entry `groups`
+/// Where a scene mesh's cells come from, so that a message names a cell as the user's file does:
+/// the mesh's key path ("meshes[1]"), its file ("" if generated), and per cell its Gmsh element
+/// tag (empty for other formats). A cell's index is its place in the file's element order (Gmsh
+/// points and VTK vertices left out, as the reader does).
+struct MeshSource {
+  std::string key;
+  std::string file;
+  std::vector<std::int64_t> element_tags;
+  /// "cell 12 (Gmsh element 40) of b.msh", "cell 3" for a generated mesh (`key` names the mesh).
+  [[nodiscard]] std::string cell(std::uint32_t c) const;
+};
+
+/// The mesh of `file` without the points no cell uses (what `sewn run` simulates and `sewn check`
+/// checks), with in `numbering` the file's numbers of its points and Gmsh tags of its cells, so
+/// that geometry messages name them as the file does. O(mesh).
+IndexedMesh used_part(const io::MeshFile& file, io::GeometryOptions& numbering);
+
+/// Per cell of `mesh` (one scene mesh, `source` naming it): the model.groups entry `groups`
 /// gives (match_groups().of_cell) decides; otherwise a cell in `embedded`
 /// (io::embedded_cells) is a label, and any other cell follows model.type (`mixed`:
 /// tetrahedra solid, 2D cells shell, segments rod). Throws SceneError naming the key
 /// (model.type or model.groups[k].as), the mesh and the first cell of a kind the model cannot
 /// take (solid: tetrahedra; shell: triangles; rod: segments). O(cells).
 std::vector<CellModel> cell_models(const IndexedMesh& mesh, const std::vector<bool>& embedded, const Scene& scene,
-                                   const std::string& path, const std::vector<int>& groups);
-/// The same, for a mesh with no physical names (groups selected by tag only).
+                                   const MeshSource& source, const std::vector<int>& groups);
+/// The same, for a mesh with no physical names (groups selected by tag only), `path` naming it.
 std::vector<CellModel> cell_models(const IndexedMesh& mesh, const std::vector<bool>& embedded, const Scene& scene,
                                    const std::string& path);
 

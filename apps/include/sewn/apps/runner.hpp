@@ -14,6 +14,7 @@
 #include "sewn/apps/cell_models.hpp"
 #include "sewn/apps/scene.hpp"
 #include "sewn/cmap/mesh.hpp"
+#include "sewn/physics/cell_input_error.hpp"
 
 namespace sewn::app {
 
@@ -51,9 +52,17 @@ struct Assembly {
   std::vector<std::uint32_t> material_of_cell;
   std::vector<std::string> material_names;
   std::vector<std::uint32_t> first_cell;  ///< per scene mesh, its first cell in `mesh`
+  std::vector<MeshSource> sources;        ///< per scene mesh, how its file names its cells
+  std::vector<std::uint32_t> file_cell;   ///< per cell of `mesh`, its index in its scene mesh's file (MeshSource)
   std::uint32_t split_asked = 0;  ///< hexahedra too elongated for Baudet's stiffness, split (materials' elongated = "split")
   std::uint32_t split_cells = 0;  ///< source cells cut into near-cubes (those and their sheets' neighbours)
   std::uint32_t source_cells = 0; ///< cells before the split
+
+  /// The scene mesh (index in `sources`) that cell `c` of `mesh` comes from.
+  [[nodiscard]] std::size_t mesh_of_cell(std::uint32_t c) const;
+  /// A CellInputError of a model built on `mesh`, restated (same class of error) at the scene
+  /// mesh that holds the cell, naming it as its file does (MeshSource::cell).
+  [[nodiscard]] physics::InputError in_file(const std::string& scene_file, const physics::CellInputError& e) const;
 };
 
 /// Generates or reads every mesh of the scene, places it, and assigns materials by region.

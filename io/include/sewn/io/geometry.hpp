@@ -65,6 +65,11 @@ struct GeometryOptions {
   double min_relative_length = 1e-12;
   /// find_geometry_issues stops after this many issues.
   std::size_t max_issues = 100;
+  /// How messages number the points: the file's numbers (io::MeshFile::point_numbers after the
+  /// same renumbering as the mesh), or by index in the mesh if empty.
+  std::vector<std::int64_t> point_numbers;
+  /// Each cell's Gmsh element tag (io::MeshFile::element_tags), named after the cell's index; empty: none.
+  std::vector<std::int64_t> element_tags;
 };
 
 enum class GeometryProblem { non_finite_point, inverted, degenerate, duplicate };
@@ -72,7 +77,7 @@ enum class GeometryProblem { non_finite_point, inverted, degenerate, duplicate }
 struct GeometryIssue {
   GeometryProblem kind;
   std::uint32_t cell;  ///< GeometryError::no_cell for an unused non-finite point
-  std::vector<std::uint32_t> points;
+  std::vector<std::uint32_t> points;  ///< indices in the mesh (the message numbers them as GeometryOptions says)
   std::string message;  ///< complete, starting with the source name
 };
 

@@ -52,9 +52,17 @@ struct MeshFile {
   std::vector<TagName> tag_names;      ///< Gmsh $PhysicalNames, in file order
   std::size_t skipped_points = 0;      ///< 0D elements left out (Gmsh type 15, VTK vertex / poly-vertex)
   std::size_t file_elements = 0;       ///< elements the file declared, skipped ones included
+  std::vector<std::int64_t> node_tags;     ///< Gmsh: the node tag of each point of `mesh` (empty for other formats)
+  std::vector<std::int64_t> element_tags;  ///< Gmsh: the element tag of each cell of `mesh` (empty for other formats)
   /// What the file most likely leaves out that its writer meant in (each a full sentence naming
   /// the file): Gmsh saves only the elements of physical groups once any is defined.
   std::vector<std::string> warnings;
+
+  /// How the file numbers point `p` of `mesh`, for messages: its Gmsh node tag, its MEDIT
+  /// vertex number (from 1), its VTK point index (from 0).
+  [[nodiscard]] std::int64_t point_number(std::uint32_t p) const;
+  /// point_number of every point of `mesh`.
+  [[nodiscard]] std::vector<std::int64_t> point_numbers() const;
 };
 
 /// Reads a Gmsh .msh file, version 2.x or 4.1, ASCII or binary (either byte order). Throws IoError subclasses (see errors.hpp).
