@@ -11,7 +11,10 @@ namespace sewn::io {
 
 namespace {
 
-constexpr double max_grid_cells = 268435456.0;  // 2^28, box_union's bound
+// 2^22 grid cells (a cube at 161 cells a side): the mesh of a full grid takes about 70 bytes a
+// hexahedron (a point, 8 corners, type, tag), 300 MB here, and a simulation about 4 kB more
+// each. A flat surface's rows or a cube's cells past this ran into gigabytes, not into an error.
+constexpr double max_grid_cells = 4194304.0;
 
 std::string number(double x) {
   char buf[32];
@@ -117,15 +120,18 @@ IndexedMesh voxelize(const Surface& s, std::uint32_t cells, const std::string& s
     for (std::size_t k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
   const double longest = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
   if (!(longest > 0)) throw SemanticError(source, 0, "the surface has no extent to voxelize");
+  // coordinates from -1e308 to 1e308 overflow the extent; a few subnormal ones make a cube of side 0
+  if (!std::isfinite(longest) || !(longest / cells > 0))
+    throw SemanticError(source, 0, "the surface's extent, " + number(longest) + ", cannot be cut into " + std::to_string(cells) + " cells");
   const double a = longest / cells;
-  std::array<int, 3> n{};
-  double total = 1;
-  for (std::size_t k = 0; k < 3; ++k) {
-    n[k] = std::max(1, static_cast<int>(std::ceil((hi[k] - lo[k]) / a)));
-    total *= n[k];
-  }
+  // counted in double first: cells near 2^32 overflow an int
+  std::array<double, 3> along{};
+  for (std::size_t k = 0; k < 3; ++k) along[k] = std::max(1.0, std::ceil((hi[k] - lo[k]) / a));
+  const double total = along[0] * along[1] * along[2];
   if (total > max_grid_cells)
-    throw SemanticError(source, 0, "voxelizing at " + std::to_string(cells) + " cells makes a grid of " + number(total) + " cells, more than 2^28");
+    throw SemanticError(source, 0, "voxelizing at " + std::to_string(cells) + " cells makes a grid of " + number(total) +
+                                       " cells, more than the 2^22 the voxelizer makes (about 300 MB of mesh)");
+  const std::array<int, 3> n{static_cast<int>(along[0]), static_cast<int>(along[1]), static_cast<int>(along[2])};
 
   // x of every crossing of the ray through each row's cell centres
   std::vector<std::vector<double>> hits(static_cast<std::size_t>(n[1]) * static_cast<std::size_t>(n[2]));

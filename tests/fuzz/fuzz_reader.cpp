@@ -7,21 +7,17 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <string_view>
 
+#include "fuzz_check.hpp"
 #include "sewn/io/read.hpp"
 
 namespace {
 
 const std::string source = "fuzz-input";
 
-[[noreturn]] void finding(const char* what) {
-  std::fprintf(stderr, "fuzz_reader: %s\n", what);
-  std::abort();
-}
+[[noreturn]] void finding(const char* what) { sewn::fuzz::finding("fuzz_reader", what); }
 
 sewn::io::MeshFile parse(std::string_view bytes) {
 #if SEWN_FUZZ_FORMAT == 1
@@ -60,9 +56,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     check_read(parse(bytes).mesh);
   } catch (const sewn::io::IoError& e) {
-    // refused: the message must name the source and give a reason
-    if (e.file() != source || e.reason().empty()) finding("an IoError without its file or reason");
-    if (std::string_view(e.what()).substr(0, source.size()) != source) finding("what() does not start with the file");
+    sewn::fuzz::check_refusal("fuzz_reader", e, source);
   }
   return 0;
 }

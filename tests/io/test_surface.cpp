@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <random>
 #include <string>
@@ -323,7 +324,33 @@ TEST_CASE("surface files and voxelization: bad input named") {
   CHECK(message_of<SemanticError>([&] { (void)voxelize(read_surface(dir.write("slab.off", box_off(1, 1, 0.01))), 1, "slab"); })
             .find("no cell centre lies inside") != std::string::npos);
   CHECK(message_of<SemanticError>([&] { (void)voxelize(octahedron(), 0, "zero"); }).find("at least 1 cell") != std::string::npos);
-  CHECK(message_of<SemanticError>([&] { (void)voxelize(octahedron(), 100000, "huge"); }).find("more than 2^28") != std::string::npos);
+  CHECK(message_of<SemanticError>([&] { (void)voxelize(octahedron(), 100000, "huge"); }).find("more than the 2^22") != std::string::npos);
+}
+
+// A tetrahedron with corners at the origin and at s along each axis.
+Surface corner_tetrahedron(double sx, double sy, double sz) {
+  Surface t;
+  t.points = {{0, 0, 0}, {sx, 0, 0}, {0, sy, 0}, {0, 0, sz}};
+  t.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  return t;
+}
+
+TEST_CASE("voxelize: grids that would take gigabytes and extents that overflow are refused by name") {
+  // A sheet 1e-5 thick across x at 16384 cells: a grid of 1 x 16384 x 16384 = 2^28 cells passed
+  // the old bound and allocated a list of crossings per row, 6 GB before the first triangle.
+  CHECK(message_of<SemanticError>([&] { (void)voxelize(corner_tetrahedron(1e-5, 1, 1), 16384, "sheet"); })
+            .find("sheet: voxelizing at 16384 cells makes a grid of 2.68435e+08 cells, more than the 2^22") != std::string::npos);
+  // cells near 2^32: the cells along x overflowed an int (UB) before the grid was bounded
+  CHECK(message_of<SemanticError>([&] { (void)voxelize(octahedron(), 4000000000u, "max"); }).find("more than the 2^22") != std::string::npos);
+  // from -1e308 to 1e308 the extent is inf (the cells along x were NaN cast to int)
+  Surface wide = corner_tetrahedron(1e308, 1, 1);
+  wide.points[0][0] = -1e308;
+  CHECK(message_of<SemanticError>([&] { (void)voxelize(wide, 4, "wide"); }).find("wide: the surface's extent, inf, cannot be cut into 4 cells") !=
+        std::string::npos);
+  // the smallest subnormal extent halves to a cube of side 0 (its cells along x were inf cast to int)
+  const double tiny = std::numeric_limits<double>::denorm_min();
+  CHECK(message_of<SemanticError>([&] { (void)voxelize(corner_tetrahedron(tiny, tiny, tiny), 2, "tiny"); })
+            .find("tiny: the surface's extent, 4.94066e-324, cannot be cut into 2 cells") != std::string::npos);
 }
 
 }  // namespace test_surface
