@@ -3,7 +3,6 @@
 // fuzz-input.off/.obj/.stl, so content that identifies another format is read as that one, as
 // read_surface does. Contract: every input is read or refused with an IoError naming the
 // source; what was read is a surface the voxelizer may index without checks.
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -34,19 +33,13 @@ void check_read(const sewn::io::Surface& s) {
       if (v >= s.points.size()) finding("a triangle names a point that does not exist");
     if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) finding("a triangle repeats a corner");
   }
-  for (const auto& p : s.points)
-    for (const double x : p)
-      if (!std::isfinite(x)) finding("a point with a non-finite coordinate");
+  sewn::fuzz::check_finite("fuzz_surface", s.points);
 }
 
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);
-  try {
-    check_read(sewn::io::parse_surface(bytes, source));
-  } catch (const sewn::io::IoError& e) {
-    sewn::fuzz::check_refusal("fuzz_surface", e, source);
-  }
+  sewn::fuzz::read_or_refusal("fuzz_surface", source, [&] { return sewn::io::parse_surface(bytes, source); }, check_read);
   return 0;
 }

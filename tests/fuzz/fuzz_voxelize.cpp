@@ -118,18 +118,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::uint32_t cells = 1 + data[1] % 24;
   const std::string_view bytes(reinterpret_cast<const char*>(data + 2), size - 2);
   sewn::io::Surface s;
-  try {
-    s = sewn::io::parse_surface(bytes, source);
-  } catch (const sewn::io::IoError& e) {
-    sewn::fuzz::check_refusal("fuzz_voxelize", e, source);
-    return 0;
-  }
-  try {
-    const sewn::IndexedMesh m = sewn::io::voxelize(s, cells, source);
-    const Grid g = grid_of(s, cells);
-    check_parity(s, g, cubes_of(m, g));
-  } catch (const sewn::io::IoError& e) {
-    sewn::fuzz::check_refusal("fuzz_voxelize", e, source);
-  }
+  sewn::fuzz::read_or_refusal(
+      "fuzz_voxelize", source,
+      [&] {
+        s = sewn::io::parse_surface(bytes, source);
+        return sewn::io::voxelize(s, cells, source);
+      },
+      [&](const sewn::IndexedMesh& m) {
+        const Grid g = grid_of(s, cells);
+        check_parity(s, g, cubes_of(m, g));
+      });
   return 0;
 }
