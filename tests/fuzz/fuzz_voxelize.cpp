@@ -84,27 +84,31 @@ std::set<std::array<long, 3>> cubes_of(const sewn::IndexedMesh& m, const Grid& g
 // by a millionth of a cell along each axis (a q on or next to the surface, where the
 // voxelizer's perturbation decides, gives none), and within 1e-6 of it (an inconsistently
 // oriented surface gives none).
-std::optional<long> clear_winding(const sewn::io::Surface& s, const Point3& q, double a) {
+std::optional<long> clear_winding(const sewn::io::Surface& s, const Point3& q) {
   const double w = winding(s, q), r = std::round(w);
-  if (std::abs(w - r) > 1e-6) return std::nullopt;
+  if (!(std::abs(w - r) <= 1e-6)) return std::nullopt;
   for (std::size_t k = 0; k < 3; ++k)
-    for (const double d : {-1e-6 * a, 1e-6 * a}) {
+    for (const double d : {-1e-6, 1e-6}) {
       Point3 p = q;
       p[k] += d;
-      if (std::abs(winding(s, p) - r) > 1e-6) return std::nullopt;
+      if (!(std::abs(winding(s, p) - r) <= 1e-6)) return std::nullopt;
     }
   return std::lround(r);
 }
 
 // Up to 32 grid cells spread over the grid: in the mesh exactly when the winding number around
 // their centre is odd, where it is clearly an integer.
+// The winding numbers are taken in grid units (corner at 0, cells of side 1), where coordinates
+// of 1e200 do not overflow their products.
 void check_parity(const sewn::io::Surface& s, const Grid& g, const std::set<std::array<long, 3>>& cubes) {
+  sewn::io::Surface unit = s;
+  for (Point3& p : unit.points)
+    for (std::size_t k = 0; k < 3; ++k) p[k] = (p[k] - g.lo[k]) / g.a;
   const long total = g.n[0] * g.n[1] * g.n[2], step = std::max(1L, total / 32);
   for (long c = 0; c < total; c += step) {
     const std::array<long, 3> ijk{c % g.n[0], c / g.n[0] % g.n[1], c / (g.n[0] * g.n[1])};
-    Point3 q{};
-    for (std::size_t k = 0; k < 3; ++k) q[k] = g.lo[k] + (static_cast<double>(ijk[k]) + 0.5) * g.a;
-    const std::optional<long> w = clear_winding(s, q, g.a);
+    const Point3 q{static_cast<double>(ijk[0]) + 0.5, static_cast<double>(ijk[1]) + 0.5, static_cast<double>(ijk[2]) + 0.5};
+    const std::optional<long> w = clear_winding(unit, q);
     if (w && (*w % 2 != 0) != (cubes.count(ijk) == 1)) finding("a cell's membership disagrees with the parity of its winding number");
   }
 }

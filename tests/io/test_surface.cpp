@@ -335,6 +335,19 @@ Surface corner_tetrahedron(double sx, double sy, double sz) {
   return t;
 }
 
+TEST_CASE("voxelize: the cells do not depend on the surface's scale, 1e-200 to 1e200") {
+  // At 1e200 the edge functions' products overflowed to inf and the crossings were NaN, cast to
+  // int (UB; found by fuzz_voxelize under UBSan): the voxelizer now works in grid units.
+  const IndexedMesh unit = voxelize(corner_tetrahedron(1, 1, 1), 6, "unit");
+  for (const double scale : {1e-200, 1e-100, 1e100, 1e200, 1e300}) {
+    CAPTURE(scale);
+    const IndexedMesh m = voxelize(corner_tetrahedron(scale, scale, scale), 6, "scaled");
+    REQUIRE(m.num_cells() == unit.num_cells());
+    for (std::uint32_t c = 0; c < m.num_cells(); ++c)
+      for (std::size_t k = 0; k < 3; ++k) CHECK(cell_centre(m, c)[k] / scale == doctest::Approx(cell_centre(unit, c)[k]));
+  }
+}
+
 TEST_CASE("voxelize: grids that would take gigabytes and extents that overflow are refused by name") {
   // A sheet 1e-5 thick across x at 16384 cells: a grid of 1 x 16384 x 16384 = 2^28 cells passed
   // the old bound and allocated a list of crossings per row, 6 GB before the first triangle.
