@@ -152,11 +152,15 @@ std::vector<std::vector<double>> crossings(const std::vector<Point3>& g, const S
   return hits;
 }
 
-}  // namespace
+// The grid: its corner, its cells' side, how many along each axis. Refuses (naming the source)
+// any grid the voxelizer cannot make exactly or within its memory bound.
+struct Grid {
+  Point3 lo;
+  double a;
+  std::array<int, 3> n;
+};
 
-IndexedMesh voxelize(const Surface& s, std::uint32_t cells, const std::string& source) {
-  if (cells < 1) throw SemanticError(source, 0, "voxelize: at least 1 cell along the longest side is needed");
-  require_closed(s, source);
+Grid grid_for(const Surface& s, std::uint32_t cells, const std::string& source) {
   Point3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
   for (const Point3& p : s.points)
     for (std::size_t k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
@@ -166,6 +170,12 @@ IndexedMesh voxelize(const Surface& s, std::uint32_t cells, const std::string& s
   if (!std::isfinite(longest) || !(longest / cells > 0))
     throw SemanticError(source, 0, "the surface's extent, " + number(longest) + ", cannot be cut into " + std::to_string(cells) + " cells");
   const double a = longest / cells;
+  // Corners lo + i a round together when a is near the rounding unit of the coordinates (a
+  // surface 1e-5 across at 1e10 from the origin gave hexahedra of zero volume, silently).
+  const double far = std::max({std::abs(lo[0]), std::abs(lo[1]), std::abs(lo[2]), std::abs(hi[0]), std::abs(hi[1]), std::abs(hi[2])});
+  if (a < 1e-9 * far)
+    throw SemanticError(source, 0, "cells of side " + number(a) + " are too small for a surface " + number(far) +
+                                       " from the origin (their corners would round together): use fewer cells or move the surface");
   // counted in double first: cells near 2^32 overflow an int
   std::array<double, 3> along{};
   for (std::size_t k = 0; k < 3; ++k) along[k] = std::max(1.0, std::ceil((hi[k] - lo[k]) / a));
@@ -173,8 +183,15 @@ IndexedMesh voxelize(const Surface& s, std::uint32_t cells, const std::string& s
   if (total > max_grid_cells)
     throw SemanticError(source, 0, "voxelizing at " + std::to_string(cells) + " cells makes a grid of " + number(total) +
                                        " cells, more than the 2^22 the voxelizer makes (about 300 MB of mesh)");
-  const std::array<int, 3> n{static_cast<int>(along[0]), static_cast<int>(along[1]), static_cast<int>(along[2])};
+  return {lo, a, {static_cast<int>(along[0]), static_cast<int>(along[1]), static_cast<int>(along[2])}};
+}
 
+}  // namespace
+
+IndexedMesh voxelize(const Surface& s, std::uint32_t cells, const std::string& source) {
+  if (cells < 1) throw SemanticError(source, 0, "voxelize: at least 1 cell along the longest side is needed");
+  require_closed(s, source);
+  const auto [lo, a, n] = grid_for(s, cells, source);
   std::vector<std::vector<double>> hits = crossings(in_grid_units(s, lo, a), s, n);
   std::vector<LatticeBox> boxes;
   for (int k = 0; k < n[2]; ++k)

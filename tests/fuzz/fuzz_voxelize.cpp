@@ -59,7 +59,9 @@ Grid grid_of(const sewn::io::Surface& s, std::uint32_t cells) {
   return g;
 }
 
-// Every cell a hexahedron whose corners are grid points of one cube; returns the cubes' indices.
+// Every cell a hexahedron centred on a grid cube, within 1e-5 of a cell (the voxelizer keeps
+// cells above 1e-9 of the distance from the origin: corners round by 2.2e-7 of a cell at most);
+// returns the cubes' indices.
 std::set<std::array<long, 3>> cubes_of(const sewn::IndexedMesh& m, const Grid& g) {
   std::set<std::array<long, 3>> cubes;
   for (std::size_t c = 0; c < m.types.size(); ++c) {
@@ -73,7 +75,7 @@ std::set<std::array<long, 3>> cubes_of(const sewn::IndexedMesh& m, const Grid& g
     for (std::size_t k = 0; k < 3; ++k) {
       const double u = (centre[k] - g.lo[k]) / g.a - 0.5;
       ijk[k] = std::lround(u);
-      if (std::abs(u - static_cast<double>(ijk[k])) > 1e-6 || ijk[k] < 0 || ijk[k] >= g.n[k]) finding("a cell is not a cube of the grid");
+      if (!(std::abs(u - static_cast<double>(ijk[k])) <= 1e-5) || ijk[k] < 0 || ijk[k] >= g.n[k]) finding("a cell is not a cube of the grid");
     }
     if (!cubes.insert(ijk).second) finding("a grid cube appears twice");
   }

@@ -354,12 +354,24 @@ TEST_CASE("voxelize: grids that would take gigabytes and extents that overflow a
   CHECK(message_of<SemanticError>([&] { (void)voxelize(corner_tetrahedron(1e-5, 1, 1), 16384, "sheet"); })
             .find("sheet: voxelizing at 16384 cells makes a grid of 2.68435e+08 cells, more than the 2^22") != std::string::npos);
   // cells near 2^32: the cells along x overflowed an int (UB) before the grid was bounded
-  CHECK(message_of<SemanticError>([&] { (void)voxelize(octahedron(), 4000000000u, "max"); }).find("more than the 2^22") != std::string::npos);
+  CHECK(message_of<SemanticError>([&] { (void)voxelize(octahedron(), 4000000000u, "max"); }).find("max: cells of side 5e-10 are too small") !=
+        std::string::npos);
+  CHECK(message_of<SemanticError>([&] { (void)voxelize(octahedron(), 1000000000u, "1e9"); }).find("more than the 2^22") != std::string::npos);
   // from -1e308 to 1e308 the extent is inf (the cells along x were NaN cast to int)
   Surface wide = corner_tetrahedron(1e308, 1, 1);
   wide.points[0][0] = -1e308;
   CHECK(message_of<SemanticError>([&] { (void)voxelize(wide, 4, "wide"); }).find("wide: the surface's extent, inf, cannot be cut into 4 cells") !=
         std::string::npos);
+  // 1e-5 across at 1e10 from the origin at 24 cells: corners 1e10 + i 4.2e-7 round together
+  // (the rounding unit there is 1.9e-6), and the hexahedra had zero volume, silently
+  auto moved = [](double by) {
+    Surface t = corner_tetrahedron(1e-5, 1e-5, 1e-5);
+    for (Point3& p : t.points) p = {p[0] + by, p[1] + by, p[2] + by};
+    return t;
+  };
+  CHECK(message_of<SemanticError>([&] { (void)voxelize(moved(1e10), 24, "far"); }).find("too small for a surface 1e+10 from the origin") !=
+        std::string::npos);
+  CHECK(voxelize(moved(1), 24, "near").num_cells() > 0);  // at 1 from the origin a cell is 1.9e9 rounding units
   // the smallest subnormal extent halves to a cube of side 0 (its cells along x were inf cast to int)
   const double tiny = std::numeric_limits<double>::denorm_min();
   CHECK(message_of<SemanticError>([&] { (void)voxelize(corner_tetrahedron(tiny, tiny, tiny), 2, "tiny"); })

@@ -44,7 +44,8 @@ Surface parse_surface(std::string_view data, const std::string& source);
 /// boxes are glued by box_union. `source` names the surface in errors. Throws SemanticError if
 /// the surface is not closed (an edge not shared by exactly 2 triangles, naming it), if no cell
 /// centre lies inside (too few cells), for cells < 1, for a grid of more than 2^22 cells (its
-/// mesh alone could take 300 MB) and for an extent that overflows or cannot be cut into cells.
+/// mesh alone could take 300 MB), for an extent that overflows or cannot be cut into cells, and
+/// for cells smaller than 1e-9 of the surface's distance from the origin (corners would round together).
 /// O(cells² · triangles' extent in rows + cells inside).
 IndexedMesh voxelize(const Surface& s, std::uint32_t cells, const std::string& source);
 
