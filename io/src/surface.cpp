@@ -228,10 +228,10 @@ bool is_binary_stl(std::string_view bytes) {
 
 }  // namespace
 
-Surface read_surface(const std::filesystem::path& path) {
-  const std::string name = path.string();
-  const std::string data = detail::slurp(path);
-  const std::string ext = lower(path.extension().string());
+Surface read_surface(const std::filesystem::path& path) { return parse_surface(detail::slurp(path), path.string()); }
+
+Surface parse_surface(std::string_view data, const std::string& name) {
+  const std::string ext = lower(std::filesystem::path(name).extension().string());
   Surface s;
   if (starts_with_off_header(data)) {
     s = parse_off(data, name);

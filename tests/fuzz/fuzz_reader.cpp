@@ -4,24 +4,19 @@
 // a crash, a sanitizer report, a hang or an allocation past libFuzzer's -malloc_limit_mb is a
 // finding. A result that was read must also be self-consistent, since the tool goes on to
 // build a map from it.
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <string_view>
 
+#include "fuzz_check.hpp"
 #include "sewn/io/read.hpp"
 
 namespace {
 
 const std::string source = "fuzz-input";
 
-[[noreturn]] void finding(const char* what) {
-  std::fprintf(stderr, "fuzz_reader: %s\n", what);
-  std::abort();
-}
+[[noreturn]] void finding(const char* what) { sewn::fuzz::finding("fuzz_reader", what); }
 
 sewn::io::MeshFile parse(std::string_view bytes) {
 #if SEWN_FUZZ_FORMAT == 1
@@ -48,21 +43,14 @@ void check_read(const sewn::IndexedMesh& m) {
       finding("a cell's vertex count does not match its type");
   for (const auto v : m.conn)
     if (v >= m.points.size()) finding("a cell names a point that does not exist");
-  for (const auto& p : m.points)
-    for (const double x : p)
-      if (!std::isfinite(x)) finding("a point with a non-finite coordinate");
+  sewn::fuzz::check_finite("fuzz_reader", m.points);
 }
 
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);
-  try {
-    check_read(parse(bytes).mesh);
-  } catch (const sewn::io::IoError& e) {
-    // refused: the message must name the source and give a reason
-    if (e.file() != source || e.reason().empty()) finding("an IoError without its file or reason");
-    if (std::string_view(e.what()).substr(0, source.size()) != source) finding("what() does not start with the file");
-  }
+  sewn::fuzz::read_or_refusal(
+      "fuzz_reader", source, [&] { return parse(bytes); }, [](const sewn::io::MeshFile& f) { check_read(f.mesh); });
   return 0;
 }

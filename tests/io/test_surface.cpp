@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <random>
 #include <string>
@@ -323,7 +324,58 @@ TEST_CASE("surface files and voxelization: bad input named") {
   CHECK(message_of<SemanticError>([&] { (void)voxelize(read_surface(dir.write("slab.off", box_off(1, 1, 0.01))), 1, "slab"); })
             .find("no cell centre lies inside") != std::string::npos);
   CHECK(message_of<SemanticError>([&] { (void)voxelize(octahedron(), 0, "zero"); }).find("at least 1 cell") != std::string::npos);
-  CHECK(message_of<SemanticError>([&] { (void)voxelize(octahedron(), 100000, "huge"); }).find("more than 2^28") != std::string::npos);
+  CHECK(message_of<SemanticError>([&] { (void)voxelize(octahedron(), 100000, "huge"); }).find("more than the 2^22") != std::string::npos);
+}
+
+// A tetrahedron with corners at the origin and at s along each axis.
+Surface corner_tetrahedron(double sx, double sy, double sz) {
+  Surface t;
+  t.points = {{0, 0, 0}, {sx, 0, 0}, {0, sy, 0}, {0, 0, sz}};
+  t.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  return t;
+}
+
+TEST_CASE("voxelize: the cells do not depend on the surface's scale, 1e-200 to 1e200") {
+  // At 1e200 the edge functions' products overflowed to inf and the crossings were NaN, cast to
+  // int (UB; found by fuzz_voxelize under UBSan): the voxelizer now works in grid units.
+  const IndexedMesh unit = voxelize(corner_tetrahedron(1, 1, 1), 6, "unit");
+  for (const double scale : {1e-200, 1e-100, 1e100, 1e200, 1e300}) {
+    CAPTURE(scale);
+    const IndexedMesh m = voxelize(corner_tetrahedron(scale, scale, scale), 6, "scaled");
+    REQUIRE(m.num_cells() == unit.num_cells());
+    for (std::uint32_t c = 0; c < m.num_cells(); ++c)
+      for (std::size_t k = 0; k < 3; ++k) CHECK(cell_centre(m, c)[k] / scale == doctest::Approx(cell_centre(unit, c)[k]));
+  }
+}
+
+TEST_CASE("voxelize: grids that would take gigabytes and extents that overflow are refused by name") {
+  // A sheet 1e-5 thick across x at 16384 cells: a grid of 1 x 16384 x 16384 = 2^28 cells passed
+  // the old bound and allocated a list of crossings per row, 6 GB before the first triangle.
+  CHECK(message_of<SemanticError>([&] { (void)voxelize(corner_tetrahedron(1e-5, 1, 1), 16384, "sheet"); })
+            .find("sheet: voxelizing at 16384 cells makes a grid of 2.68435e+08 cells, more than the 2^22") != std::string::npos);
+  // cells near 2^32: the cells along x overflowed an int (UB) before the grid was bounded
+  CHECK(message_of<SemanticError>([&] { (void)voxelize(octahedron(), 4000000000u, "max"); }).find("max: cells of side 5e-10 are too small") !=
+        std::string::npos);
+  CHECK(message_of<SemanticError>([&] { (void)voxelize(octahedron(), 1000000000u, "1e9"); }).find("more than the 2^22") != std::string::npos);
+  // from -1e308 to 1e308 the extent is inf (the cells along x were NaN cast to int)
+  Surface wide = corner_tetrahedron(1e308, 1, 1);
+  wide.points[0][0] = -1e308;
+  CHECK(message_of<SemanticError>([&] { (void)voxelize(wide, 4, "wide"); }).find("wide: the surface's extent, inf, cannot be cut into 4 cells") !=
+        std::string::npos);
+  // 1e-5 across at 1e10 from the origin at 24 cells: corners 1e10 + i 4.2e-7 round together
+  // (the rounding unit there is 1.9e-6), and the hexahedra had zero volume, silently
+  auto moved = [](double by) {
+    Surface t = corner_tetrahedron(1e-5, 1e-5, 1e-5);
+    for (Point3& p : t.points) p = {p[0] + by, p[1] + by, p[2] + by};
+    return t;
+  };
+  CHECK(message_of<SemanticError>([&] { (void)voxelize(moved(1e10), 24, "far"); }).find("too small for a surface 1e+10 from the origin") !=
+        std::string::npos);
+  CHECK(voxelize(moved(1), 24, "near").num_cells() > 0);  // at 1 from the origin a cell is 1.9e9 rounding units
+  // the smallest subnormal extent halves to a cube of side 0 (its cells along x were inf cast to int)
+  const double tiny = std::numeric_limits<double>::denorm_min();
+  CHECK(message_of<SemanticError>([&] { (void)voxelize(corner_tetrahedron(tiny, tiny, tiny), 2, "tiny"); })
+            .find("tiny: the surface's extent, 4.94066e-324, cannot be cut into 2 cells") != std::string::npos);
 }
 
 }  // namespace test_surface

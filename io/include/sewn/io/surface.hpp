@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "sewn/cmap/mesh.hpp"
@@ -32,6 +33,9 @@ struct Surface {
 /// file, a bad token, an index out of range, a non-finite coordinate, a face of fewer than 3
 /// vertices, no triangle.
 Surface read_surface(const std::filesystem::path& path);
+/// The same on bytes already read: `source` names them in errors and its extension is the
+/// fallback when the content does not tell the format.
+Surface parse_surface(std::string_view data, const std::string& source);
 
 /// The hexahedra of a regular grid whose centres lie inside a closed surface: `cells` cells
 /// along the longest side of its bounding box (cubes of side longest/cells), inside decided by
@@ -39,7 +43,9 @@ Surface read_surface(const std::filesystem::path& path);
 /// vertex are assigned by a symbolic perturbation). Cells of a row form one lattice box; the
 /// boxes are glued by box_union. `source` names the surface in errors. Throws SemanticError if
 /// the surface is not closed (an edge not shared by exactly 2 triangles, naming it), if no cell
-/// centre lies inside (too few cells), and for cells < 1 or more than 2^28 grid cells.
+/// centre lies inside (too few cells), for cells < 1, for a grid of more than 2^22 cells (its
+/// mesh alone could take 300 MB), for an extent that overflows or cannot be cut into cells, and
+/// for cells smaller than 1e-9 of the surface's distance from the origin (corners would round together).
 /// O(cells² · triangles' extent in rows + cells inside).
 IndexedMesh voxelize(const Surface& s, std::uint32_t cells, const std::string& source);
 
