@@ -310,8 +310,8 @@ void warn_elongation_policies(const RunSummary& sum, const Assembly& assembly) {
                  "sewn: warning: %u cells are too elongated for Baudet's stiffness and were split into near-cubes "
                  "(materials' elongated = \"split\"); %u cells were cut in all, those included with the cells sharing "
                  "their split edges: %u cells and %u points now, from %u cells. Stiffnesses are Baudet's own, unaltered: on a 1 m cantilever the static tip is "
-                 "the cube-meshed beam's at 10:1 and 5:1 boxes and 3.1 %% softer at 2.5:1 (issue 17). Mesh cell numbers below "
-                 "are those of the split mesh\n",
+                 "the cube-meshed beam's at 10:1 and 5:1 boxes and 3.1 %% softer at 2.5:1 (issue 17). Messages of the run "
+                 "number the split mesh's cells\n",
                  assembly.split_asked, assembly.split_cells, assembly.mesh.num_cells(), assembly.mesh.num_points(),
                  assembly.source_cells);
 }
