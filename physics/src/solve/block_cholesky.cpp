@@ -510,21 +510,20 @@ namespace {
 typedef double Lanes4 __attribute__((vector_size(32)));
 template <class T>
 struct PanelLanes;
+// (unaligned, and read through the panel's own pointers: aligned(sizeof(T)), may_alias)
 template <>
 struct PanelLanes<float> {
-  typedef float type __attribute__((vector_size(16)));
+  typedef float type __attribute__((vector_size(16), aligned(4), may_alias));
 };
 template <>
 struct PanelLanes<double> {
-  typedef double type __attribute__((vector_size(32)));
+  typedef double type __attribute__((vector_size(32), aligned(8), may_alias));
 };
 
 // Column c of a column-major 3×3 block, and in lane 3 the value that follows it (not used).
 template <class T>
 inline void load_column(const T* block, std::size_t c, Lanes4& to) {
-  typename PanelLanes<T>::type v;
-  std::memcpy(&v, block + 3 * c, sizeof v);
-  to = __builtin_convertvector(v, Lanes4);
+  to = __builtin_convertvector(*reinterpret_cast<const typename PanelLanes<T>::type*>(block + 3 * c), Lanes4);
 }
 
 inline void load_node(const double* at, Lanes4& to) { std::memcpy(&to, at, sizeof to); }
