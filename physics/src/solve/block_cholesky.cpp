@@ -5,6 +5,11 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <type_traits>
+
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
 
 #include <Eigen/Cholesky>
 #include <Eigen/OrderingMethods>
@@ -523,6 +528,12 @@ struct PanelLanes<double> {
 // Column c of a column-major 3×3 block, and in lane 3 the value that follows it (not used).
 template <class T>
 inline void load_column(const T* block, std::size_t c, Lanes4& to) {
+#if defined(__AVX__)
+  if constexpr (std::is_same_v<T, float>) {  // GCC 12 splits the generic conversion in halves
+    to = _mm256_cvtps_pd(_mm_loadu_ps(block + 3 * c));
+    return;
+  }
+#endif
   to = __builtin_convertvector(*reinterpret_cast<const typename PanelLanes<T>::type*>(block + 3 * c), Lanes4);
 }
 

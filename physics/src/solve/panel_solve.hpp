@@ -11,6 +11,11 @@
 #pragma once
 
 #include <cstddef>
+#include <type_traits>
+
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
 
 #include "../dot8.hpp"
 
@@ -34,6 +39,12 @@ struct Row8<double> {
 
 template <class T>
 inline void load8(const T* at, D8& to) {
+#if defined(__AVX512F__)
+  if constexpr (std::is_same_v<T, float>) {  // GCC 12 splits the generic conversion in halves
+    to = _mm512_maskz_cvtps_pd(0xFF, _mm256_loadu_ps(at));  // (maskz: GCC 12 warns on _mm512_cvtps_pd)
+    return;
+  }
+#endif
   to = __builtin_convertvector(*reinterpret_cast<const typename Row8<T>::type*>(at), D8);
 }
 
