@@ -5,11 +5,6 @@
 #include <cstring>
 #include <limits>
 #include <string>
-#include <type_traits>
-
-#if defined(__AVX__)
-#include <immintrin.h>
-#endif
 
 #include <Eigen/Cholesky>
 #include <Eigen/OrderingMethods>
@@ -508,33 +503,14 @@ void BlockCholesky::solve(std::span<const double> rhs, std::span<double> out) {
 
 namespace {
 
-// Four lanes of double, and of a panel's T: a node's entries of y_ (3 and a scratch lane), a
-// block's column and the value after it. Vector extensions of GCC and Clang: a 3×3 block times a
-// node's entries is 3 multiply-adds of 4 lanes whatever the target (with AVX one instruction
-// each), where scalar code spent 9 converts and 9 multiply-adds.
-typedef double Lanes4 __attribute__((vector_size(32)));
-template <class T>
-struct PanelLanes;
-// (unaligned, and read through the panel's own pointers: aligned(sizeof(T)), may_alias)
-template <>
-struct PanelLanes<float> {
-  typedef float type __attribute__((vector_size(16), aligned(4), may_alias));
-};
-template <>
-struct PanelLanes<double> {
-  typedef double type __attribute__((vector_size(32), aligned(8), may_alias));
-};
+using Lanes4 = solve::detail::panel_lanes::D4;  // a node's entries of y_ (3 and a scratch lane)
 
-// Column c of a column-major 3×3 block, and in lane 3 the value that follows it (not used).
+// Column c of a column-major 3×3 block, and in lane 3 the value that follows it (not used). A
+// block times a node's entries is then 3 multiply-adds of 4 lanes (one instruction each with
+// AVX), where scalar code spent 9 converts and 9 multiply-adds.
 template <class T>
 inline void load_column(const T* block, std::size_t c, Lanes4& to) {
-#if defined(__AVX__)
-  if constexpr (std::is_same_v<T, float>) {  // GCC 12 splits the generic conversion in halves
-    to = _mm256_cvtps_pd(_mm_loadu_ps(block + 3 * c));
-    return;
-  }
-#endif
-  to = __builtin_convertvector(*reinterpret_cast<const typename PanelLanes<T>::type*>(block + 3 * c), Lanes4);
+  solve::detail::panel_lanes::load(block + 3 * c, to);
 }
 
 inline void load_node(const double* at, Lanes4& to) { std::memcpy(&to, at, sizeof to); }

@@ -13,7 +13,7 @@
 #include <cstddef>
 #include <type_traits>
 
-#if defined(__AVX512F__)
+#if defined(__AVX__)
 #include <immintrin.h>
 #endif
 
@@ -23,29 +23,33 @@ namespace sewn::physics::solve::detail {
 
 namespace panel_lanes {
 
-// Eight lanes of double, and eight values of a panel column read unaligned through its own
+// Four and eight lanes of double, and N values of a panel read unaligned through its own
 // pointer type (may_alias); GCC and Clang lower them to what the target has.
+typedef double D4 __attribute__((vector_size(32)));
 typedef double D8 __attribute__((vector_size(64)));
-template <class T>
-struct Row8;
-template <>
-struct Row8<float> {
-  typedef float type __attribute__((vector_size(32), aligned(4), may_alias));
-};
-template <>
-struct Row8<double> {
-  typedef double type __attribute__((vector_size(64), aligned(8), may_alias));
+template <class T, std::size_t N>
+struct Unaligned {
+  typedef T type __attribute__((vector_size(N * sizeof(T)), aligned(sizeof(T)), may_alias));
 };
 
-template <class T>
-inline void load8(const T* at, D8& to) {
+/// `to` = the sizeof(D) / 8 values from `at` (float or double), widened to double.
+template <class D, class T>
+inline void load(const T* at, D& to) {
+  constexpr std::size_t n = sizeof(D) / sizeof(double);
+  // GCC 12 lowers the generic float conversion in halves (two loads, an insert)
 #if defined(__AVX512F__)
-  if constexpr (std::is_same_v<T, float>) {  // GCC 12 splits the generic conversion in halves
+  if constexpr (std::is_same_v<T, float> && n == 8) {
     to = _mm512_maskz_cvtps_pd(0xFF, _mm256_loadu_ps(at));  // (maskz: GCC 12 warns on _mm512_cvtps_pd)
     return;
   }
 #endif
-  to = __builtin_convertvector(*reinterpret_cast<const typename Row8<T>::type*>(at), D8);
+#if defined(__AVX__)
+  if constexpr (std::is_same_v<T, float> && n == 4) {
+    to = _mm256_cvtps_pd(_mm_loadu_ps(at));
+    return;
+  }
+#endif
+  to = __builtin_convertvector(*reinterpret_cast<const typename Unaligned<T, n>::type*>(at), D);
 }
 
 // (a[0] + a[1]) + ... in dot8's fixed order: the result does not depend on the target's width.
@@ -99,7 +103,7 @@ inline void panel_backward(const T* panel, std::size_t nc, std::size_t nr, doubl
       D8 wi, l;
       __builtin_memcpy(&wi, w + i, sizeof wi);
       for (std::size_t a = 0; a < 4; ++a) {
-        panel_lanes::load8(c[a] + i, l);
+        panel_lanes::load(c[a] + i, l);
         part[a] += l * wi;
       }
     }
