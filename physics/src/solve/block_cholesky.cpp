@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -287,9 +288,9 @@ void BlockCholesky::partition(const std::vector<Index>& parent, const std::vecto
     // an update of s's rows on a later supernode's pivots: at most all of them by the widest
     work = std::max(work, 9 * below * below);
   }
-  lx_.assign(sn_val_.back(), 0.0);
+  lx_.assign(sn_val_.back() + 1, 0.0);
   tmp_.assign(std::max(work, 3 * std::size_t{nb}), 0.0);
-  y_.assign(3 * std::size_t{nb}, 0.0);
+  y_.assign(4 * std::size_t{nb}, 0.0);
   // the updates each supernode receives: (d, position in rows_ of d's first row in it), d
   // ascending; d reaches t when one of its rows is among t's pivots
   const auto reaches = [this](std::size_t d, std::size_t q) { return q == sn_rows_[d] || sn_of_[rows_[q]] != sn_of_[rows_[q - 1]]; };
@@ -490,55 +491,111 @@ void BlockCholesky::solve(std::span<const double> rhs, std::span<double> out) {
   if (rhs.size() != 3 * nb || out.size() != 3 * nb)
     throw InputError("block cholesky solve: vectors of " + std::to_string(rhs.size()) + " and " + std::to_string(out.size()) +
                      " values for a factor of " + std::to_string(3 * nb) + " unknowns");
-  for (std::size_t j = 0; j < nb; ++j)
-    for (std::size_t a = 0; a < 3; ++a) y_[3 * j + a] = rhs[3 * std::size_t{perm_[j]} + a];
+  for (std::size_t j = 0; j < nb; ++j) {
+    for (std::size_t a = 0; a < 3; ++a) y_[4 * j + a] = rhs[3 * std::size_t{perm_[j]} + a];
+    y_[4 * j + 3] = 0.0;  // the scratch lane: what it gathers stays bounded
+  }
   if (lf_.empty()) solve_panels(lx_.data());
   else solve_panels(lf_.data());
   for (std::size_t j = 0; j < nb; ++j)
-    for (std::size_t a = 0; a < 3; ++a) out[3 * std::size_t{perm_[j]} + a] = y_[3 * j + a];
+    for (std::size_t a = 0; a < 3; ++a) out[3 * std::size_t{perm_[j]} + a] = y_[4 * j + a];
 }
 
-// L Lᵀ y_ = y_ on the panels lx (lx_ or its float copy). A one-pivot supernode: fixed-size 3×3
-// blocks, L(j, j)⁻¹ multiplied; a wider one: its rows gathered into tmp_, the panel's
+namespace {
+
+using Lanes4 = solve::detail::panel_lanes::D4;  // a node's entries of y_ (3 and a scratch lane)
+
+// Column c of a column-major 3×3 block, and in lane 3 the value that follows it (not used). A
+// block times a node's entries is then 3 multiply-adds of 4 lanes (one instruction each with
+// AVX), where scalar code spent 9 converts and 9 multiply-adds.
+template <class T>
+inline void load_column(const T* block, std::size_t c, Lanes4& to) {
+  solve::detail::panel_lanes::load(block + 3 * c, to);
+}
+
+inline void load_node(const double* at, Lanes4& to) { std::memcpy(&to, at, sizeof to); }
+inline void store_node(const Lanes4& v, double* at) { std::memcpy(at, &v, sizeof v); }
+
+// to -= B v, lanes 0-2 (lane 3 takes what the columns' lane 3 give: scratch).
+template <class T>
+inline void subtract_product(const T* block, const Lanes4& v, Lanes4& to) {
+  Lanes4 c0, c1, c2;
+  load_column(block, 0, c0);
+  load_column(block, 1, c1);
+  load_column(block, 2, c2);
+  to -= c0 * v[0] + c1 * v[1] + c2 * v[2];
+}
+
+// parts[c] += B's column c ⊙ v lane-wise: (Bᵀ v)[c] is the sum of parts[c]'s lanes 0-2.
+template <class T>
+inline void add_transposed(const T* block, const Lanes4& v, Lanes4 (&parts)[3]) {
+  Lanes4 c;
+  for (std::size_t k = 0; k < 3; ++k) {
+    load_column(block, k, c);
+    parts[k] += c * v;
+  }
+}
+
+inline double sum3(const Lanes4& v) { return (v[0] + v[1]) + v[2]; }
+
+}  // namespace
+
+// L Lᵀ y_ = y_ on the panels lx (lx_ or its float copy). A one-pivot supernode: its 3×3 blocks
+// on 4 lanes, L(j, j)⁻¹ multiplied; a wider one: its rows gathered into tmp_, the panel's
 // triangle and rows below in one pass (panel_solve.hpp), scattered back.
 template <class T>
 void BlockCholesky::solve_panels(const T* lx) {
-  using Block33 = Eigen::Map<const Eigen::Matrix<T, 3, 3>>;
-  const auto block = [lx](std::size_t at) { return Block33(lx + at).template cast<double>(); };
   const std::size_t ns = supernodes();
   double* y = y_.data();
   double* w = tmp_.data();
   for (std::size_t s = 0; s < ns; ++s) {  // L y = P b
     const std::size_t n = 3 * width_of(s), nr = n + 3 * below_of(s), r0 = sn_rows_[s];
-    double* ys = y + 3 * std::size_t{sn_first_[s]};
+    const T* panel = lx + sn_val_[s];
+    double* ys = y + 4 * std::size_t{sn_first_[s]};
     if (n == 3) {
-      Vec3 yj(ys);
-      yj = block(sn_val_[s]) * Eigen::Vector3d(yj);  // L(j, j)⁻¹ yj (its upper triangle zero)
-      for (std::size_t q = r0; q < sn_rows_[s + 1]; ++q) Vec3(y + 3 * std::size_t{rows_[q]}).noalias() -= block(sn_val_[s] + 9 * (q - r0 + 1)) * yj;
+      Lanes4 yj, minus = {0, 0, 0, 0};
+      load_node(ys, yj);
+      subtract_product(panel, yj, minus);  // -L(j, j)⁻¹ yj (its upper triangle zero)
+      yj = -minus;
+      store_node(yj, ys);
+      for (std::size_t q = r0; q < sn_rows_[s + 1]; ++q) {
+        double* yr = y + 4 * std::size_t{rows_[q]};
+        Lanes4 v;
+        load_node(yr, v);
+        subtract_product(panel + 9 * (1 + q - r0), yj, v);
+        store_node(v, yr);
+      }
       continue;
     }
-    std::copy_n(ys, n, w);
+    for (std::size_t k = 0; k < n / 3; ++k) std::copy_n(ys + 4 * k, 3, w + 3 * k);
     std::fill(w + n, w + nr, 0.0);
-    solve::detail::panel_forward(lx + sn_val_[s], n, nr, w);
-    std::copy_n(w, n, ys);
+    solve::detail::panel_forward(panel, n, nr, w);
+    for (std::size_t k = 0; k < n / 3; ++k) std::copy_n(w + 3 * k, 3, ys + 4 * k);
     for (std::size_t q = r0; q < sn_rows_[s + 1]; ++q)
-      for (std::size_t a = 0; a < 3; ++a) y[3 * std::size_t{rows_[q]} + a] += w[n + 3 * (q - r0) + a];
+      for (std::size_t a = 0; a < 3; ++a) y[4 * std::size_t{rows_[q]} + a] += w[n + 3 * (q - r0) + a];
   }
   for (std::size_t s = ns; s-- > 0;) {  // Lᵀ z = y
     const std::size_t n = 3 * width_of(s), nr = n + 3 * below_of(s), r0 = sn_rows_[s];
-    double* ys = y + 3 * std::size_t{sn_first_[s]};
+    const T* panel = lx + sn_val_[s];
+    double* ys = y + 4 * std::size_t{sn_first_[s]};
     if (n == 3) {
-      Vec3 yj(ys);
-      for (std::size_t q = r0; q < sn_rows_[s + 1]; ++q)
-        yj.noalias() -= block(sn_val_[s] + 9 * (q - r0 + 1)).transpose() * Vec3(y + 3 * std::size_t{rows_[q]});
-      yj = block(sn_val_[s]).transpose() * Eigen::Vector3d(yj);
+      Lanes4 parts[3] = {};
+      for (std::size_t q = r0; q < sn_rows_[s + 1]; ++q) {
+        Lanes4 v;
+        load_node(y + 4 * std::size_t{rows_[q]}, v);
+        add_transposed(panel + 9 * (1 + q - r0), v, parts);
+      }
+      const Lanes4 t = {ys[0] - sum3(parts[0]), ys[1] - sum3(parts[1]), ys[2] - sum3(parts[2]), 0.0};  // yj - L(below)ᵀ y(below)
+      Lanes4 yj[3] = {};
+      add_transposed(panel, t, yj);  // L(j, j)⁻ᵀ t
+      for (std::size_t k = 0; k < 3; ++k) ys[k] = sum3(yj[k]);
       continue;
     }
-    std::copy_n(ys, n, w);
+    for (std::size_t k = 0; k < n / 3; ++k) std::copy_n(ys + 4 * k, 3, w + 3 * k);
     for (std::size_t q = r0; q < sn_rows_[s + 1]; ++q)
-      for (std::size_t a = 0; a < 3; ++a) w[n + 3 * (q - r0) + a] = y[3 * std::size_t{rows_[q]} + a];
-    solve::detail::panel_backward(lx + sn_val_[s], n, nr, w);
-    std::copy_n(w, n, ys);
+      for (std::size_t a = 0; a < 3; ++a) w[n + 3 * (q - r0) + a] = y[4 * std::size_t{rows_[q]} + a];
+    solve::detail::panel_backward(panel, n, nr, w);
+    for (std::size_t k = 0; k < n / 3; ++k) std::copy_n(w + 3 * k, 3, ys + 4 * k);
   }
 }
 

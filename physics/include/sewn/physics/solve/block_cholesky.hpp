@@ -40,7 +40,7 @@ class BlockCholesky {
   [[nodiscard]] double factor_entries() const { return entries_; }
   /// Scalars stored in the supernodal panels: factor_entries() plus the unused upper
   /// triangles of their diagonal blocks.
-  [[nodiscard]] double stored_entries() const { return static_cast<double>(lx_.size()); }
+  [[nodiscard]] double stored_entries() const { return sn_val_.empty() ? 0.0 : static_cast<double>(sn_val_.back()); }
   /// Supernodes of the analysis (sets of consecutive pivots sharing one dense panel).
   [[nodiscard]] std::size_t supernodes() const { return sn_first_.empty() ? 0 : sn_first_.size() - 1; }
 
@@ -87,12 +87,14 @@ class BlockCholesky {
   // (in a one-pivot supernode unused: factor_pivot() scatters by pivot row)
   std::vector<std::size_t> a_col_, a_dst_;
   std::vector<Index> a_slot_, a_row_;
-  AlignedVector<double> lx_;   // the panels
+  // The panels, and one value past them: the solves read a one-pivot block's columns 4 values
+  // at a time, the last one reaching one past the block.
+  AlignedVector<double> lx_;
   AlignedVector<float> lf_;    // lx_ rounded to float (set_single_solves), else empty
   bool single_ = false;
   AlignedVector<double> w_;    // factor_pivot()'s column: 9 per pivot row, zero between pivots
   AlignedVector<double> tmp_;  // a descendant's update (factorize) or a panel's rows (solve)
-  AlignedVector<double> y_;    // the permuted vector of solve()
+  AlignedVector<double> y_;    // the permuted vector of solve(): 4 per pivot (the 4th a scratch lane)
   // Left-looking: supernode s is updated by the supernodes upd_from_[u] for u in
   // upd_start_[s] .. upd_start_[s+1), from their rows at rows_[upd_row_[u]] on (upd_rows_[u]
   // of them); from a one-pivot supernode, upd_block_[u] is the first of those blocks in lx_
