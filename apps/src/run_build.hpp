@@ -34,6 +34,11 @@ struct Bodies {
 /// physics::InputError for bad input, each naming the key or file. O(mesh).
 [[nodiscard]] Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum);
 
+/// Warnings for materials of solid tetrahedra with ν >= 0.45, where linear tetrahedra lock
+/// (too stiff in bending, whatever the mesh size), each naming the material, ν and the cell
+/// count with the measured stiffening. O(cells).
+[[nodiscard]] std::vector<std::string> locking_warnings(const Scene& scene, const Assembly& assembly);
+
 /// Does selector `s` pick cell `c` of `m` (by centroid, tag, or all its points)?
 [[nodiscard]] bool selects_cell(const Selector& s, const IndexedMesh& m, std::uint32_t c);
 
