@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -25,6 +26,20 @@ std::vector<std::string> split(const std::string& line) {
   return out;
 }
 
+// The value of `column` in the last row of a frames.csv.
+double last_value(const std::filesystem::path& csv_path, const std::string& column) {
+  std::ifstream csv(csv_path);
+  std::string line;
+  std::getline(csv, line);
+  const auto header = split(line);
+  const auto at = static_cast<std::size_t>(std::find(header.begin(), header.end(), column) - header.begin());
+  std::vector<std::string> last;
+  while (std::getline(csv, line))
+    if (!line.empty()) last = split(line);
+  REQUIRE(at < last.size());
+  return std::stod(last[at]);
+}
+
 // scenes/solid_cantilever.json's beam brought to rest (h = 0.1 s, strong Rayleigh damping) at
 // Poisson's ratio `nu`; returns the run's summary and the mean sag (m) from its gravity energy.
 RunSummary cantilever_at_rest(double nu, double& mean_sag) {
@@ -41,20 +56,85 @@ RunSummary cantilever_at_rest(double nu, double& mean_sag) {
   opt.out = sewn::test::scratch("hard_newton/beam");
   const RunSummary s = run(load_scene(scene.string()), opt);
   // gravity energy M g z̄, measured from z = 0; the beam's centroid starts at z = 0.05 m (M = 10 kg)
-  std::ifstream csv(s.csv);
-  std::string line;
-  std::getline(csv, line);
-  const auto header = split(line);
-  const auto at = static_cast<std::size_t>(std::find(header.begin(), header.end(), "gravity_energy") - header.begin());
-  std::vector<std::string> last;
-  while (std::getline(csv, line))
-    if (!line.empty()) last = split(line);
-  REQUIRE(at < last.size());
-  mean_sag = 0.05 - std::stod(last[at]) / (10.0 * 9.81);
+  mean_sag = 0.05 - last_value(s.csv, "gravity_energy") / (10.0 * 9.81);
+  return s;
+}
+
+// A MEDIT file of a plate 0.2 x 0.05 m in z = 0 (8 x 4 cells of 2 triangles, tag 1) with a fin
+// standing on the line x = 0.1 along its first `fin_cells` cells in y (tag 2); no fin if 0.
+std::string plate_with_fin(int fin_cells) {
+  const int nx = 8, ny = 4;
+  std::ostringstream pts, tris;
+  int n_pts = 0, n_tris = 0;
+  const auto point = [&](double x, double y, double z) {
+    pts << x << " " << y << " " << z << " 0\n";
+    return ++n_pts;  // MEDIT numbers from 1
+  };
+  const auto tri = [&](int a, int b, int c, int tag) {
+    tris << a << " " << b << " " << c << " " << tag << "\n";
+    ++n_tris;
+  };
+  std::vector<int> id;
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) id.push_back(point(0.2 * i / nx, 0.05 * j / ny, 0.0));
+  const auto at = [&](int i, int j) { return id[static_cast<std::size_t>(j * (nx + 1) + i)]; };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      tri(at(i, j), at(i + 1, j), at(i + 1, j + 1), 1);
+      tri(at(i, j), at(i + 1, j + 1), at(i, j + 1), 1);
+    }
+  std::vector<int> top;
+  for (int j = 0; fin_cells > 0 && j <= fin_cells; ++j) top.push_back(point(0.1, 0.05 * j / ny, 0.01));
+  for (int j = 0; j < fin_cells; ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    tri(at(4, j), at(4, j + 1), top[k + 1], 2);
+    tri(at(4, j), top[k + 1], top[k], 2);
+  }
+  return "MeshVersionFormatted 2\nDimension 3\nVertices\n" + std::to_string(n_pts) + "\n" + pts.str() + "Triangles\n" +
+         std::to_string(n_tris) + "\n" + tris.str() + "End\n";
+}
+
+// The plate clamped at x <= 25 mm (two rows of nodes: patch bending's clamp), brought to rest
+// under gravity with connections on; the fin nearly massless (its own material) so that the
+// sag compares with the bare plate's. Returns the summary and the gravity energy at rest (J).
+RunSummary plate_at_rest(int fin_cells, double& gravity_energy) {
+  sewn::test::scratch_file("hard_newton/plate.mesh", plate_with_fin(fin_cells));
+  const std::string fin = fin_cells > 0 ? R"(, "regions": [{"where": {"type": "tag", "tag": 2}, "material": "light"}])" : "";
+  const auto scene = sewn::test::scratch_file("hard_newton/plate.json", R"({
+    "materials": {"m": {"young": 1e9, "poisson": 0.3, "density": 1000, "thickness": 0.002},
+                  "light": {"young": 1e9, "poisson": 0.3, "density": 0.01, "thickness": 0.002}},
+    "meshes": [{"type": "file", "path": "plate.mesh", "material": "m")" + fin + R"(}],
+    "fixed": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [0.0251, 1, 1]}}],
+    "gravity": [0, 0, -9.81], "damping": {"model": "rayleigh", "alpha": 20},
+    "model": {"type": "mixed", "bending": "patch", "connections": {}},
+    "integrator": {"type": "newton", "step": 0.01}, "duration": 2,
+    "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})");
+  RunOptions opt;
+  opt.quiet = true;
+  opt.out = sewn::test::scratch("hard_newton/plate");
+  const RunSummary s = run(load_scene(scene.string()), opt);
+  gravity_energy = last_value(s.csv, "gravity_energy");
   return s;
 }
 
 }  // namespace
+
+TEST_CASE("a fin along part of a plate's line hinges the plate there, and the run says so") {
+  double bare = 0, part = 0, whole = 0;
+  const RunSummary b = plate_at_rest(0, bare);
+  const RunSummary p = plate_at_rest(2, part);
+  const RunSummary w = plate_at_rest(4, whole);
+  // half the line hinged: 9 % more sag; the whole line parts the plate, and the connections
+  // join the pieces (a joint as stiff as one cell: a little stiffer than the bare plate)
+  CHECK(part / bare > 1.05);
+  CHECK(whole / bare == doctest::Approx(1.0).epsilon(0.05));
+  CHECK(b.model_warnings.empty());
+  CHECK(w.model_warnings.empty());
+  REQUIRE(p.model_warnings.size() == 1);
+  CHECK_MESSAGE(p.model_warnings[0].find("2 edge(s) shared by 3 or more shell triangles of one sheet (first: the edge "
+                                          "(0.1, 0, 0) to (0.1, 0.0125, 0) of meshes[0] cell 6") == 0,
+                p.model_warnings[0]);
+}
 
 TEST_CASE("nearly incompressible linear tetrahedra lock, and the run says so") {
   double soft = 0, locked = 0;
@@ -68,6 +148,33 @@ TEST_CASE("nearly incompressible linear tetrahedra lock, and the run says so") {
   const std::string& w = s5.model_warnings[0];
   CHECK_MESSAGE(w.find("materials.beam.poisson: nu = 0.4999 on 480 solid tetrahedra") == 0, w);
   CHECK_MESSAGE(w.find("lock") != std::string::npos, w);
+}
+
+TEST_CASE("a rod on a plate's node that is not the plate's own point is said to be unjoined") {
+  // The rod's top point is a plate node's place, but in another mesh (or a duplicate node of a
+  // file): the two share no node, and the rod fell off the plate with nothing said.
+  const auto scene = [](const std::string& rod) {
+    return sewn::test::scratch_file("hard_newton/rod_on_plate.json", R"({
+      "materials": {"m": {"young": 1e9, "poisson": 0.3, "density": 1000, "thickness": 0.002}},
+      "meshes": [{"type": "tri_grid", "cells": [4, 2], "size": [0.1, 0.05], "material": "m"})" + rod + R"(],
+      "fixed": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [0.0251, 1, 1]}}],
+      "model": {"type": "mixed"}, "damping": {"model": "rayleigh", "alpha": 20},
+      "integrator": {"type": "newton", "step": 0.01, "solver": "ldlt"}, "duration": 0.01,
+      "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})");
+  };
+  RunOptions opt;
+  opt.quiet = true;
+  opt.out = sewn::test::scratch("hard_newton/rod_on_plate");
+  const RunSummary alone = run(load_scene(scene("").string()), opt);
+  CHECK(alone.model_warnings.empty());
+  const RunSummary both = run(
+      load_scene(scene(R"(, {"type": "polyline", "points": [[0.1, 0.025, 0], [0.1, 0.025, -0.02]], "material": "m"})").string()),
+      opt);
+  REQUIRE(both.model_warnings.size() == 1);
+  CHECK_MESSAGE(both.model_warnings[0].find("1 pair(s) of distinct mesh points coincide (first: at (0.1, 0.025, 0), of "
+                                             "meshes[1] cell 0 (rod) and meshes[0] cell 6 (shell))") == 0,
+                both.model_warnings[0]);
+  CHECK(both.connections.find("none") != std::string::npos);  // what the run simulated: no joint
 }
 
 }  // namespace test_hard_newton
