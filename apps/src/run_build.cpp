@@ -525,9 +525,12 @@ Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum) {
   if (!quiet) warn_elongation_policies(sum, assembly);
 
   // The continuum models (solids, shells, rods) and the volume term join or replace the springs.
-  if (scene.model != "mass-spring")
-    b.continuum = build_continuum(scene, materials, assembly.mesh, assembly.model_of_cell, assembly.group_of_cell, model,
-                                  held_nodes(scene, assembly, model));
+  if (scene.model != "mass-spring") try {
+      b.continuum = build_continuum(scene, materials, assembly.mesh, assembly.model_of_cell, assembly.group_of_cell, model,
+                                    held_nodes(scene, assembly, model));
+    } catch (const physics::CellInputError& e) {
+      throw assembly.in_file(scene.file, e);
+    }
   // the rotational energies where the bodies meet (model.connections), on the rest state
   if (scene.model != "mass-spring")
     b.joints = build_connections(scene, assembly.mesh, assembly.model_of_cell, materials, b.continuum, model);

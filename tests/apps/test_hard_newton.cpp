@@ -11,6 +11,7 @@
 
 #include "sewn/apps/runner.hpp"
 #include "sewn/apps/scene.hpp"
+#include "sewn/physics/errors.hpp"
 #include "scratch.hpp"
 
 namespace test_hard_newton {
@@ -175,6 +176,35 @@ TEST_CASE("a rod on a plate's node that is not the plate's own point is said to 
                                              "meshes[1] cell 0 (rod) and meshes[0] cell 6 (shell))") == 0,
                 both.model_warnings[0]);
   CHECK(both.connections.find("none") != std::string::npos);  // what the run simulated: no joint
+}
+
+TEST_CASE("a shell triangle given reversed is refused naming its cell in the file") {
+  // two triangles of a square, the second listed clockwise: the diagonal runs 3 -> 1 in both
+  sewn::test::scratch_file("hard_newton/square.mesh",
+                           "MeshVersionFormatted 2\nDimension 3\nVertices\n4\n0 0 0 0\n1 0 0 0\n1 1 0 0\n0 1 0 0\n"
+                           "Triangles\n2\n1 2 3 1\n1 4 3 1\nEnd\n");
+  for (const char* bending : {"hinge", "patch", "morley"}) {
+    const auto scene = sewn::test::scratch_file("hard_newton/square.json", std::string(R"({
+      "materials": {"m": {"young": 1e9, "poisson": 0.3, "density": 1000, "thickness": 0.002}},
+      "meshes": [{"type": "file", "path": "square.mesh", "material": "m"}],
+      "model": {"type": "shell", "bending": ")") + bending + R"("}, "damping": {"model": "none"},
+      "integrator": {"type": "newton", "step": 0.01}, "duration": 0.01,
+      "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})");
+    RunOptions opt;
+    opt.quiet = true;
+    opt.out = sewn::test::scratch("hard_newton/square");
+    std::string told;
+    try {
+      (void)run(load_scene(scene.string()), opt);
+    } catch (const sewn::physics::InputError& e) {
+      told = e.what();
+    }
+    // it used to say "meshes: shell triangles: triangles 0 and 1 ...", in the model's own numbering
+    CHECK_MESSAGE(told.find("meshes[0]: cell 1 of " + sewn::test::scratch("hard_newton/square.mesh").string() +
+                            " (triangle) runs its edge from corner 2 to corner 0 the same way as the shell triangle "
+                            "across it: the two are oriented inconsistently") != std::string::npos,
+                  bending << ": " << told);
+  }
 }
 
 }  // namespace test_hard_newton
