@@ -542,11 +542,12 @@ Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum) {
   sum.model_warnings = locking_warnings(scene, assembly);
   for (auto& w : junction_warnings(assembly)) sum.model_warnings.push_back(std::move(w));
   for (auto& w : coincidence_warnings(assembly)) sum.model_warnings.push_back(std::move(w));
-  if (!quiet)
-    for (const auto& w : sum.model_warnings) std::fprintf(stderr, "sewn: warning: %s\n", w.c_str());
   add_volume_term(scene, assembly.material_names, model);
 
   b.motion = set_initial_state(scene, assembly, model);
+  for (auto& w : obstacle_start_warnings(model.nodes().x(), scene.obstacles)) sum.model_warnings.push_back(std::move(w));
+  if (!quiet)
+    for (const auto& w : sum.model_warnings) std::fprintf(stderr, "sewn: warning: %s\n", w.c_str());
   if (scene.refinement.enabled) b.refinement = std::make_unique<RefinementRun>(scene, model);
   return b;
 }

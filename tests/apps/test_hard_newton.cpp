@@ -207,4 +207,30 @@ TEST_CASE("a shell triangle given reversed is refused naming its cell in the fil
   }
 }
 
+TEST_CASE("a body meshed into an obstacle is said to start inside it") {
+  // a cube 0.1 m on a side with its lower half behind a ground plane at z = 0.05: the penalty's
+  // energy launched it (centroid 1.02 m up after 0.5 s) with nothing said
+  const auto summary = [](double ground) {
+    const auto scene = sewn::test::scratch_file("hard_newton/ground.json", R"({
+      "materials": {"m": {"young": 1e6, "poisson": 0.3, "density": 1000}},
+      "meshes": [{"type": "tet_grid", "material": "m", "cells": [3, 3, 3], "size": [0.1, 0.1, 0.1]}],
+      "obstacles": [{"type": "plane", "point": [0, 0, )" + std::to_string(ground) + R"(], "normal": [0, 0, 1]}],
+      "model": {"type": "solid"}, "damping": {"model": "rayleigh", "alpha": 5},
+      "integrator": {"type": "newton", "step": 0.01}, "duration": 0.01,
+      "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})");
+    RunOptions opt;
+    opt.quiet = true;
+    opt.out = sewn::test::scratch("hard_newton/ground");
+    return run(load_scene(scene.string()), opt);
+  };
+  CHECK(summary(0.0).model_warnings.empty());  // resting on it: no particle inside
+  const RunSummary inside = summary(0.05);
+  REQUIRE(inside.model_warnings.size() == 1);
+  // the grid's layers z = 0 and 0.0333 are inside: 2 x 16 particles, the deepest 0.05 m; each
+  // layer holds 16 x ½ k d² with k = 1e5 N/m: 2000 + 222.2 J
+  CHECK_MESSAGE(inside.model_warnings[0].find("obstacles[0] (plane): 32 particle(s) start inside it, the deepest 0.05 m "
+                                               "(particle 0 at (0, 0, 0)); its penalty holds 2222.22 J") == 0,
+                inside.model_warnings[0]);
+}
+
 }  // namespace test_hard_newton

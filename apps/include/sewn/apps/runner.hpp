@@ -115,7 +115,7 @@ struct RunSummary {
   bool stopped = false;              ///< stopped after a checkpoint (stop_after_checkpoints)
   std::string connections;           ///< model `mixed`: where its bodies meet (connections_text), else ""
   std::string connection_energies;    ///< model.connections: the energies built (connection_energies_text), else ""
-  std::vector<std::string> model_warnings;  ///< what is doubtful in the model built (near-incompressible linear tetrahedra, a sheet hinged at a non-manifold edge), each printed as a warning
+  std::vector<std::string> model_warnings;  ///< what is doubtful in the model built (near-incompressible linear tetrahedra, a sheet hinged at a non-manifold edge, coincident unshared points, particles starting inside an obstacle), each printed as a warning
 };
 
 /// Runs the scene to its end. Throws SceneError / io errors / physics::InputError / OutputPathError
