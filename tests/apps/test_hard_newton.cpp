@@ -233,4 +233,26 @@ TEST_CASE("a body meshed into an obstacle is said to start inside it") {
                 inside.model_warnings[0]);
 }
 
+TEST_CASE("an explicit connection far from every mesh point says how far, and the tolerance, in metres") {
+  const auto scene = sewn::test::scratch_file("hard_newton/far_joint.json", R"({
+    "materials": {"m": {"young": 1e9, "poisson": 0.3, "density": 1000, "thickness": 0.002}},
+    "meshes": [{"type": "tri_grid", "cells": [4, 2], "size": [0.1, 0.05], "material": "m"}],
+    "model": {"type": "mixed", "connections": {"explicit": [{"kind": "curve", "at": [0.3, 0.025, 0]}]}},
+    "damping": {"model": "none"}, "integrator": {"type": "newton", "step": 0.01}, "duration": 0.01,
+    "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})");
+  RunOptions opt;
+  opt.quiet = true;
+  opt.out = sewn::test::scratch("hard_newton/far_joint");
+  std::string told;
+  try {
+    (void)run(load_scene(scene.string()), opt);
+  } catch (const SceneError& e) {
+    told = e.path() + ": " + e.reason();
+  }
+  // the tolerance, 1e-6 of the plate's diagonal (0.112 m), used to print as 0.000000 m
+  CHECK_MESSAGE(told == "model.connections.explicit[0].at: no mesh point is there: the nearest is mesh point 9 at "
+                        "[0.1, 0.025, 0], 0.2 m away (tolerance 1.11803e-07 m)",
+                told);
+}
+
 }  // namespace test_hard_newton
