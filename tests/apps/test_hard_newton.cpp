@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -253,6 +254,41 @@ TEST_CASE("an explicit connection far from every mesh point says how far, and th
   CHECK_MESSAGE(told == "model.connections.explicit[0].at: no mesh point is there: the nearest is mesh point 9 at "
                         "[0.1, 0.025, 0], 0.2 m away (tolerance 1.11803e-07 m)",
                 told);
+}
+
+TEST_CASE("a Newton step that stops right after a deep line-search cut is flagged as doubtful") {
+  // A rod pinned at one end and released horizontal, 20 s: at h = 10 s and 1e-3 m/s Newton's
+  // step test passed one iteration after the line search had cut the step to 3e-5, with the rod
+  // 9 % of the way down (the settled fall is 0.1 m at h = 10 ms); it said nothing.
+  const auto pendulum = [](double h, double& fall) {
+    char integrator[160];
+    std::snprintf(integrator, sizeof integrator, R"("type": "newton", "step": %g, "solver": "ldlt", "newton_tolerance": 1e-3)", h);
+    const auto scene = sewn::test::scratch_file("hard_newton/pendulum.json", std::string(R"({
+      "materials": {"w": {"young": 2e8, "poisson": 0.35, "density": 1200}},
+      "meshes": [{"type": "polyline", "points": [[0, 0, 0], [0.1, 0, 0], [0.2, 0, 0]], "material": "w"}],
+      "fixed": [{"where": {"type": "box", "min": [-1, -1, -1], "max": [0.0001, 1, 1]}}],
+      "gravity": [0, 0, -9.81], "damping": {"model": "rayleigh", "alpha": 0.5},
+      "model": {"type": "mixed", "groups": [{"tag": 0, "as": "rod", "radius": 0.003}]},
+      "integrator": {)") + integrator + R"(}, "duration": 20,
+      "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})");
+    RunOptions opt;
+    opt.quiet = true;
+    opt.out = sewn::test::scratch("hard_newton/pendulum");
+    const RunSummary s = run(load_scene(scene.string()), opt);
+    const double mass = 1200 * 3.141592653589793 * 0.003 * 0.003 * 0.2;
+    fall = -last_value(s.csv, "gravity_energy") / (mass * 9.81);
+    return s;
+  };
+  double settled = 0, crawled = 0;
+  const RunSummary fine = pendulum(0.01, settled);
+  const RunSummary coarse = pendulum(10, crawled);
+  CHECK(settled == doctest::Approx(0.1).epsilon(1e-3));  // hanging straight down: its centre 0.1 m below the pin
+  CHECK(crawled < 0.2 * settled);                       // what the loose test let through
+  CHECK(fine.newton_short_stops == 0);
+  CHECK(coarse.newton_short_stops >= 1);
+  CHECK_MESSAGE(coarse.first_newton_short_stop.find("the Newton step at t = 0 s stopped 2 iteration(s) in, right after its "
+                                                     "line search had cut the step to") == 0,
+                coarse.first_newton_short_stop);
 }
 
 }  // namespace test_hard_newton

@@ -105,6 +105,8 @@ struct RunSummary {
   std::uint64_t substepped = 0;     ///< midpoint steps Newton could only take in sub-steps (the summary says so)
   int most_substeps = 0;             ///< the most sub-steps one of them took
   std::string first_energy_rise;    ///< the warning printed for the first of them ("" if none)
+  std::uint64_t newton_short_stops = 0;  ///< Newton steps that stopped right after a line search cut the step below ¼ (doubtful)
+  std::string first_newton_short_stop;   ///< the warning printed for the first of them ("" if none)
   std::uint64_t clamped_cells = 0;   ///< cells whose stiffness the `clamp` policy altered (a warning says so)
   std::uint64_t split_cells = 0;     ///< source cells the `split` policy cut into near-cubes (a warning says so)
   std::uint64_t inverted_max = 0;   ///< most inverted hexahedra and tetrahedra seen at once (frames, or steps if checked)
