@@ -28,6 +28,26 @@ std::vector<std::string> split(const std::string& line) {
   return out;
 }
 
+// Runs the scene file quietly, its output in scratch folder `out`.
+RunSummary run_quietly(const std::filesystem::path& scene, const std::string& out) {
+  RunOptions opt;
+  opt.quiet = true;
+  opt.out = sewn::test::scratch("hard_newton/" + out);
+  return run(load_scene(scene.string()), opt);
+}
+
+// What a run of the scene that refuses it says (a SceneError or a physics::InputError), "" if it ran.
+std::string refusal(const std::filesystem::path& scene, const std::string& out) {
+  try {
+    (void)run_quietly(scene, out);
+  } catch (const SceneError& e) {
+    return e.what();
+  } catch (const sewn::physics::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 // The value of `column` in the last row of a frames.csv.
 double last_value(const std::filesystem::path& csv_path, const std::string& column) {
   std::ifstream csv(csv_path);
@@ -53,10 +73,7 @@ RunSummary cantilever_at_rest(double nu, double& mean_sag) {
     "integrator": {"type": "newton", "step": 0.1}, "duration": 3,
     "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})";
   const auto scene = sewn::test::scratch_file("hard_newton/beam.json", text);
-  RunOptions opt;
-  opt.quiet = true;
-  opt.out = sewn::test::scratch("hard_newton/beam");
-  const RunSummary s = run(load_scene(scene.string()), opt);
+  const RunSummary s = run_quietly(scene, "beam");
   // gravity energy M g z̄, measured from z = 0; the beam's centroid starts at z = 0.05 m (M = 10 kg)
   mean_sag = 0.05 - last_value(s.csv, "gravity_energy") / (10.0 * 9.81);
   return s;
@@ -111,10 +128,7 @@ RunSummary plate_at_rest(int fin_cells, double& gravity_energy) {
     "model": {"type": "mixed", "bending": "patch", "connections": {}},
     "integrator": {"type": "newton", "step": 0.01}, "duration": 2,
     "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})");
-  RunOptions opt;
-  opt.quiet = true;
-  opt.out = sewn::test::scratch("hard_newton/plate");
-  const RunSummary s = run(load_scene(scene.string()), opt);
+  const RunSummary s = run_quietly(scene, "plate");
   gravity_energy = last_value(s.csv, "gravity_energy");
   return s;
 }
@@ -164,14 +178,10 @@ TEST_CASE("a rod on a plate's node that is not the plate's own point is said to 
       "integrator": {"type": "newton", "step": 0.01, "solver": "ldlt"}, "duration": 0.01,
       "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})");
   };
-  RunOptions opt;
-  opt.quiet = true;
-  opt.out = sewn::test::scratch("hard_newton/rod_on_plate");
-  const RunSummary alone = run(load_scene(scene("").string()), opt);
+  const RunSummary alone = run_quietly(scene(""), "rod_on_plate");
   CHECK(alone.model_warnings.empty());
-  const RunSummary both = run(
-      load_scene(scene(R"(, {"type": "polyline", "points": [[0.1, 0.025, 0], [0.1, 0.025, -0.02]], "material": "m"})").string()),
-      opt);
+  const RunSummary both =
+      run_quietly(scene(R"(, {"type": "polyline", "points": [[0.1, 0.025, 0], [0.1, 0.025, -0.02]], "material": "m"})"), "rod_on_plate");
   REQUIRE(both.model_warnings.size() == 1);
   CHECK_MESSAGE(both.model_warnings[0].find("1 pair(s) of distinct mesh points coincide (first: at (0.1, 0.025, 0), of "
                                              "meshes[1] cell 0 (rod) and meshes[0] cell 6 (shell))") == 0,
@@ -191,15 +201,7 @@ TEST_CASE("a shell triangle given reversed is refused naming its cell in the fil
       "model": {"type": "shell", "bending": ")") + bending + R"("}, "damping": {"model": "none"},
       "integrator": {"type": "newton", "step": 0.01}, "duration": 0.01,
       "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})");
-    RunOptions opt;
-    opt.quiet = true;
-    opt.out = sewn::test::scratch("hard_newton/square");
-    std::string told;
-    try {
-      (void)run(load_scene(scene.string()), opt);
-    } catch (const sewn::physics::InputError& e) {
-      told = e.what();
-    }
+    const std::string told = refusal(scene, "square");
     // it used to say "meshes: shell triangles: triangles 0 and 1 ...", in the model's own numbering
     CHECK_MESSAGE(told.find("meshes[0]: cell 1 of " + sewn::test::scratch("hard_newton/square.mesh").string() +
                             " (triangle) runs its edge from corner 2 to corner 0 the same way as the shell triangle "
@@ -219,10 +221,7 @@ TEST_CASE("a body meshed into an obstacle is said to start inside it") {
       "model": {"type": "solid"}, "damping": {"model": "rayleigh", "alpha": 5},
       "integrator": {"type": "newton", "step": 0.01}, "duration": 0.01,
       "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})");
-    RunOptions opt;
-    opt.quiet = true;
-    opt.out = sewn::test::scratch("hard_newton/ground");
-    return run(load_scene(scene.string()), opt);
+    return run_quietly(scene, "ground");
   };
   CHECK(summary(0.0).model_warnings.empty());  // resting on it: no particle inside
   const RunSummary inside = summary(0.05);
@@ -241,18 +240,10 @@ TEST_CASE("an explicit connection far from every mesh point says how far, and th
     "model": {"type": "mixed", "connections": {"explicit": [{"kind": "curve", "at": [0.3, 0.025, 0]}]}},
     "damping": {"model": "none"}, "integrator": {"type": "newton", "step": 0.01}, "duration": 0.01,
     "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})");
-  RunOptions opt;
-  opt.quiet = true;
-  opt.out = sewn::test::scratch("hard_newton/far_joint");
-  std::string told;
-  try {
-    (void)run(load_scene(scene.string()), opt);
-  } catch (const SceneError& e) {
-    told = e.path() + ": " + e.reason();
-  }
+  const std::string told = refusal(scene, "far_joint");
   // the tolerance, 1e-6 of the plate's diagonal (0.112 m), used to print as 0.000000 m
-  CHECK_MESSAGE(told == "model.connections.explicit[0].at: no mesh point is there: the nearest is mesh point 9 at "
-                        "[0.1, 0.025, 0], 0.2 m away (tolerance 1.11803e-07 m)",
+  CHECK_MESSAGE(told.find("model.connections.explicit[0].at: no mesh point is there: the nearest is mesh point 9 at "
+                          "[0.1, 0.025, 0], 0.2 m away (tolerance 1.11803e-07 m)") != std::string::npos,
                 told);
 }
 
@@ -271,10 +262,7 @@ TEST_CASE("a Newton step that stops right after a deep line-search cut is flagge
       "model": {"type": "mixed", "groups": [{"tag": 0, "as": "rod", "radius": 0.003}]},
       "integrator": {)") + integrator + R"(}, "duration": 20,
       "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})");
-    RunOptions opt;
-    opt.quiet = true;
-    opt.out = sewn::test::scratch("hard_newton/pendulum");
-    const RunSummary s = run(load_scene(scene.string()), opt);
+    const RunSummary s = run_quietly(scene, "pendulum");
     const double mass = 1200 * 3.141592653589793 * 0.003 * 0.003 * 0.2;
     fall = -last_value(s.csv, "gravity_energy") / (mass * 9.81);
     return s;
