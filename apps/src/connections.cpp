@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <optional>
@@ -385,10 +386,10 @@ std::uint32_t nearest_point(const Around& a, const std::array<double, 3>& at, co
   const double tol = 1e-6 * (hi - lo).norm();
   if (!(best_d <= tol)) {
     const Vec3d x = a.x(best);
-    throw SceneError(file, key + ".at",
-                     "no mesh point is there: the nearest is mesh point " + std::to_string(best) + " at [" + std::to_string(x.x()) +
-                         ", " + std::to_string(x.y()) + ", " + std::to_string(x.z()) + "], " + std::to_string(best_d) +
-                         " m away (tolerance " + std::to_string(tol) + " m)");
+    char text[256];  // %g: a tolerance of 1e-7 m printed as 0.000000 read as "must be exact"
+    std::snprintf(text, sizeof text, "no mesh point is there: the nearest is mesh point %u at [%g, %g, %g], %g m away (tolerance %g m)",
+                  best, x.x(), x.y(), x.z(), best_d, tol);
+    throw SceneError(file, key + ".at", text);
   }
   return best;
 }

@@ -5,6 +5,7 @@
 #include <map>
 #include <numbers>
 
+#include "sewn/physics/cell_input_error.hpp"
 #include "sewn/physics/shells/shell_terms.hpp"
 
 namespace sewn::app {
@@ -209,6 +210,10 @@ void add_shells(const std::vector<physics::MaterialParams>& materials, const Ind
     }
     parts.hinges = &model.system().add<physics::shells::Hinges>();
     parts.hinges->add_interior_edges(triangles, rest_state(model), k_b);
+  } catch (const physics::CellInputError& e) {
+    // a shell triangle named by the mesh cell it came from (build_bodies names the file's cell)
+    const physics::Index mesh_cell = model.elements()[parts.element_of_membrane[e.cell()]].mesh_cell;
+    throw physics::CellInputError("shell triangles", static_cast<std::uint32_t>(mesh_cell), e.detail());
   } catch (const physics::InputError& e) {
     throw SceneError(scene.file, "meshes", e.what());
   }

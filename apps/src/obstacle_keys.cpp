@@ -1,6 +1,9 @@
 #include "sewn/apps/obstacle_keys.hpp"
 
+#include <cstdio>
 #include <numbers>
+
+#include <Eigen/Geometry>
 
 #include "sewn/physics/errors.hpp"
 
@@ -88,6 +91,42 @@ void add_obstacles(physics::System& sys, const std::vector<ObstacleSpec>& obstac
     auto& term = sys.add<physics::obstacles::Obstacles>(o.stiffness, o.friction_velocity);
     (void)term.add(o.shape);
   }
+}
+
+std::vector<std::string> obstacle_start_warnings(std::span<const double> x, const std::vector<ObstacleSpec>& obstacles) {
+  // A body meshed into an obstacle is shot out of it by the penalty in the first steps: a cube
+  // half inside the ground plane was launched 1 m up in 0.5 s, with nothing said.
+  const std::size_t n = x.size() / 3;
+  const auto at = [&](std::size_t i) { return physics::obstacles::Vec3(x[3 * i], x[3 * i + 1], x[3 * i + 2]); };
+  Eigen::AlignedBox3d box;
+  for (std::size_t i = 0; i < n; ++i) box.extend(at(i));
+  const double tol = n > 0 ? 1e-9 * box.diagonal().norm() : 0.0;
+  std::vector<std::string> out;
+  for (std::size_t k = 0; k < obstacles.size(); ++k) {
+    std::size_t inside = 0, deepest = 0;
+    double most = 0, energy = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double d = physics::obstacles::depth(obstacles[k].shape, at(i)).depth;
+      if (!(d > tol)) continue;
+      ++inside;
+      energy += 0.5 * obstacles[k].stiffness * d * d;
+      if (d > most) {
+        most = d;
+        deepest = i;
+      }
+    }
+    if (inside == 0) continue;
+    const auto p = at(deepest);
+    char text[512];
+    std::snprintf(text, sizeof text,
+                  "obstacles[%zu] (%s): %zu particle(s) start inside it, the deepest %g m (particle %zu at (%g, %g, %g)); "
+                  "its penalty holds %g J there, which the first steps turn into motion the scene did not supply: "
+                  "start the bodies outside it",
+                  k, std::string(physics::obstacles::type_name(obstacles[k].shape)).c_str(), inside, most, deepest, p.x(), p.y(),
+                  p.z(), energy);
+    out.emplace_back(text);
+  }
+  return out;
 }
 
 }  // namespace sewn::app

@@ -1,9 +1,15 @@
 #include "run_build.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
+#include <map>
 #include <set>
 #include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Geometry>
 
 #include "sewn/apps/obstacle_keys.hpp"
 #include "sewn/io/cleanup.hpp"
@@ -296,6 +302,133 @@ physics::MssOptions model_options(const Scene& scene) {
   return mo;
 }
 
+}  // namespace
+
+namespace detail {
+
+std::vector<std::string> locking_warnings(const Scene& scene, const Assembly& assembly) {
+  // Linear tetrahedra lock as ν → ½: the volumetric term λ(tr ε)² cannot be kept near zero by
+  // their constant strains in bending. Measured on scenes/solid_cantilever.json (20x2x2 cells,
+  // 6 tets each) at rest under gravity: mean sag 3.02 mm at ν = 0.3, 1.80 at 0.45, 0.67 at 0.49,
+  // 0.13 at 0.4999; on 40x4x4 cells 4.69, 1.73 and 0.15 mm; the continuum's 5.9 mm barely
+  // depends on ν. Refining does not cure it, so the user is told.
+  constexpr double locking_poisson = 0.45;
+  std::vector<std::uint64_t> solid_cells(assembly.material_names.size(), 0);
+  for (std::uint32_t c = 0; c < assembly.mesh.num_cells(); ++c)
+    if (assembly.model_of_cell[c] == CellModel::solid) ++solid_cells[assembly.material_of_cell[c]];
+  std::vector<std::string> out;
+  for (std::size_t m = 0; m < solid_cells.size(); ++m) {
+    const double nu = scene.materials.at(assembly.material_names[m]).poisson;
+    if (solid_cells[m] == 0 || nu < locking_poisson) continue;
+    char text[640];
+    std::snprintf(text, sizeof text,
+                  "materials.%s.poisson: nu = %g on %llu solid tetrahedra: linear tetrahedra lock when nearly "
+                  "incompressible (lambda/mu = %.3g), so this body is too stiff in bending, and refining does not cure "
+                  "it: the 1 m cantilever of scenes/solid_cantilever.json sags 3.0 mm at nu = 0.3, 0.67 mm at 0.49 and "
+                  "0.13 mm at 0.4999 (40x4x4 cells: 4.7, 1.7, 0.15 mm) against the continuum's 5.9 mm; use nu < %g",
+                  assembly.material_names[m].c_str(), nu, static_cast<unsigned long long>(solid_cells[m]),
+                  2 * nu / (1 - 2 * nu), locking_poisson);
+    out.emplace_back(text);
+  }
+  return out;
+}
+
+std::vector<std::string> junction_warnings(const Assembly& assembly) {
+  // No bending term crosses an edge of three or more shell triangles (shells::triangles_across
+  // pairs an edge's two triangles only), and model.connections joins only separate components
+  // (connect::detect_connections). Where the sheets around such an edge are still one component
+  // (a fin along part of a plate's line), nothing keeps the sheet from folding there: a plate
+  // 0.2 x 0.05 m (8 x 4 cells) with a massless fin on 2 of its 4 edges at mid-length sagged 9 %
+  // more than without it.
+  const MeshConnections found = mesh_connections(assembly.mesh, assembly.model_of_cell);
+  if (!found.skipped.empty()) return {};
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::uint32_t>> around;  // edge -> mesh cells
+  std::vector<std::uint32_t> listed;  // per mesh cell, its index among the simulated cells
+  for (std::uint32_t c = 0, k = 0; c < assembly.mesh.num_cells(); ++c) {
+    listed.push_back(k);
+    if (assembly.model_of_cell[c] == CellModel::label) continue;
+    ++k;
+    if (assembly.model_of_cell[c] != CellModel::shell || assembly.mesh.types[c] != CellType::triangle) continue;
+    const auto v = assembly.mesh.cell(c);
+    for (int i = 0; i < 3; ++i) around[std::minmax(v[i], v[(i + 1) % 3])].push_back(c);
+  }
+  std::uint64_t hinged = 0;
+  std::string first;
+  for (const auto& [edge, cells] : around) {
+    if (cells.size() < 3) continue;
+    std::vector<std::uint32_t> comps;
+    for (const auto c : cells) comps.push_back(found.found.component_of_cell[listed[c]]);
+    std::sort(comps.begin(), comps.end());
+    if (std::adjacent_find(comps.begin(), comps.end()) == comps.end()) continue;  // all separate: connections join them
+    if (hinged++ > 0) continue;
+    const auto at = [&](std::uint32_t p) {
+      const auto& x = assembly.mesh.points[p];
+      char text[96];
+      std::snprintf(text, sizeof text, "(%g, %g, %g)", x[0], x[1], x[2]);
+      return std::string(text);
+    };
+    first = "the edge " + at(edge.first) + " to " + at(edge.second) + " of";
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+      const MeshSource& source = assembly.sources[assembly.mesh_of_cell(cells[k])];
+      first += std::string(k == 0 ? " " : ", ") + source.key + " " + source.cell(assembly.file_cell[cells[k]]);
+    }
+  }
+  if (hinged == 0) return {};
+  return {std::to_string(hinged) + " edge(s) shared by 3 or more shell triangles of one sheet (first: " + first +
+          "): no bending term crosses such an edge and model.connections joins only separate sheets, so the sheet is "
+          "hinged along it (a plate with a fin along half of one cell line sagged 9 % more); run the junction across "
+          "the whole sheet, so that it parts the sheet into pieces model.connections joins"};
+}
+
+std::vector<std::string> coincidence_warnings(const Assembly& assembly) {
+  // A mesh exported with duplicate nodes (a Gmsh file whose rod and shell were meshed apart and
+  // never made coherent) leaves bodies that look joined unjoined: a rod hanging from a plate by
+  // such a node fell off it, with exit 0. Points of simulated cells closer than 1e-9 of the
+  // model's size are reported (generated meshes share their points; cuts come later).
+  const IndexedMesh& mesh = assembly.mesh;
+  std::vector<std::uint32_t> used;
+  std::vector<std::uint8_t> seen(mesh.num_points(), 0);
+  for (std::uint32_t c = 0; c < mesh.num_cells(); ++c)
+    if (assembly.model_of_cell[c] != CellModel::label)
+      for (const auto p : mesh.cell(c))
+        if (!seen[p]) {
+          seen[p] = 1;
+          used.push_back(p);
+        }
+  if (used.size() < 2) return {};
+  Eigen::AlignedBox3d box;
+  for (const auto p : used) box.extend(Vec3d(mesh.points[p][0], mesh.points[p][1], mesh.points[p][2]));
+  const double tol = 1e-9 * box.diagonal().norm();
+  const auto x = [&](std::uint32_t p) { return Vec3d(mesh.points[p][0], mesh.points[p][1], mesh.points[p][2]); };
+  std::sort(used.begin(), used.end(), [&](std::uint32_t a, std::uint32_t b) { return mesh.points[a][0] < mesh.points[b][0]; });
+  std::uint64_t pairs = 0;
+  std::array<std::uint32_t, 2> first{};
+  for (std::size_t i = 0; i < used.size(); ++i)
+    for (std::size_t j = i + 1; j < used.size() && mesh.points[used[j]][0] - mesh.points[used[i]][0] <= tol; ++j)
+      if ((x(used[i]) - x(used[j])).norm() <= tol && pairs++ == 0) first = {used[i], used[j]};
+  if (pairs == 0) return {};
+  std::string cells;  // a cell of each point of the first pair
+  for (const auto p : first)
+    for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
+      const auto v = mesh.cell(c);
+      if (assembly.model_of_cell[c] == CellModel::label || std::find(v.begin(), v.end(), p) == v.end()) continue;
+      const MeshSource& source = assembly.sources[assembly.mesh_of_cell(c)];
+      cells += std::string(cells.empty() ? "" : " and ") + source.key + " " + source.cell(assembly.file_cell[c]) + " (" +
+               to_string(assembly.model_of_cell[c]) + ")";
+      break;
+    }
+  char at[96];
+  std::snprintf(at, sizeof at, "(%g, %g, %g)", mesh.points[first[0]][0], mesh.points[first[0]][1], mesh.points[first[0]][2]);
+  return {std::to_string(pairs) + " pair(s) of distinct mesh points coincide (first: at " + at + ", of " + cells +
+          "): cells on coincident points are not joined there (they share no node), so bodies that look attached are "
+          "free of each other; if they should be one, merge the duplicate nodes in the mesher (Gmsh: Coherence Mesh), and "
+          "put bodies that meet in one mesh file: the scene's meshes never share points"};
+}
+
+}  // namespace detail
+
+namespace {
+
 // A policy that altered the cells is said so: the body is not the material's.
 void warn_elongation_policies(const RunSummary& sum, const Assembly& assembly) {
   if (sum.clamped_cells > 0)
@@ -392,9 +525,12 @@ Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum) {
   if (!quiet) warn_elongation_policies(sum, assembly);
 
   // The continuum models (solids, shells, rods) and the volume term join or replace the springs.
-  if (scene.model != "mass-spring")
-    b.continuum = build_continuum(scene, materials, assembly.mesh, assembly.model_of_cell, assembly.group_of_cell, model,
-                                  held_nodes(scene, assembly, model));
+  if (scene.model != "mass-spring") try {
+      b.continuum = build_continuum(scene, materials, assembly.mesh, assembly.model_of_cell, assembly.group_of_cell, model,
+                                    held_nodes(scene, assembly, model));
+    } catch (const physics::CellInputError& e) {
+      throw assembly.in_file(scene.file, e);
+    }
   // the rotational energies where the bodies meet (model.connections), on the rest state
   if (scene.model != "mass-spring")
     b.joints = build_connections(scene, assembly.mesh, assembly.model_of_cell, materials, b.continuum, model);
@@ -403,9 +539,15 @@ Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum) {
   if (b.continuum.rods && !b.continuum.rods->has_angle_dofs() && scene.integrator == "newton")
     b.continuum.rods->condense_twist(model.system().angles());
   sum.connection_energies = connection_energies_text(b.joints);
+  sum.model_warnings = locking_warnings(scene, assembly);
+  for (auto& w : junction_warnings(assembly)) sum.model_warnings.push_back(std::move(w));
+  for (auto& w : coincidence_warnings(assembly)) sum.model_warnings.push_back(std::move(w));
   add_volume_term(scene, assembly.material_names, model);
 
   b.motion = set_initial_state(scene, assembly, model);
+  for (auto& w : obstacle_start_warnings(model.nodes().x(), scene.obstacles)) sum.model_warnings.push_back(std::move(w));
+  if (!quiet)
+    for (const auto& w : sum.model_warnings) std::fprintf(stderr, "sewn: warning: %s\n", w.c_str());
   if (scene.refinement.enabled) b.refinement = std::make_unique<RefinementRun>(scene, model);
   return b;
 }

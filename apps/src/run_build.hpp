@@ -34,6 +34,23 @@ struct Bodies {
 /// physics::InputError for bad input, each naming the key or file. O(mesh).
 [[nodiscard]] Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum);
 
+/// Warnings for materials of solid tetrahedra with ν >= 0.45, where linear tetrahedra lock
+/// (too stiff in bending, whatever the mesh size), each naming the material, ν and the cell
+/// count with the measured stiffening. O(cells).
+[[nodiscard]] std::vector<std::string> locking_warnings(const Scene& scene, const Assembly& assembly);
+
+/// A warning (at most one) for the edges three or more shell triangles share where two of them
+/// are one component (connect::detect_connections): no bending term crosses such an edge and no
+/// connection joins a component to itself, so the sheet is hinged there. Names the first edge by
+/// its points and its triangles by mesh and file cell. O(cells log cells).
+[[nodiscard]] std::vector<std::string> junction_warnings(const Assembly& assembly);
+
+/// A warning (at most one) for distinct points of simulated cells within 1e-9 of the model's
+/// bounding-box diagonal of each other (duplicate nodes: the cells on them are not joined),
+/// naming the first pair's place and a cell on each. O(points log points) unless many points
+/// share an x.
+[[nodiscard]] std::vector<std::string> coincidence_warnings(const Assembly& assembly);
+
 /// Does selector `s` pick cell `c` of `m` (by centroid, tag, or all its points)?
 [[nodiscard]] bool selects_cell(const Selector& s, const IndexedMesh& m, std::uint32_t c);
 

@@ -450,6 +450,7 @@ NewtonReport NewtonEuler::step(System& sys, double h) {
       const double phi_t = evaluate(sys, trial_, ls == 0);
       if (std::isfinite(phi_t) && phi_t <= phi + opt_.armijo * alpha * slope + noise) {
         std::swap(q_, trial_);
+        rep.last_alpha = alpha;
         phi = ls == 0 ? phi_t : evaluate(sys, q_, true);
         break;
       }

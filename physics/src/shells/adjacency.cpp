@@ -4,6 +4,7 @@
 #include <string>
 #include <tuple>
 
+#include "sewn/physics/cell_input_error.hpp"
 #include "sewn/physics/errors.hpp"
 
 namespace sewn::physics::shells {
@@ -37,9 +38,11 @@ std::vector<std::array<Across, 3>> triangles_across(std::span<const std::array<I
     if (j - i == 2) {
       const Half& A = halves[i];
       const Half& B = halves[i + 1];
-      if (B.from != A.to)
-        throw InputError("shell triangles: triangles " + std::to_string(A.tri) + " and " + std::to_string(B.tri) +
-                         " are oriented inconsistently across edge " + std::to_string(A.lo) + "-" + std::to_string(A.hi));
+      if (B.from != A.to)  // named by the later triangle, as a file's reader names a cell (CellInputError)
+        throw CellInputError("shell triangles", static_cast<std::uint32_t>(B.tri),
+                             "(triangle) runs its edge from corner " + std::to_string((B.corner + 1) % 3) + " to corner " +
+                                 std::to_string((B.corner + 2) % 3) + " the same way as the shell triangle across it: the two are oriented inconsistently (their normals, and so the sign of "
+                                 "bending, disagree); reverse one, or orient the sheet consistently");
       out[A.tri][static_cast<std::size_t>(A.corner)] = {B.tri, B.corner};
       out[B.tri][static_cast<std::size_t>(B.corner)] = {A.tri, A.corner};
     }

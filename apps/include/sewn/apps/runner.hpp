@@ -105,6 +105,8 @@ struct RunSummary {
   std::uint64_t substepped = 0;     ///< midpoint steps Newton could only take in sub-steps (the summary says so)
   int most_substeps = 0;             ///< the most sub-steps one of them took
   std::string first_energy_rise;    ///< the warning printed for the first of them ("" if none)
+  std::uint64_t newton_short_stops = 0;  ///< Newton steps that stopped right after a line search cut the step below ¼ (doubtful)
+  std::string first_newton_short_stop;   ///< the warning printed for the first of them ("" if none)
   std::uint64_t clamped_cells = 0;   ///< cells whose stiffness the `clamp` policy altered (a warning says so)
   std::uint64_t split_cells = 0;     ///< source cells the `split` policy cut into near-cubes (a warning says so)
   std::uint64_t inverted_max = 0;   ///< most inverted hexahedra and tetrahedra seen at once (frames, or steps if checked)
@@ -115,6 +117,7 @@ struct RunSummary {
   bool stopped = false;              ///< stopped after a checkpoint (stop_after_checkpoints)
   std::string connections;           ///< model `mixed`: where its bodies meet (connections_text), else ""
   std::string connection_energies;    ///< model.connections: the energies built (connection_energies_text), else ""
+  std::vector<std::string> model_warnings;  ///< what is doubtful in the model built (near-incompressible linear tetrahedra, a sheet hinged at a non-manifold edge, coincident unshared points, particles starting inside an obstacle), each printed as a warning
 };
 
 /// Runs the scene to its end. Throws SceneError / io errors / physics::InputError / OutputPathError

@@ -123,6 +123,10 @@ struct NewtonReport {
   int term_step_limits = 0;   ///< iterations whose step a term shortened (ForceTerm::step_fraction)
   double guess_fraction = 1.0; ///< α of the initial guess q_n + α h v_n on the free axes
   int forcing_refinements = 0; ///< loose solves (cg_forcing_max) solved on to cg_tolerance before the stopping test
+  /// α the line search took at the iteration before the one that stopped (1: none). Well below 1,
+  /// Newton was still far from the solution one iteration before the step test passed: its steps
+  /// can be short there because the line search or curvature keeps them so, not because it is done.
+  double last_alpha = 1.0;
   double step_velocity = 0.0; ///< |p|∞/h of the last iteration, m/s (angles as length × Δθ)
   double phi_decrease = 0.0;  ///< Φ(q̂) - Φ(q_{n+1}) ≥ 0
 };

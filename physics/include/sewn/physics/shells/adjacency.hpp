@@ -19,8 +19,9 @@ struct Across {
 
 /// Per triangle t and corner i, what lies across the edge opposite corner i (the edge
 /// (v[i+1], v[i+2])). Throws InputError naming the node when a triangle refers to a node
-/// ≥ n_nodes, and naming the two triangles when an interior edge is traversed the same way by
-/// both (inconsistent orientation: a fold would read as the fold plus π). O(T log T).
+/// ≥ n_nodes, and CellInputError naming the later triangle and its edge when an interior edge
+/// is traversed the same way by both of its triangles (inconsistent orientation: a fold would
+/// read as the fold plus π). O(T log T).
 [[nodiscard]] std::vector<std::array<Across, 3>> triangles_across(std::span<const std::array<Index, 3>> triangles,
                                                                   std::size_t n_nodes);
 
