@@ -20,6 +20,12 @@ def families(raw):
             out.setdefault(("shell strip vs Euler-Bernoulli", f"{m.group(1)}, {m.group(2)}", "nx"), {})[int(m.group(3))] = (
                 b["error vs Euler-Bernoulli %"], ms)
             continue
+        m = re.match(r"elastic/shell_course/([a-z_]+)/([a-z]+)/([a-z]+)/n(\d+)/", name)
+        if m and "error vs reference %" in b:
+            answer = {"scordelis_lo": "Scordelis-Lo roof vs 0.3024", "hemisphere": "pinched hemisphere vs 0.094",
+                      "pinched_cylinder": "pinched cylinder vs 1.8248e-5"}[m.group(1)]
+            out.setdefault((answer, f"{m.group(2)}, {m.group(3)}", "n"), {})[int(m.group(4))] = (b["error vs reference %"], ms)
+            continue
         m = re.match(r"elastic/rod_elastica/seg(\d+)/", name)
         if m and "error vs elastica %" in b:
             out.setdefault(("rod end-moment cantilever vs the elastica", "discrete elastic rod (tip / L)", "segments"), {})[
