@@ -79,14 +79,7 @@ inline const char* case_name(Case c) {
   return "?";
 }
 inline const char* mesh_name(Mesh m) { return m == Mesh::structured ? "structured" : "jittered"; }
-inline const char* bending_name(Bending b) {
-  switch (b) {
-    case Bending::morley: return "morley";
-    case Bending::patch: return "patch";
-    case Bending::hinge: return "hinge";
-  }
-  return "?";
-}
+using shell_strip::bending_name;
 
 /// The published answer (see the header comment), at the full load.
 inline double reference(Case c) {
@@ -124,10 +117,7 @@ class PointLoads final : public physics::ForceTerm {
   std::vector<Load> loads_;
 };
 
-struct Surface {
-  std::vector<double> rest;  // 3 per node
-  std::vector<std::array<physics::Index, 3>> triangles;
-};
+using Surface = shell_strip::Strip;  // rest positions (3 per node) and triangles
 
 /// A (cols × rows)-cell grid of parameters (u, v) in [0, 1]² mapped by `at` onto the surface,
 /// counter-clockwise in (u, v); `wrap_u` joins column cols to column 0 (the hemisphere's
@@ -191,34 +181,11 @@ struct Built {
 };
 
 /// Membranes and the bending model on `s` (no clamps: the diaphragms are simple supports and
-/// the hemisphere is free), nodes with lumped masses ρ t Ā/3.
+/// the hemisphere and cylinder are free), nodes with lumped masses ρ t Ā/3.
 inline void add_shell(physics::System& sys, const Surface& s, Bending bending, double young, double poisson,
                       double thickness, double rho) {
-  using physics::Index;
-  const Index n = static_cast<Index>(s.rest.size() / 3);
-  auto at = [&](Index i) { return Eigen::Vector3d(s.rest[3 * i], s.rest[3 * i + 1], s.rest[3 * i + 2]); };
-  std::vector<double> mass(n, 0.0);
-  for (const auto& tr : s.triangles) {
-    const double area = 0.5 * (at(tr[1]) - at(tr[0])).cross(at(tr[2]) - at(tr[0])).norm();
-    for (Index v : tr) mass[v] += rho * thickness * area / 3.0;
-  }
-  for (Index i = 0; i < n; ++i) sys.nodes().add(at(i), Eigen::Vector3d::Zero(), mass[i]);
-  auto& membranes = sys.add<physics::shells::Membranes>();
-  for (const auto& tr : s.triangles) {
-    physics::shells::TriPositions X;
-    for (int k = 0; k < 3; ++k) X.col(k) = at(tr[static_cast<std::size_t>(k)]);
-    membranes.add(tr, X, young, poisson, thickness);
-  }
-  const std::vector<physics::shells::PlateMaterial> mat(s.triangles.size(),
-                                                        physics::shells::plate_material(young, poisson, thickness));
-  switch (bending) {
-    case Bending::hinge:
-      sys.add<physics::shells::Hinges>().add_interior_edges(s.triangles, s.rest,
-                                                             physics::shells::hinge_stiffness(young, poisson, thickness));
-      break;
-    case Bending::morley: (void)physics::shells::add_morley_bending(sys, s.triangles, s.rest, mat); break;
-    case Bending::patch: (void)physics::shells::add_patch_bending(sys, s.triangles, s.rest, mat); break;
-  }
+  shell_strip::add_membrane_sheet(sys, s, young, poisson, thickness, rho);
+  shell_strip::add_bending(sys, s, bending, young, poisson, thickness);
 }
 
 /// Scordelis-Lo, n cells per quarter side (2n × 2n). x along the axis (ends at ±25), z up, the
