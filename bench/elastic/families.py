@@ -6,6 +6,9 @@ CPU ms per solve)}; dynamic_families(): the runs from release to rest, the same 
 import re
 
 TIMOSHENKO_MM = 14.868  # the cantilever's answer, Euler-Bernoulli plus shear (PHYSICS_NOTES §4)
+# shell_course.cpp's cases -> their answer (the published value they are compared with)
+SHELL_COURSE = {"scordelis_lo": "Scordelis-Lo roof vs 0.3024", "hemisphere": "pinched hemisphere vs 0.094",
+                "pinched_cylinder": "pinched cylinder vs 1.8248e-5"}
 
 
 def families(raw):
@@ -19,6 +22,11 @@ def families(raw):
         if m and "error vs Euler-Bernoulli %" in b:
             out.setdefault(("shell strip vs Euler-Bernoulli", f"{m.group(1)}, {m.group(2)}", "nx"), {})[int(m.group(3))] = (
                 b["error vs Euler-Bernoulli %"], ms)
+            continue
+        m = re.match(r"elastic/shell_course/([a-z_]+)/([a-z]+)/([a-z]+)/n(\d+)/", name)
+        if m and "error vs reference %" in b:
+            out.setdefault((SHELL_COURSE[m.group(1)], f"{m.group(2)}, {m.group(3)}", "n"), {})[int(m.group(4))] = (
+                b["error vs reference %"], ms)
             continue
         m = re.match(r"elastic/rod_elastica/seg(\d+)/", name)
         if m and "error vs elastica %" in b:

@@ -34,15 +34,6 @@ void strip_tip(benchmark::State& st, Mesh mesh, Bending bending, int nx) {
   st.counters["_triangles"] = static_cast<double>(r.triangles);
 }
 
-const char* bending_name(Bending b) {
-  switch (b) {
-    case Bending::morley: return "morley";
-    case Bending::patch: return "patch";
-    case Bending::hinge: return "hinge";
-  }
-  return "?";
-}
-
 void register_all() {
   using sewn::bench::Scale;
   const Scale scale = sewn::bench::scale();
@@ -52,7 +43,7 @@ void register_all() {
     for (Mesh mesh : {Mesh::square, Mesh::flipped, Mesh::row, Mesh::jittered, Mesh::diagonals, Mesh::offset})
       for (int nx : sizes)
         sewn::bench::ours("elastic",
-                          std::string("shell_strip/") + bending_name(bending) + "/" +
+                          std::string("shell_strip/") + sewn::shell_strip::bending_name(bending) + "/" +
                               sewn::shell_strip::mesh_name(mesh) + "/nx" + std::to_string(nx),
                           [=](benchmark::State& st) { strip_tip(st, mesh, bending, nx); })
             ->Iterations(1);

@@ -23,6 +23,7 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -37,6 +38,15 @@ namespace sewn::shell_strip {
 
 enum class Mesh { square, flipped, row, jittered, diagonals, offset };
 enum class Bending { patch, hinge, morley };
+
+inline const char* bending_name(Bending b) {
+  switch (b) {
+    case Bending::morley: return "morley";
+    case Bending::patch: return "patch";
+    case Bending::hinge: return "hinge";
+  }
+  return "?";
+}
 
 inline const char* mesh_name(Mesh m) {
   switch (m) {
@@ -162,39 +172,56 @@ struct Built {
   std::size_t triangles = 0;
 };
 
-inline void build(Built& out, Mesh mesh, Bending bending, int nx, const Shape& shape = {}) {
+/// Nodes at the sheet's rest positions with lumped masses (ρ t Ā/3 from each triangle per
+/// corner) and a CST membrane per triangle. Shared with shell_course.hpp.
+inline void add_membrane_sheet(physics::System& sys, const Strip& s, double young, double poisson, double thickness,
+                               double density) {
   using physics::Index;
-  const Strip s = strip_mesh(mesh, nx, shape);
-  physics::System& sys = out.sys;
   const Index n = static_cast<Index>(s.rest.size() / 3);
   std::vector<double> mass(n, 0.0);
   auto at = [&](Index i) { return Eigen::Vector3d(s.rest[3 * i], s.rest[3 * i + 1], s.rest[3 * i + 2]); };
   for (const auto& tr : s.triangles) {
     const double area = 0.5 * (at(tr[1]) - at(tr[0])).cross(at(tr[2]) - at(tr[0])).norm();
-    for (Index v : tr) mass[v] += rho * thickness * area / 3.0;
+    for (Index v : tr) mass[v] += density * thickness * area / 3.0;
   }
   for (Index i = 0; i < n; ++i) sys.nodes().add(at(i), Eigen::Vector3d::Zero(), mass[i]);
   auto& membranes = sys.add<physics::shells::Membranes>();
   for (const auto& tr : s.triangles) {
     physics::shells::TriPositions X;
     for (int k = 0; k < 3; ++k) X.col(k) = at(tr[static_cast<std::size_t>(k)]);
-    membranes.add(tr, X, young, 0.0, thickness);
+    membranes.add(tr, X, young, poisson, thickness);
   }
+}
+
+/// The bending model over the sheet's triangles; patch and Morley take `clamp` (per triangle,
+/// empty: none), hinges have no clamps. Shared with shell_course.hpp.
+inline void add_bending(physics::System& sys, const Strip& s, Bending bending, double young, double poisson,
+                        double thickness, std::span<const std::uint8_t> clamp = {}) {
   if (bending == Bending::hinge) {
     sys.add<physics::shells::Hinges>().add_interior_edges(s.triangles, s.rest,
-                                                           physics::shells::hinge_stiffness(young, 0.0, thickness));
-  } else {  // patch and Morley: the cells behind x = 0 are held, clamps on the edge x = 0
-    const std::vector<physics::shells::PlateMaterial> mat(s.triangles.size(),
-                                                          physics::shells::plate_material(young, 0.0, thickness));
-    std::vector<std::uint8_t> clamp(s.triangles.size(), 0);
-    for (std::size_t t = 0; t < s.triangles.size(); ++t)
-      clamp[t] = s.rest[3 * std::size_t{s.triangles[t][0]}] <= 1e-12 && s.rest[3 * std::size_t{s.triangles[t][1]}] <= 1e-12 &&
-                 s.rest[3 * std::size_t{s.triangles[t][2]}] <= 1e-12;
-    if (bending == Bending::morley)
-      (void)physics::shells::add_morley_bending(sys, s.triangles, s.rest, mat, clamp);
-    else
-      (void)physics::shells::add_patch_bending(sys, s.triangles, s.rest, mat, clamp);
+                                                           physics::shells::hinge_stiffness(young, poisson, thickness));
+    return;
   }
+  const std::vector<physics::shells::PlateMaterial> mat(s.triangles.size(),
+                                                        physics::shells::plate_material(young, poisson, thickness));
+  if (bending == Bending::morley)
+    (void)physics::shells::add_morley_bending(sys, s.triangles, s.rest, mat, clamp);
+  else
+    (void)physics::shells::add_patch_bending(sys, s.triangles, s.rest, mat, clamp);
+}
+
+inline void build(Built& out, Mesh mesh, Bending bending, int nx, const Shape& shape = {}) {
+  using physics::Index;
+  const Strip s = strip_mesh(mesh, nx, shape);
+  physics::System& sys = out.sys;
+  const Index n = static_cast<Index>(s.rest.size() / 3);
+  add_membrane_sheet(sys, s, young, 0.0, thickness, rho);
+  // patch and Morley: the cells behind x = 0 are held, clamps on the edge x = 0
+  std::vector<std::uint8_t> clamp(s.triangles.size(), 0);
+  for (std::size_t t = 0; t < s.triangles.size(); ++t)
+    clamp[t] = s.rest[3 * std::size_t{s.triangles[t][0]}] <= 1e-12 && s.rest[3 * std::size_t{s.triangles[t][1]}] <= 1e-12 &&
+               s.rest[3 * std::size_t{s.triangles[t][2]}] <= 1e-12;
+  add_bending(sys, s, bending, young, 0.0, thickness, clamp);
   sys.add<physics::Gravity>(Eigen::Vector3d(0, 0, -gravity));
   for (Index i = 0; i < n; ++i) {
     if (s.rest[3 * i] <= 1e-12) sys.nodes().fix(i);
