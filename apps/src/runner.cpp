@@ -336,13 +336,17 @@ void RunLoop::check_inversion(std::uint64_t step) {
   inverted_now_ = c.elements;
   sum_.inverted_max = std::max<std::uint64_t>(sum_.inverted_max, c.elements);
   if (c.elements == 0 || !sum_.first_inversion.empty()) return;
-  char msg[300];
-  std::snprintf(msg, sizeof msg, "element %u (mesh cell %u) is inverted at step %llu (t = %.6g s)%s", c.first, c.first_cell,
-                static_cast<unsigned long long>(step), static_cast<double>(step) * scene_.step,
-                c.elements > 1 ? (", with " + std::to_string(c.elements - 1) + " more").c_str() : "");
+  // the cell as its file names it: elements past the mesh's cells are children of refinement
+  const Assembly& assembly = b_.assembly;
+  const std::string cell = (c.first < assembly.mesh.num_cells() ? "" : "refined from ") + assembly.cell_name(c.first_cell, true);
+  char when[100];
+  std::snprintf(when, sizeof when, " is inverted at step %llu (t = %.6g s)", static_cast<unsigned long long>(step),
+                static_cast<double>(step) * scene_.step);
+  const std::string msg = "element " + std::to_string(c.first) + " (" + cell + ")" + when +
+                          (c.elements > 1 ? ", with " + std::to_string(c.elements - 1) + " more" : "");
   sum_.first_inversion = msg;
   if (scene_.stop_on_inversion) throw std::runtime_error(std::string(msg) + "; stopped there (integrator.stop_on_inversion)");
-  if (!options_.quiet) std::fprintf(stderr, "\nsewn: warning: %s\n", msg);
+  if (!options_.quiet) std::fprintf(stderr, "\nsewn: warning: %s\n", msg.c_str());
 }
 
 void RunLoop::write_frame(double t) {
