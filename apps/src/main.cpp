@@ -320,7 +320,8 @@ int cmd_check(const std::vector<std::string>& args) {
               built.sewn_facets, built.nonmanifold_facets, built.unorientable_edges);
   std::fprintf(out, "validation: %s\n", report.str().c_str());
   if (!report.ok()) sound = false;
-  const sewn::app::MeshTopology topo = sewn::app::mesh_topology(mesh, path);
+  sewn::app::MeshTopology topo = sewn::app::mesh_topology(mesh, path);
+  topo.point_numbers = file.point_numbers();  // points as the file numbers them
   std::fputs(sewn::app::topology_text(topo).c_str(), out);
   if (json) {
     nlohmann::json j = sewn::app::topology_json(topo);

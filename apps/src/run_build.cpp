@@ -451,7 +451,8 @@ Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum) {
                                   held_nodes(scene, assembly, model));
   // the rotational energies where the bodies meet (model.connections), on the rest state
   if (scene.model != "mass-spring")
-    b.joints = build_connections(scene, assembly.mesh, assembly.model_of_cell, materials, b.continuum, model);
+    b.joints = build_connections(scene, assembly.mesh, assembly.model_of_cell, materials, b.continuum, model,
+                                 [&](std::uint32_t p) { return assembly.point_name(p, true); });
   // Rods whose twist no joint turns keep it quasi-static; under Newton it joins the linear system
   // condensed, so each Newton step is the reduced energy's exact one (docs/rods.md).
   if (b.continuum.rods && !b.continuum.rods->has_angle_dofs() && scene.integrator == "newton")

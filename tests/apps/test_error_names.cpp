@@ -38,10 +38,16 @@ TEST_CASE("the map builder's refusals name the file's cells: a face of three vol
                          " (tetrahedron) and cell 2 (Gmsh element 11)" + in + " (tetrahedron)") != std::string::npos,
                 err);
 
+  // sewn check reports the face's points by their node tags (were their places in the file: 1, 2, 3)
+  std::string check_err;
+  CHECK(run_sewn("check " + three.string(), check_err) == 0);
+  for (const char* node : {"10", "20", "30"})
+    CHECK_MESSAGE(check_err.find("vertex at point " + std::string(node) + ": a face at it lies in 3 volumes") != std::string::npos, check_err);
+  CHECK_MESSAGE(check_err.find("vertex at point 1:") == std::string::npos, check_err);
+
   // without the tetrahedron below, the other two overlap: check and run say the same of it
   const fs::path two = tool_write("two_on_face.msh", msh(face_nodes, three_on_a_face(false)));
   const fs::path scene2 = tool_write("two_on_face.json", file_scene("mass-spring", {first_grid, file_mesh(two)}));
-  std::string check_err;
   CHECK(run_sewn("run --quiet --out " + tool_scratch("two").string() + " " + scene2.string(), err) == 2);
   CHECK(run_sewn("check " + two.string(), check_err) == 2);
   const std::string of = " of " + two.string();
@@ -126,6 +132,24 @@ TEST_CASE("point selectors name the entry, and the file's node of the scene poin
       {"where": {"type": "points", "indices": [10, 11]}, "velocity": [0, 1, 0]}], )");
   CHECK(run_sewn("run --quiet --out " + tool_scratch("selected").string() + " " + twice.string(), err) == 2);
   CHECK_MESSAGE(err.find("motion[1].where: drives the particle at meshes[1] point 40" + of + ", which motion[0] drives") != std::string::npos, err);
+}
+
+TEST_CASE("an explicit connection where no mesh point is names the nearest one as its file numbers it") {
+  // the fin scene, its mesh file by its full path, a joint asked for far from the body
+  std::string text = read(fs::path(SEWN_SOURCE_DIR) / "scenes" / "mixed_fin.json");
+  const std::string fin = (fs::path(SEWN_SOURCE_DIR) / "scenes" / "meshes" / "fin.msh").string();
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const std::size_t at = text.find(from);
+    REQUIRE(at != std::string::npos);
+    text.replace(at, from.size(), to);
+  };
+  replace("\"meshes/fin.msh\"", "\"" + fin + "\"");
+  replace(R"("connections": { "detect": true })", R"("connections": {"detect": false, "explicit": [{"kind": "point", "at": [5, 5, 5]}]})");
+  const fs::path scene = tool_write("far_joint.json", text);
+  std::string err;
+  CHECK(run_sewn("run --quiet --out " + tool_scratch("far_joint").string() + " " + scene.string(), err) == 2);
+  CHECK_MESSAGE(err.find("model.connections.explicit[0].at: no mesh point is there: the nearest is meshes[0] point ") != std::string::npos, err);
+  CHECK_MESSAGE(err.find(" of " + fin + " at [") != std::string::npos, err);
 }
 
 }  // namespace test_error_names
