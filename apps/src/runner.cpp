@@ -168,6 +168,8 @@ class RunLoop {
   void apply_due_cuts(double t);
   refine::CutReport apply_cut(std::size_t k);
   int step(double t);
+  // A blow-up's message with the particle it names told as its file numbers its point.
+  [[nodiscard]] physics::BlowupError in_files(const physics::BlowupError& e) const;
   void check_energy(std::uint64_t step);
   void refine_after(std::uint64_t step);
   void write_frame(double t);
@@ -513,6 +515,17 @@ int RunLoop::step(double t) {
   return 0;
 }
 
+physics::BlowupError RunLoop::in_files(const physics::BlowupError& e) const {
+  const Index i = e.node();
+  if (i == physics::invalid_index || i >= model_.nodes().size()) return e;
+  const std::uint32_t p = model_.point_of_node(i);
+  // a cut's copy of a particle keeps its point; refinement's new particles have none
+  const std::string where = p < b_.assembly.mesh.num_points() ? "is a particle at " + b_.assembly.point_name(p, true)
+                                                               : "was added by refinement (no mesh point)";
+  return physics::BlowupError(std::string(e.what()) + "; node " + std::to_string(i) + " " + where, i, e.quantity(), e.step(),
+                              e.suggested_step());
+}
+
 void RunLoop::check_energy(std::uint64_t step) {
   if (!use_implicit_) return;
   const auto rise = ledger_.after_step(model_.system(), step);
@@ -563,7 +576,12 @@ void RunLoop::run() {
     const auto t0 = Clock::now();
     const std::clock_t c0 = std::clock();
     apply_due_cuts(t);
-    const int cg = step(t);
+    int cg = 0;
+    try {
+      cg = step(t);
+    } catch (const physics::BlowupError& e) {
+      throw in_files(e);
+    }
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     sum_.stepping += ms / 1e3;
     sum_.stepping_cpu += static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;

@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <string>
+#include <vector>
 
 #include "sewn_tool.hpp"
 
@@ -13,7 +14,7 @@ namespace test_error_names {
 namespace fs = std::filesystem;
 using namespace sewn::test::tool;
 
-// A first scene mesh of the given material, so that the file's cells and points are not the
+// A first scene mesh (material m), so that the file's cells and points are not the
 // assembled mesh's first ones.
 const std::string first_grid = R"({"type": "hex_grid", "material": "m", "cells": [1, 1, 1], "size": [1, 1, 1], "origin": [0, 5, 0]})";
 
@@ -150,6 +151,20 @@ TEST_CASE("an explicit connection where no mesh point is names the nearest one a
   CHECK(run_sewn("run --quiet --out " + tool_scratch("far_joint").string() + " " + scene.string(), err) == 2);
   CHECK_MESSAGE(err.find("model.connections.explicit[0].at: no mesh point is there: the nearest is meshes[0] point ") != std::string::npos, err);
   CHECK_MESSAGE(err.find(" of " + fin + " at [") != std::string::npos, err);
+}
+
+TEST_CASE("a blow-up names its particle's point as the file numbers it") {
+  // one stiff tetrahedron, its apex (scene point 3, node 40) thrown at 10 m/s, stepped far past
+  // the semi-implicit stable step: the apex is the fastest particle when the energy blows up
+  const fs::path file = tool_write("blow.msh", msh({"100 5 5 5", "10 0 0 0", "20 1 0 0", "30 0 1 0", "40 0 0 1"}, {"9 4 2 0 0 10 20 30 40"}));
+  const fs::path scene = tool_write("blow.json", R"({"materials": {"m": {"young": 1e9, "density": 1000}}, "meshes": [)" + file_mesh(file) + R"(],
+      "velocities": [{"where": {"type": "points", "indices": [3]}, "linear": [0, 0, 10]}],
+      "integrator": {"type": "semi-implicit", "step": 0.1, "allow_unstable": true}, "duration": 100,
+      "output": {"frames": 2, "vtu": false, "picture": {"enabled": false}}})");
+  std::string err;
+  CHECK(run_sewn("run --quiet --out " + tool_scratch("blow").string() + " " + scene.string(), err) == 1);
+  CHECK_MESSAGE(err.find("fastest node 3 ") != std::string::npos, err);
+  CHECK_MESSAGE(err.find("; node 3 is a particle at meshes[0] point 40 of " + file.string()) != std::string::npos, err);
 }
 
 }  // namespace test_error_names
