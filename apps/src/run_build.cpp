@@ -228,12 +228,18 @@ std::string Assembly::in_files(const std::string& scene_file, const IndexedMessa
   std::optional<std::size_t> one;
   bool several = false;
   for (const auto& r : m.refs()) {
+    if (r.kind == IndexedMessage::Ref::Kind::material) continue;
     const auto k = r.kind == IndexedMessage::Ref::Kind::cell ? std::optional(mesh_of_cell(r.index)) : mesh_of_point(r.index);
     several = several || !k || (one && *one != *k);
     one = k;
   }
   const std::string text = m.render([&](const IndexedMessage::Ref& r) {
-    return r.kind == IndexedMessage::Ref::Kind::cell ? cell_name(r.index, several) : point_name(r.index, several);
+    switch (r.kind) {
+      case IndexedMessage::Ref::Kind::cell: return cell_name(r.index, several);
+      case IndexedMessage::Ref::Kind::point: return point_name(r.index, several);
+      default:  // materials past the scene's are the copies apply_rod_sections made for rods
+        return r.index < material_names.size() ? "material \"" + material_names[r.index] + "\"" : "material " + std::to_string(r.index);
+    }
   });
   return scene_file + ": " + (one && !several ? sources[*one].key + ": " : "") + text;
 }

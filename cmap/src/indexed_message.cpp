@@ -19,6 +19,12 @@ IndexedMessage& IndexedMessage::operator<<(PointRef p) {
   return *this;
 }
 
+IndexedMessage& IndexedMessage::operator<<(MaterialRef m) {
+  refs_.push_back({Ref::Kind::material, m.index});
+  texts_.emplace_back();
+  return *this;
+}
+
 IndexedMessage& IndexedMessage::operator<<(const IndexedMessage& more) {
   texts_.back() += more.texts_[0];
   refs_.insert(refs_.end(), more.refs_.begin(), more.refs_.end());
@@ -33,7 +39,8 @@ std::string IndexedMessage::render(const std::function<std::string(const Ref&)>&
 }
 
 std::string IndexedMessage::str() const {
-  return render([](const Ref& r) { return (r.kind == Ref::Kind::cell ? "cell " : "point ") + std::to_string(r.index); });
+  static constexpr const char* words[] = {"cell ", "point ", "material "};
+  return render([](const Ref& r) { return words[static_cast<int>(r.kind)] + std::to_string(r.index); });
 }
 
 }  // namespace sewn

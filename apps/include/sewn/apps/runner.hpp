@@ -73,7 +73,8 @@ struct Assembly {
   [[nodiscard]] std::string point_name(std::uint32_t p, bool key) const;
   /// A message about cells and points of `mesh` (physics::CellInputError, MeshCellError),
   /// restated as "<scene_file>: <message>" with each named as its file does (cell_name,
-  /// MeshSource::point); a message about one scene mesh starts at its key ("meshes[1]: ...").
+  /// MeshSource::point) and each material by its scene name; a message about one scene mesh
+  /// starts at its key ("meshes[1]: ...").
   [[nodiscard]] std::string in_files(const std::string& scene_file, const IndexedMessage& m) const;
 };
 

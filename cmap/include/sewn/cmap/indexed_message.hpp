@@ -24,23 +24,28 @@ struct CellRef {
 struct PointRef {
   std::uint32_t index;
 };
+/// A material of the cells, by its index in the list the caller gave with the mesh.
+struct MaterialRef {
+  std::uint32_t index;
+};
 
 class IndexedMessage {
  public:
-  /// One number of the message: a cell or a point of the mesh, by its index there.
+  /// One number of the message: a cell or a point of the mesh, by its index there, or a material.
   struct Ref {
-    enum class Kind : std::uint8_t { cell, point } kind;
+    enum class Kind : std::uint8_t { cell, point, material } kind;
     std::uint32_t index;
   };
 
   IndexedMessage& operator<<(const std::string& text);
   IndexedMessage& operator<<(CellRef c);
   IndexedMessage& operator<<(PointRef p);
+  IndexedMessage& operator<<(MaterialRef m);
   IndexedMessage& operator<<(const IndexedMessage& more);
 
   /// The message with each reference in the words `name` gives it. O(length).
   [[nodiscard]] std::string render(const std::function<std::string(const Ref&)>& name) const;
-  /// The message in the mesh's own numbers: "cell 3", "point 7".
+  /// The message in the mesh's own numbers: "cell 3", "point 7", "material 1".
   [[nodiscard]] std::string str() const;
   [[nodiscard]] const std::vector<Ref>& refs() const noexcept { return refs_; }
 
