@@ -86,6 +86,10 @@ std::string MeshSource::cell(std::uint32_t c) const {
          (file.empty() ? "" : " of " + file);
 }
 
+std::string MeshSource::point(std::uint32_t p) const {
+  return "point " + (point_numbers.empty() ? std::to_string(p) : std::to_string(point_numbers[p])) + (file.empty() ? "" : " of " + file);
+}
+
 IndexedMesh used_part(const io::MeshFile& file, io::GeometryOptions& numbering) {
   IndexedMesh m = file.mesh;
   const std::vector<std::uint32_t> new_index = io::drop_unused_points(m);
@@ -98,7 +102,7 @@ IndexedMesh used_part(const io::MeshFile& file, io::GeometryOptions& numbering) 
 
 std::vector<CellModel> cell_models(const IndexedMesh& mesh, const std::vector<bool>& embedded, const Scene& scene,
                                    const std::string& path) {
-  return cell_models(mesh, embedded, scene, MeshSource{path, "", {}}, match_groups(mesh, MeshNames{}, scene).of_cell);
+  return cell_models(mesh, embedded, scene, MeshSource{path, "", {}, {}}, match_groups(mesh, MeshNames{}, scene).of_cell);
 }
 
 std::vector<CellModel> cell_models(const IndexedMesh& mesh, const std::vector<bool>& embedded, const Scene& scene,

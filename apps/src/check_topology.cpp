@@ -33,8 +33,8 @@ std::string betti_str(const ComponentTopology& c, int dim) {
 
 std::string where(const MeshTopology& t, const NonManifoldCell& c) {
   const std::uint32_t x = c.dart.index();
-  if (c.dim == 0) return "vertex at point " + std::to_string(t.point_of_dart[x]);
-  return "edge between points " + std::to_string(t.point_of_dart[x]) + " and " + std::to_string(t.next_of_dart[x]);
+  if (c.dim == 0) return "vertex at point " + std::to_string(t.number(t.point_of_dart[x]));
+  return "edge between points " + std::to_string(t.number(t.point_of_dart[x])) + " and " + std::to_string(t.number(t.next_of_dart[x]));
 }
 
 }  // namespace
@@ -134,8 +134,8 @@ nlohmann::json topology_json(const MeshTopology& t) {
   json nm = json::array();
   for (const auto& c : tp.nonmanifold) {
     json j{{"dim", c.dim}, {"why", c.why}};
-    if (c.dim == 0) j["point"] = t.point_of_dart[c.dart.index()];
-    else j["points"] = {t.point_of_dart[c.dart.index()], t.next_of_dart[c.dart.index()]};
+    if (c.dim == 0) j["point"] = t.number(t.point_of_dart[c.dart.index()]);
+    else j["points"] = {t.number(t.point_of_dart[c.dart.index()]), t.number(t.next_of_dart[c.dart.index()])};
     nm.push_back(std::move(j));
   }
   return json{{"dimension", D},       {"cells", counts(tp.total.cells, D)}, {"euler", tp.total.euler},

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <map>
 #include <optional>
@@ -33,6 +34,7 @@ struct Around {
   std::vector<std::int64_t> component;          // per mesh cell, -1: a label
   std::vector<Index> element;                   // per mesh cell, its model element
   std::vector<std::vector<std::uint32_t>> at;   // per mesh point, its simulated cells
+  std::function<std::string(std::uint32_t)> point_name;  // how messages name a mesh point
 
   [[nodiscard]] Vec3d x(std::uint32_t p) const { return model.rest_position(model.node_of_point(p)); }
   [[nodiscard]] Index node(std::uint32_t p) const { return model.node_of_point(p); }
@@ -54,7 +56,7 @@ struct Around {
 
 Around gather(const IndexedMesh& mesh, const std::vector<CellModel>& models, const std::vector<physics::MaterialParams>& materials,
               const ContinuumParts& parts, const physics::MssModel<3>& model, const std::string& file) {
-  Around a{mesh, model, materials, parts, {}, {}, {}, {}};
+  Around a{mesh, model, materials, parts, {}, {}, {}, {}, {}};
   // rods as the Rods term chained them (split by group and material): two rods meeting at a
   // node are two components, joined by a rod–rod point connection
   std::vector<std::uint32_t> chain(mesh.num_cells(), 0);
@@ -144,7 +146,7 @@ PointSide solid_point_side(const Around& a, std::uint32_t comp, std::uint32_t p,
   if (!surface) normal = toward;
   if (!(normal.norm() > 1e-9 * (surface ? 1.0 : scale)))
     throw SceneError(file, key,
-                     who + ": the solid's frame cannot be built at mesh point " + std::to_string(p) +
+                     who + ": the solid's frame cannot be built at " + a.point_name(p) +
                          (surface ? ": its surface one-ring has no normal (the angle-weighted face normals cancel)"
                                   : ": the joint's other side sits on the point itself"));
   normal.normalize();
@@ -386,9 +388,9 @@ std::uint32_t nearest_point(const Around& a, const std::array<double, 3>& at, co
   const double tol = 1e-6 * (hi - lo).norm();
   if (!(best_d <= tol)) {
     const Vec3d x = a.x(best);
-    char text[256];  // %g: a tolerance of 1e-7 m printed as 0.000000 read as "must be exact"
-    std::snprintf(text, sizeof text, "no mesh point is there: the nearest is mesh point %u at [%g, %g, %g], %g m away (tolerance %g m)",
-                  best, x.x(), x.y(), x.z(), best_d, tol);
+    char text[512];  // %g: a tolerance of 1e-7 m printed as 0.000000 read as "must be exact"
+    std::snprintf(text, sizeof text, "no mesh point is there: the nearest is %s at [%g, %g, %g], %g m away (tolerance %g m)",
+                  a.point_name(best).c_str(), x.x(), x.y(), x.z(), best_d, tol);
     throw SceneError(file, key + ".at", text);
   }
   return best;
@@ -410,7 +412,7 @@ std::vector<std::optional<Choice>> choose(const Around& a, const ConnectionsSpec
     for (const auto& f : a.found.connections)
       if (f.kind == kind && std::find(f.points.begin(), f.points.end(), p) != f.points.end()) pairs.push_back(f.components);
     if (pairs.empty())
-      throw SceneError(file, key, "no two bodies meet in a " + e.kind + " connection at mesh point " + std::to_string(p) +
+      throw SceneError(file, key, "no two bodies meet in a " + e.kind + " connection at " + a.point_name(p) +
                                       " (`sewn check` lists where they meet)");
     const Choice ch{key, "explicit[" + std::to_string(k) + "] ", e.twisting ? e.twisting : spec.twisting,
                     e.bending ? e.bending : spec.bending, e.stiffness ? e.stiffness : spec.curve_stiffness, e.rigid.value_or(spec.rigid)};
@@ -471,14 +473,15 @@ double rod_inertia(const Around& a) {
 
 ConnectionParts build_connections(const Scene& scene, const IndexedMesh& mesh, const std::vector<CellModel>& models,
                                   const std::vector<physics::MaterialParams>& materials, const ContinuumParts& parts,
-                                  physics::MssModel<3>& model) {
+                                  physics::MssModel<3>& model, const std::function<std::string(std::uint32_t)>& point_name) {
   ConnectionParts out;
   const ConnectionsSpec& spec = scene.connections;
   if (!spec.enabled) return out;
   if (scene.refinement.enabled)
     throw SceneError(scene.file, "refinement", "a scene with model.connections cannot be refined (the connections' stencils would not follow the new elements)");
   out.sources = std::make_shared<JointSources>();
-  const Around a = gather(mesh, models, materials, parts, model, scene.file);
+  Around a = gather(mesh, models, materials, parts, model, scene.file);
+  a.point_name = point_name ? point_name : [](std::uint32_t p) { return "mesh point " + std::to_string(p); };
   const std::vector<std::optional<Choice>> chosen = choose(a, spec, scene.file);
   const double rigid = spec.rigid_factor;
   physics::System& sys = model.system();

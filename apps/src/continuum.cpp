@@ -211,9 +211,13 @@ void add_shells(const std::vector<physics::MaterialParams>& materials, const Ind
     parts.hinges = &model.system().add<physics::shells::Hinges>();
     parts.hinges->add_interior_edges(triangles, rest_state(model), k_b);
   } catch (const physics::CellInputError& e) {
-    // a shell triangle named by the mesh cell it came from (build_bodies names the file's cell)
-    const physics::Index mesh_cell = model.elements()[parts.element_of_membrane[e.cell()]].mesh_cell;
-    throw physics::CellInputError("shell triangles", static_cast<std::uint32_t>(mesh_cell), e.detail());
+    // shell triangles restated as the mesh cells they came from (build_bodies names the file's cells)
+    const auto mesh_cell = [&](const IndexedMessage::Ref& r) {
+      if (r.kind != IndexedMessage::Ref::Kind::cell) return r;
+      const physics::Index c = model.elements()[parts.element_of_membrane[r.index]].mesh_cell;
+      return IndexedMessage::Ref{r.kind, static_cast<std::uint32_t>(c)};
+    };
+    throw physics::CellInputError("shell triangles", e.message().renumbered(mesh_cell));
   } catch (const physics::InputError& e) {
     throw SceneError(scene.file, "meshes", e.what());
   }

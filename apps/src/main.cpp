@@ -208,6 +208,19 @@ sewn::IndexedMesh simulated_cells(const sewn::IndexedMesh& read, const std::vect
   return mesh;
 }
 
+// A message of the map builder on the simulated cells (simulated_cells), its cells and points
+// named as `sewn run` names them (Assembly::in_files): "cell 1 (Gmsh element 9) of b.msh".
+std::string in_file(const sewn::IndexedMessage& m, const sewn::io::MeshFile& file, const std::string& path,
+                    const std::vector<sewn::app::CellModel>& models) {
+  std::vector<std::uint32_t> file_cell;
+  for (std::uint32_t c = 0; c < models.size(); ++c)
+    if (models[c] != sewn::app::CellModel::label) file_cell.push_back(c);
+  const sewn::app::MeshSource source{"", path, file.element_tags, file.point_numbers()};
+  return m.render([&](const sewn::IndexedMessage::Ref& r) {
+    return r.kind == sewn::IndexedMessage::Ref::Kind::cell ? source.cell(file_cell[r.index]) : source.point(r.index);
+  });
+}
+
 std::string tag_name(const sewn::io::MeshFile& file, std::int32_t tag, int dim) {
   for (const auto& n : file.tag_names)
     if (n.tag == tag && n.dimension == dim) return " \"" + n.name + "\"";
@@ -291,7 +304,12 @@ int cmd_check(const std::vector<std::string>& args) {
   sewn::CMap<3, std::uint32_t> map;
   sewn::BuildOptions bopt;
   bopt.source = path;
-  const sewn::BuildResult built = sewn::build(map, mesh, bopt);
+  sewn::BuildResult built;
+  try {
+    built = sewn::build(map, mesh, bopt);
+  } catch (const sewn::MeshCellError& e) {
+    throw sewn::MeshError(path + ": " + in_file(e.message(), file, path, models));
+  }
   map.create_attributes<0>([&](sewn::Dart d) { return built.vertex_of_dart[d.index()]; });
   const auto report = map.validate();
   const auto n = map.count_all();
@@ -302,7 +320,8 @@ int cmd_check(const std::vector<std::string>& args) {
               built.sewn_facets, built.nonmanifold_facets, built.unorientable_edges);
   std::fprintf(out, "validation: %s\n", report.str().c_str());
   if (!report.ok()) sound = false;
-  const sewn::app::MeshTopology topo = sewn::app::mesh_topology(mesh, path);
+  sewn::app::MeshTopology topo = sewn::app::mesh_topology(mesh, path);
+  topo.point_numbers = file.point_numbers();  // points as the file numbers them
   std::fputs(sewn::app::topology_text(topo).c_str(), out);
   if (json) {
     nlohmann::json j = sewn::app::topology_json(topo);

@@ -69,7 +69,7 @@ std::vector<MotionSpec> read_motion(const nlohmann::json& j, const Field& schema
 }
 
 MotionDriver::MotionDriver(std::vector<MotionSpec> specs, const std::vector<std::vector<physics::Index>>& nodes,
-                           physics::NodeTable& table, const std::string& file)
+                           physics::NodeTable& table, const std::string& file, const std::function<std::string(physics::Index)>& name)
     : specs_(std::move(specs)) {
   std::map<physics::Index, std::vector<std::uint32_t>> by_node;
   for (std::size_t k = 0; k < nodes.size(); ++k)
@@ -79,7 +79,7 @@ MotionDriver::MotionDriver(std::vector<MotionSpec> specs, const std::vector<std:
     for (std::size_t q = 1; q < ks.size(); ++q)
       if (specs_[ks[q]].from < specs_[ks[q - 1]].until)
         throw SceneError(file, "motion[" + std::to_string(std::max(ks[q], ks[q - 1])) + "].where",
-                         "drives particle " + std::to_string(node) + ", which motion[" + std::to_string(std::min(ks[q], ks[q - 1])) +
+                         "drives " + (name ? name(node) : "particle " + std::to_string(node)) + ", which motion[" + std::to_string(std::min(ks[q], ks[q - 1])) +
                              "] drives at overlapping times: one particle follows one motion at a time");
     table.fix(node, physics::all_axes);
     driven_.push_back({node, table.position(node), ks});

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <utility>
@@ -16,6 +17,7 @@
 #include "sewn/io/geometry.hpp"
 #include "sewn/io/read.hpp"
 #include "sewn/io/surface.hpp"
+#include "sewn/physics/cell_input_error.hpp"
 #include "sewn/physics/solids/volume_term.hpp"
 #include "sewn/physics/split_boxes.hpp"
 #include "sewn/physics/stiffness.hpp"
@@ -107,6 +109,7 @@ IndexedMesh generate(const MeshSpec& spec, const std::string& file, const std::s
     m = used_part(read, numbering);
     source.file = spec.path;
     source.element_tags = numbering.element_tags;
+    source.point_numbers = numbering.point_numbers;
     transform(m, spec.scale, spec.translate);
     io::check_mesh_geometry(m, spec.path, numbering);
   }
@@ -129,10 +132,15 @@ std::set<Index> selected_nodes(const Selector& where, const Assembly& assembly, 
           for (std::uint32_t q : cells->cell(c))
             if (model.node_of_point(q) != physics::invalid_index) nodes.insert(model.node_of_point(q));
   } else if (where.type == Selector::Type::points) {
-    for (std::uint32_t q : where.points) {
-      if (q >= mesh.num_points() || model.node_of_point(q) == physics::invalid_index)
-        throw SceneError(file, path + ".indices",
-                         "point " + std::to_string(q) + " is not a point of any cell (" + std::to_string(mesh.num_points()) + " points)");
+    for (std::size_t k = 0; k < where.points.size(); ++k) {
+      const std::uint32_t q = where.points[k];
+      const std::string at = path + ".indices[" + std::to_string(k) + "]";
+      if (q >= mesh.num_points())
+        throw SceneError(file, at, "point " + std::to_string(q) + " is past the scene's " + std::to_string(mesh.num_points()) + " points (numbered " +
+                                       point_numbering + ")");
+      if (model.node_of_point(q) == physics::invalid_index)
+        throw SceneError(file, at, "point " + std::to_string(q) + " (" + assembly.point_name(q, true) +
+                                       ") is a point of labels only (faces or edges of other cells), which carry no particle");
       nodes.insert(model.node_of_point(q));
     }
   } else {
@@ -147,6 +155,7 @@ std::set<Index> selected_nodes(const Selector& where, const Assembly& assembly, 
 // for it, are cut into near-cubes (physics/split_boxes.hpp) with their sheets' neighbours.
 void split_elongated(const Scene& scene, Assembly& a) {
   a.source_cells = a.mesh.num_cells();
+  a.source_points = a.mesh.num_points();
   std::vector<std::uint8_t> wanted(a.mesh.num_cells(), 0);
   bool any = false;
   for (std::uint32_t c = 0; c < a.mesh.num_cells(); ++c) {
@@ -157,7 +166,12 @@ void split_elongated(const Scene& scene, Assembly& a) {
     any = any || wanted[c] != 0;
   }
   if (!any) return;
-  physics::BoxSplit split = physics::split_boxes(a.mesh, wanted, scene.file);
+  physics::BoxSplit split;
+  try {
+    split = physics::split_boxes(a.mesh, wanted, scene.file);
+  } catch (const physics::CellInputError& e) {
+    throw physics::InputError(a.in_files(scene.file, e.message()));
+  }
   std::vector<std::uint32_t> material(split.source_cell.size());
   std::vector<CellModel> model(split.source_cell.size());
   std::vector<int> group(split.source_cell.size());
@@ -176,6 +190,7 @@ void split_elongated(const Scene& scene, Assembly& a) {
   a.model_of_cell = std::move(model);
   a.group_of_cell = std::move(group);
   a.file_cell = std::move(file_cell);
+  a.split_source = std::move(split.source_cell);
   a.split_asked = split.asked;
   a.split_cells = split.split;
 }
@@ -193,9 +208,46 @@ std::size_t Assembly::mesh_of_cell(std::uint32_t c) const {
   return static_cast<std::size_t>(std::upper_bound(first_cell.begin(), first_cell.end(), c) - first_cell.begin()) - 1;
 }
 
-physics::InputError Assembly::in_file(const std::string& scene_file, const physics::CellInputError& e) const {
-  const MeshSource& source = sources[mesh_of_cell(e.cell())];
-  return physics::InputError(scene_file + ": " + source.key + ": " + source.cell(file_cell[e.cell()]) + " " + e.detail());
+std::string Assembly::cell_name(std::uint32_t c, bool key) const {
+  const MeshSource& source = sources[mesh_of_cell(c)];
+  std::string piece;
+  if (!split_source.empty()) {
+    const auto [first, last] = std::equal_range(split_source.begin(), split_source.end(), split_source[c]);
+    if (last - first > 1) piece = "piece " + std::to_string(c - static_cast<std::uint32_t>(first - split_source.begin())) + " of ";
+  }
+  return (key ? source.key + " " : "") + piece + source.cell(file_cell[c]);
+}
+
+std::optional<std::size_t> Assembly::mesh_of_point(std::uint32_t p) const {
+  if (!split_source.empty() && p >= source_points) return std::nullopt;
+  return static_cast<std::size_t>(std::upper_bound(first_point.begin(), first_point.end(), p) - first_point.begin()) - 1;
+}
+
+std::string Assembly::point_name(std::uint32_t p, bool key) const {
+  const auto k = mesh_of_point(p);
+  if (!k) return "point " + std::to_string(p) + " (added by the split into near-cubes)";
+  return (key ? sources[*k].key + " " : "") + sources[*k].point(p - first_point[*k]);
+}
+
+std::string Assembly::in_files(const std::string& scene_file, const IndexedMessage& m) const {
+  // the scene mesh of each number: a message within one starts at its key
+  std::optional<std::size_t> one;
+  bool several = false;
+  for (const auto& r : m.refs()) {
+    if (r.kind == IndexedMessage::Ref::Kind::material) continue;
+    const auto k = r.kind == IndexedMessage::Ref::Kind::cell ? std::optional(mesh_of_cell(r.index)) : mesh_of_point(r.index);
+    several = several || !k || (one && *one != *k);
+    one = k;
+  }
+  const std::string text = m.render([&](const IndexedMessage::Ref& r) {
+    switch (r.kind) {
+      case IndexedMessage::Ref::Kind::cell: return cell_name(r.index, several);
+      case IndexedMessage::Ref::Kind::point: return point_name(r.index, several);
+      default:  // materials past the scene's are the copies apply_rod_sections made for rods
+        return r.index < material_names.size() ? "material \"" + material_names[r.index] + "\"" : "material " + std::to_string(r.index);
+    }
+  });
+  return scene_file + ": " + (one && !several ? sources[*one].key + ": " : "") + text;
 }
 
 Assembly assemble(const Scene& scene) {
@@ -247,6 +299,7 @@ Assembly assemble(const Scene& scene) {
                                   : ""));
     }
     const std::uint32_t first_point = append(a.mesh, piece);
+    a.first_point.push_back(first_point);
     for (std::uint32_t c = 0; c < labels.num_cells(); ++c) {
       std::vector<std::uint32_t> v(labels.cell(c).begin(), labels.cell(c).end());
       for (auto& q : v) q += first_point;
@@ -443,10 +496,15 @@ void warn_elongation_policies(const RunSummary& sum, const Assembly& assembly) {
                  "sewn: warning: %u cells are too elongated for Baudet's stiffness and were split into near-cubes "
                  "(materials' elongated = \"split\"); %u cells were cut in all, those included with the cells sharing "
                  "their split edges: %u cells and %u points now, from %u cells. Stiffnesses are Baudet's own, unaltered: on a 1 m cantilever the static tip is "
-                 "the cube-meshed beam's at 10:1 and 5:1 boxes and 3.1 %% softer at 2.5:1 (issue 17). Messages of the run "
-                 "number the split mesh's cells\n",
+                 "the cube-meshed beam's at 10:1 and 5:1 boxes and 3.1 %% softer at 2.5:1 (issue 17). Messages name a piece "
+                 "of a split cell as such\n",
                  assembly.split_asked, assembly.split_cells, assembly.mesh.num_cells(), assembly.mesh.num_points(),
                  assembly.source_cells);
+}
+
+// "the particle at meshes[1] point 40 of b.msh": particle `i` named by its point, as its file numbers it.
+std::string particle_name(const Assembly& assembly, const physics::MssModel<3>& model, Index i) {
+  return "the particle at " + assembly.point_name(model.point_of_node(i), true);
 }
 
 // The particles `motion` drives (held on every axis from here), none of them in `fixed`.
@@ -457,10 +515,10 @@ MotionDriver driven_particles(const Scene& scene, const Assembly& assembly, phys
     const std::set<Index> picked = selected_nodes(scene.motion_where[k], assembly, model, scene.file, path);
     for (Index i : picked)
       if (model.nodes().fixed(i) != physics::no_axes)
-        throw SceneError(scene.file, path, "selects particle " + std::to_string(i) + ", which `fixed` holds: a particle is either held or driven");
+        throw SceneError(scene.file, path, "selects " + particle_name(assembly, model, i) + ", which `fixed` holds: a particle is either held or driven");
     nodes.emplace_back(picked.begin(), picked.end());
   }
-  return MotionDriver(scene.motion, nodes, model.nodes(), scene.file);
+  return MotionDriver(scene.motion, nodes, model.nodes(), scene.file, [&](Index i) { return particle_name(assembly, model, i); });
 }
 
 // The fixed particles, the driven ones, then the initial velocities of the free axes.
@@ -515,7 +573,9 @@ Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum) {
   try {
     b.model = std::make_unique<physics::MssModel<3>>(assembly.mesh, materials, assembly.material_of_cell, model_options(scene));
   } catch (const physics::CellInputError& e) {
-    throw assembly.in_file(scene.file, e);
+    throw physics::InputError(assembly.in_files(scene.file, e.message()));
+  } catch (const MeshCellError& e) {
+    throw MeshError(assembly.in_files(scene.file, e.message()));
   }
   physics::MssModel<3>& model = *b.model;
   add_obstacles(model.system(), scene.obstacles);
@@ -529,11 +589,12 @@ Bodies build_bodies(const Scene& scene, bool quiet, RunSummary& sum) {
       b.continuum = build_continuum(scene, materials, assembly.mesh, assembly.model_of_cell, assembly.group_of_cell, model,
                                     held_nodes(scene, assembly, model));
     } catch (const physics::CellInputError& e) {
-      throw assembly.in_file(scene.file, e);
+      throw physics::InputError(assembly.in_files(scene.file, e.message()));
     }
   // the rotational energies where the bodies meet (model.connections), on the rest state
   if (scene.model != "mass-spring")
-    b.joints = build_connections(scene, assembly.mesh, assembly.model_of_cell, materials, b.continuum, model);
+    b.joints = build_connections(scene, assembly.mesh, assembly.model_of_cell, materials, b.continuum, model,
+                                 [&](std::uint32_t p) { return assembly.point_name(p, true); });
   // Rods whose twist no joint turns keep it quasi-static; under Newton it joins the linear system
   // condensed, so each Newton step is the reduced energy's exact one (docs/rods.md).
   if (b.continuum.rods && !b.continuum.rods->has_angle_dofs() && scene.integrator == "newton")

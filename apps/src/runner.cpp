@@ -168,6 +168,8 @@ class RunLoop {
   void apply_due_cuts(double t);
   refine::CutReport apply_cut(std::size_t k);
   int step(double t);
+  // A blow-up's message with the particle it names told as its file numbers its point.
+  [[nodiscard]] physics::BlowupError in_files(const physics::BlowupError& e) const;
   void check_energy(std::uint64_t step);
   void note_short_stop(double t, const physics::integrate::NewtonReport& rep);
   void refine_after(std::uint64_t step);
@@ -337,13 +339,17 @@ void RunLoop::check_inversion(std::uint64_t step) {
   inverted_now_ = c.elements;
   sum_.inverted_max = std::max<std::uint64_t>(sum_.inverted_max, c.elements);
   if (c.elements == 0 || !sum_.first_inversion.empty()) return;
-  char msg[300];
-  std::snprintf(msg, sizeof msg, "element %u (mesh cell %u) is inverted at step %llu (t = %.6g s)%s", c.first, c.first_cell,
-                static_cast<unsigned long long>(step), static_cast<double>(step) * scene_.step,
-                c.elements > 1 ? (", with " + std::to_string(c.elements - 1) + " more").c_str() : "");
+  // the cell as its file names it: elements past the mesh's cells are children of refinement
+  const Assembly& assembly = b_.assembly;
+  const std::string cell = (c.first < assembly.mesh.num_cells() ? "" : "refined from ") + assembly.cell_name(c.first_cell, true);
+  char when[100];
+  std::snprintf(when, sizeof when, " is inverted at step %llu (t = %.6g s)", static_cast<unsigned long long>(step),
+                static_cast<double>(step) * scene_.step);
+  const std::string msg = "element " + std::to_string(c.first) + " (" + cell + ")" + when +
+                          (c.elements > 1 ? ", with " + std::to_string(c.elements - 1) + " more" : "");
   sum_.first_inversion = msg;
   if (scene_.stop_on_inversion) throw std::runtime_error(std::string(msg) + "; stopped there (integrator.stop_on_inversion)");
-  if (!options_.quiet) std::fprintf(stderr, "\nsewn: warning: %s\n", msg);
+  if (!options_.quiet) std::fprintf(stderr, "\nsewn: warning: %s\n", msg.c_str());
 }
 
 void RunLoop::write_frame(double t) {
@@ -528,6 +534,17 @@ void RunLoop::note_short_stop(double t, const physics::integrate::NewtonReport& 
   if (!options_.quiet) std::fprintf(stderr, "%ssewn: warning: %s\n", bar_ ? "\n" : "", msg);
 }
 
+physics::BlowupError RunLoop::in_files(const physics::BlowupError& e) const {
+  const Index i = e.node();
+  if (i == physics::invalid_index || i >= model_.nodes().size()) return e;
+  const std::uint32_t p = model_.point_of_node(i);
+  // a cut's copy of a particle keeps its point; refinement's new particles have none
+  const std::string where = p < b_.assembly.mesh.num_points() ? "is a particle at " + b_.assembly.point_name(p, true)
+                                                               : "was added by refinement (no mesh point)";
+  return physics::BlowupError(std::string(e.what()) + "; node " + std::to_string(i) + " " + where, i, e.quantity(), e.step(),
+                              e.suggested_step());
+}
+
 void RunLoop::check_energy(std::uint64_t step) {
   if (!use_implicit_) return;
   const auto rise = ledger_.after_step(model_.system(), step);
@@ -578,7 +595,12 @@ void RunLoop::run() {
     const auto t0 = Clock::now();
     const std::clock_t c0 = std::clock();
     apply_due_cuts(t);
-    const int cg = step(t);
+    int cg = 0;
+    try {
+      cg = step(t);
+    } catch (const physics::BlowupError& e) {
+      throw in_files(e);
+    }
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     sum_.stepping += ms / 1e3;
     sum_.stepping_cpu += static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;

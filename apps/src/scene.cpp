@@ -40,7 +40,7 @@ Field selector_schema(std::string key, std::string doc) {
   s.variant("tag", "Cells carrying a mesh tag (Gmsh physical group, MEDIT reference); for points: points of such cells.",
             {field("tag", Kind::integer).required().at_least(-2147483648.0).at_most(2147483647.0).doc("The tag (a 32-bit signed integer).")});
   s.variant("points", "Mesh points by index (cells: all of whose points are listed).",
-            {field("indices", Kind::number_list).required().whole().at_least(0).at_most(max_point_index).items(1, 1u << 30).doc("Point indices.")});
+            {field("indices", Kind::number_list).required().whole().at_least(0).at_most(max_point_index).items(1, 1u << 30).doc(std::string("Point indices, numbered ") + point_numbering + ".")});
   return s;
 }
 
@@ -60,7 +60,7 @@ Field build_schema() {
       field("volume_stiffness", Kind::number).unit("Pa").fallback(0.0).at_least(0).at_most(1e13)
           .doc("Bulk stiffness κ of a volume-preserving term (Teschner et al. 2004): each tetrahedron, and each corner of a hexahedron with an eighth of its volume, stores ½ κ V̄ (V/V̄ - 1)². Springs see lengths, not orientation: a region much softer than its load (a 1 kPa region under a 1 GPa block) turns inside out, and κ well above the pressure it carries (e.g. 100× E for a soft, nearly incompressible solid) keeps it from inverting. 0: no term. Follows cuts (each element keeps its own particles after one) and `refinement` (each child gets its own stencils, a refined parent's are retired)."),
       field("elongated", Kind::string).one_of({"refuse", "clamp", "split"}).fallback("refuse")
-          .doc("Baudet's edge stiffness turns negative for boxes longer than ~1.5× their width. `refuse`: such an element is refused, naming it. `split`: each such hexahedron is cut into near-cubes (pieces of aspect at most √2) before the model is built, and so are the hexahedra sharing its split edges, so that the mesh stays conforming; on the 1 m cantilever at E = 100 MPa (4 cells through its thickness) the static tip is the cube-meshed beam's at 10:1 and 5:1 boxes (the pieces are its cubes) and 3.1 % softer at 2.5:1 (pieces of 0.83:1), at the cost of the cube mesh's particles. Cells of other types on a split edge are refused. Errors while the model is built name the file's cells; messages of the run (an inverted element, a cut) number the split mesh's cells. `clamp`: the negative edge stiffnesses are set to 0 and the diagonals carry the load along the long axis, which makes the body far too stiff in bending (on that cantilever: 4.8× at 2.5:1, 66× at 5:1, 860× at 10:1). Both `split` and `clamp` print a warning with the number of cells they changed."),
+          .doc("Baudet's edge stiffness turns negative for boxes longer than ~1.5× their width. `refuse`: such an element is refused, naming it. `split`: each such hexahedron is cut into near-cubes (pieces of aspect at most √2) before the model is built, and so are the hexahedra sharing its split edges, so that the mesh stays conforming; on the 1 m cantilever at E = 100 MPa (4 cells through its thickness) the static tip is the cube-meshed beam's at 10:1 and 5:1 boxes (the pieces are its cubes) and 3.1 % softer at 2.5:1 (pieces of 0.83:1), at the cost of the cube mesh's particles. Cells of other types on a split edge are refused. Messages name the file's cells, a piece of a split cell as such (\"piece 2 of cell 7 ...\"); the split's new points come after the mesh's, whose numbers stay. `clamp`: the negative edge stiffnesses are set to 0 and the diagonals carry the load along the long axis, which makes the body far too stiff in bending (on that cantilever: 4.8× at 2.5:1, 66× at 5:1, 860× at 10:1). Both `split` and `clamp` print a warning with the number of cells they changed."),
   });
 
   Field mesh = field("mesh", Kind::object);
@@ -148,9 +148,9 @@ Field build_schema() {
                selector_schema("within", "Only faces whose centroid lies in this region.")});
   cut.variant("faces", "Explicit faces, each given by its mesh point indices.",
               {field("faces", Kind::array).of(field("face", Kind::number_list).items(2, 4).whole().at_least(0).at_most(max_point_index)).items(1, 1u << 24).required()
-                   .doc("Each face as 3 or 4 point indices (2 for an edge of a 2D mesh).")});
+                   .doc(std::string("Each face as 3 or 4 point indices (2 for an edge of a 2D mesh), numbered ") + point_numbering + ".")});
   cut.variant("particles", "Every inner face (edge) all of whose points are among the listed particles: a cut along a path.",
-              {field("particles", Kind::number_list).whole().at_least(0).at_most(max_point_index).items(2, 1u << 30).required().doc("Mesh point indices.")});
+              {field("particles", Kind::number_list).whole().at_least(0).at_most(max_point_index).items(2, 1u << 30).required().doc(std::string("Mesh point indices, numbered ") + point_numbering + ".")});
   cut.variant("pierce", "Unsew every face of the volumes whose centroid lies in a region.",
               {selector_schema("where", "Volumes to free.").required(),
                field("remove", Kind::boolean).fallback(true).doc("Remove the freed volumes (true) or keep them as loose pieces.")});

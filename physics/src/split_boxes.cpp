@@ -8,6 +8,7 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "sewn/physics/cell_input_error.hpp"
 #include "sewn/physics/errors.hpp"
 #include "sewn/physics/mss_model.hpp"
 
@@ -142,9 +143,6 @@ std::array<double, 3> box_axis_lengths(const IndexedMesh& mesh, std::uint32_t ce
 
 BoxSplit split_boxes(const IndexedMesh& mesh, std::span<const std::uint8_t> wanted, const std::string& source) {
   const auto edges = MssModel<3>::local_edges(ElementKind::hexahedron);  // 4 per axis, axis-major
-  const auto cell_name = [&](std::uint32_t c) {
-    return source + ": cell " + std::to_string(c) + " (" + to_string(mesh.types[c]) + ")";
-  };
   BoxSplit out;
   Sheets sheets;
   for (std::uint32_t c = 0; c < mesh.num_cells(); ++c) {
@@ -164,8 +162,8 @@ BoxSplit split_boxes(const IndexedMesh& mesh, std::span<const std::uint8_t> want
     for (std::size_t a = 0; a < 3; ++a) {
       const std::uint32_t n = pieces(len[a], shortest);
       if (n > 4096)
-        throw InputError(cell_name(c) + ": splitting it into near-cubes would take " + std::to_string(n) +
-                         " pieces along one axis (at most 4096)");
+        throw CellInputError(source, IndexedMessage() << CellRef{c} << " (hexahedron): splitting it into near-cubes would take " +
+                                                                       std::to_string(n) + " pieces along one axis (at most 4096)");
       const std::uint32_t sheet = sheets.id(v[edges[4 * a][0]], v[edges[4 * a][1]]);
       std::uint32_t& count = sheets.count(sheet);
       if (n > count) asked_by[sheets.root(sheet)] = c;
@@ -184,12 +182,15 @@ BoxSplit split_boxes(const IndexedMesh& mesh, std::span<const std::uint8_t> want
           const double aspect = *std::max_element(len.begin(), len.end()) / *std::min_element(len.begin(), len.end());
           char ratio[32];
           std::snprintf(ratio, sizeof ratio, "%.3g:1", aspect);
-          throw InputError(cell_name(c) + " shares the edge (points " + std::to_string(v[i]) + ", " + std::to_string(v[j]) +
-                           ") with hexahedra split into near-cubes (its edge would be cut into " + std::to_string(sheets.count(*e)) +
-                           " pieces because hexahedron " + std::to_string(by) + ", " + ratio +
-                           ", is too elongated for Baudet's stiffness), and only hexahedra can follow such a split: a " +
-                           to_string(mesh.types[c]) + " would be left with a hanging point on its edge; mesh the "
-                           "elongated region finer, or use elongated = \"clamp\" there");
+          const std::string type = to_string(mesh.types[c]);
+          throw CellInputError(source, IndexedMessage()
+                                           << CellRef{c} << " (" + type + ") shares the edge from " << PointRef{v[i]} << " to "
+                                           << PointRef{v[j]} << " with hexahedra split into near-cubes (its edge would be cut into " +
+                                                                    std::to_string(sheets.count(*e)) + " pieces because the hexahedron "
+                                           << CellRef{by} << ", " + std::string(ratio) +
+                                                                 ", is too elongated for Baudet's stiffness), and only hexahedra can follow such a split: a " +
+                                                                 type + " would be left with a hanging point on its edge; mesh the "
+                                                                        "elongated region finer, or use elongated = \"clamp\" there");
         }
   }
 

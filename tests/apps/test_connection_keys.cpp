@@ -203,7 +203,7 @@ TEST_CASE("rods on and from a solid: curve and point connections with rod sides,
   sewn::physics::MssModel<3> model(m, materials, std::vector<std::uint32_t>{}, mo);
   const auto groups = std::vector<int>{-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 0, -1, -1};
   REQUIRE(groups.size() == m.num_cells());
-  const auto models = sewn::app::cell_models(m, sewn::io::embedded_cells(m), s, sewn::app::MeshSource{"m", "", {}}, groups);
+  const auto models = sewn::app::cell_models(m, sewn::io::embedded_cells(m), s, sewn::app::MeshSource{"m", "", {}, {}}, groups);
   const auto parts = sewn::app::build_continuum(s, materials, m, models, groups, model);
   const auto joints = sewn::app::build_connections(s, m, models, materials, parts, model);
   // two rods (split by group where they meet); detection chains segments by the same rule

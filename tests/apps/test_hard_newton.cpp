@@ -242,7 +242,7 @@ TEST_CASE("an explicit connection far from every mesh point says how far, and th
     "output": {"frames": 1, "vtu": false, "picture": {"enabled": false}}})");
   const std::string told = refusal(scene, "far_joint");
   // the tolerance, 1e-6 of the plate's diagonal (0.112 m), used to print as 0.000000 m
-  CHECK_MESSAGE(told.find("model.connections.explicit[0].at: no mesh point is there: the nearest is mesh point 9 at "
+  CHECK_MESSAGE(told.find("model.connections.explicit[0].at: no mesh point is there: the nearest is meshes[0] point 9 at "
                           "[0.1, 0.025, 0], 0.2 m away (tolerance 1.11803e-07 m)") != std::string::npos,
                 told);
 }

@@ -103,13 +103,13 @@ TEST_CASE("scene motion: bad values name the key") {
   // found when the particles are selected
   json held = beam_scene(R"([{"where": )" + end + R"(, "velocity": [1, 0, 0]}])");
   held["fixed"] = json::parse(R"([{"where": {"type": "box", "min": [0.99, -1, -1], "max": [2, 1, 1]}, "axes": "z"}])");
-  CHECK(error_of(held, true).find("motion[0].where: selects particle") == 0);
+  CHECK(error_of(held, true).find("motion[0].where: selects the particle at meshes[0] point ") == 0);
   CHECK(error_of(held, true).find("which `fixed` holds") != std::string::npos);
   CHECK(error_of(beam_scene(R"([{"where": {"type": "box", "min": [5, 5, 5], "max": [6, 6, 6]}, "velocity": [1, 0, 0]}])"), true) ==
         "motion[0].where: selects no particle");
   const std::string overlap = R"([{"where": )" + end + R"(, "velocity": [1, 0, 0], "until": 0.05},
                                   {"where": {"type": "all"}, "velocity": [0, 1, 0], "from": 0.04}])";
-  CHECK(error_of(beam_scene(overlap), true).find("motion[1].where: drives particle") == 0);
+  CHECK(error_of(beam_scene(overlap), true).find("motion[1].where: drives the particle at meshes[0] point ") == 0);
   CHECK(error_of(beam_scene(overlap), true).find("which motion[0] drives at overlapping times") != std::string::npos);
   // the same entries one after the other chain
   CHECK(error_of(beam_scene(R"([{"where": )" + end + R"(, "velocity": [1, 0, 0], "until": 0.05},

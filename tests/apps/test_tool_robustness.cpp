@@ -12,67 +12,18 @@
 #include <sstream>
 #include <string>
 #include <vector>
-#include "scratch.hpp"
+
+#include "sewn_tool.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path tool_scratch(const std::string& name) { return sewn::test::scratch("tool/" + name); }
-
-fs::path tool_write(const std::string& name, const std::string& text) {
-  const fs::path p = tool_scratch(name);
-  std::ofstream(p) << text;
-  return p;
-}
-
-std::string read(const fs::path& p) {
-  std::ifstream in(p);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-// Runs `sewn <args>` through bash (for ulimit), with `prefix` run first; returns the exit code
-// and fills `err` with what it printed (standard output and error).
-int run_sewn(const std::string& args, std::string& err, const std::string& prefix = "") {
-  const fs::path log = tool_scratch("stderr.txt");
-  const std::string inner = prefix + std::string(SEWN_BINARY) + " " + args + " > " + log.string() + " 2>&1";
-  const std::string cmd = "bash -c '" + inner + "'";
-  const int status = std::system(cmd.c_str());
-  err = read(log);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+using namespace sewn::test::tool;
 
 const std::string tiny_scene = R"({"materials": {"m": {"young": 1e6, "density": 1000}},
   "meshes": [{"type": "hex_grid", "material": "m", "cells": [1, 1, 1], "size": [0.1, 0.1, 0.1]}],
   "integrator": {"step": 0.001}, "duration": 0.2, "output": {"frames": 200}})";
-
-// A Gmsh 2.2 file of the given nodes ("tag x y z") and elements ("tag type tags... nodes").
-std::string msh(const std::vector<std::string>& nodes, const std::vector<std::string>& elements) {
-  std::string s = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n" + std::to_string(nodes.size()) + "\n";
-  for (const auto& n : nodes) s += n + "\n";
-  s += "$EndNodes\n$Elements\n" + std::to_string(elements.size()) + "\n";
-  for (const auto& e : elements) s += e + "\n";
-  return s + "$EndElements\n";
-}
-
-// The unit cube's 8 points (tags 1..8) and the given elements ("type tags... nodes"), tagged 1..n.
-std::string cube_msh(const std::vector<std::string>& elements) {
-  const char* corners[] = {"0 0 0", "1 0 0", "1 1 0", "0 1 0", "0 0 1", "1 0 1", "1 1 1", "0 1 1"};
-  std::vector<std::string> nodes, numbered;
-  for (int i = 0; i < 8; ++i) nodes.push_back(std::to_string(i + 1) + " " + corners[i]);
-  for (std::size_t i = 0; i < elements.size(); ++i) numbered.push_back(std::to_string(i + 1) + " " + elements[i]);
-  return msh(nodes, numbered);
-}
-
-// A scene of `meshes` (JSON objects) with model.type `model` and model.groups `groups` (a JSON list).
-std::string file_scene(const std::string& model, const std::vector<std::string>& meshes, const std::string& groups = "[]") {
-  std::string list;
-  for (const auto& m : meshes) list += (list.empty() ? "" : ", ") + m;
-  return R"({"materials": {"m": {"young": 1e6, "density": 1000}}, "model": {"type": ")" + model + R"(", "groups": )" + groups + R"(},
-      "meshes": [)" + list + R"(], "duration": 0.01})";
-}
-
-std::string file_mesh(const fs::path& p) { return R"({"type": "file", "path": ")" + p.string() + R"(", "material": "m"})"; }
 
 }  // namespace
 

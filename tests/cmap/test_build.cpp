@@ -307,6 +307,18 @@ TEST_CASE("bad meshes are refused with the cell named") {
     const auto msg = message_of([&] { build(m, t, strict); });
     CHECK(msg.find("three.msh") != std::string::npos);
     CHECK(msg.find("non-manifold") != std::string::npos);
+    // the cells apart, for a caller that numbers them as its files do
+    try {
+      UMap3 again;
+      build(again, t, strict);
+      FAIL("no error");
+    } catch (const MeshCellError& e) {
+      CHECK(e.message().refs().size() == 2);
+      const std::string renamed = e.message().render([](const IndexedMessage::Ref& r) { return "element " + std::to_string(r.index + 10); });
+      CHECK_MESSAGE(renamed == "3 cells share one face, among them element 10 (tetrahedron) and element 11 (tetrahedron) "
+                               "(a non-manifold face where a manifold is required)", renamed);
+      CHECK(std::string(e.what()) == "three.msh: " + e.message().str());
+    }
     UMap3 lax;
     const auto r = build_with_points(lax, t);
     CHECK(r.nonmanifold_facets == 1);

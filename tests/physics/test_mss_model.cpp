@@ -150,9 +150,12 @@ TEST_CASE("bad input is refused with the element or material named") {
     (void)MssModel<3>(long_boxes, {paper_material}, {});
     FAIL("no error");
   } catch (const CellInputError& e) {
-    CHECK(e.cell() == 0);
-    CHECK(e.detail().rfind("(hexahedron): too elongated", 0) == 0);
-    CHECK(std::string(e.what()).find(e.detail()) != std::string::npos);
+    REQUIRE(e.message().refs().size() == 1);
+    CHECK(e.message().refs()[0].kind == IndexedMessage::Ref::Kind::cell);
+    CHECK(e.message().refs()[0].index == 0);
+    const std::string renamed = e.message().render([](const IndexedMessage::Ref& r) { return "cell " + std::to_string(r.index + 40); });
+    CHECK(renamed.rfind("cell 40 (hexahedron): too elongated", 0) == 0);
+    CHECK(std::string(e.what()).find(e.message().str()) != std::string::npos);
   }
   MaterialParams clamped = paper_material;
   clamped.elongated = ElongatedPolicy::clamp;

@@ -11,6 +11,7 @@
 #include <Eigen/SparseCholesky>
 
 #include "helpers.hpp"
+#include "sewn/physics/cell_input_error.hpp"
 #include "sewn/physics/mss_model.hpp"
 #include "sewn/physics/split_boxes.hpp"
 #include "sewn/physics/stiffness.hpp"
@@ -115,7 +116,20 @@ TEST_CASE("split boxes: a 2.5:1 block and its neighbour across a shared face spl
                        doctest::Contains("mixed.msh: cell 1 (tetrahedron)"), InputError);
   // and why: which hexahedron asked, how elongated it is, how the edge would be cut
   CHECK_THROWS_WITH_AS((void)split_boxes(mixed, std::vector<std::uint8_t>{1, 0}, "mixed.msh"),
-                       doctest::Contains("cut into 10 pieces because hexahedron 0, 10:1, is too elongated"), InputError);
+                       doctest::Contains("cut into 10 pieces because the hexahedron cell 0, 10:1, is too elongated"), InputError);
+  // the cells and points apart, for a caller that names them as its files do
+  try {
+    (void)split_boxes(mixed, std::vector<std::uint8_t>{1, 0}, "mixed.msh");
+    FAIL("no error");
+  } catch (const CellInputError& e) {
+    const auto& refs = e.message().refs();
+    REQUIRE(refs.size() == 4);
+    CHECK((refs[0].kind == IndexedMessage::Ref::Kind::cell && refs[0].index == 1));
+    CHECK((refs[1].kind == IndexedMessage::Ref::Kind::point && refs[1].index == 0));
+    CHECK((refs[2].kind == IndexedMessage::Ref::Kind::point && refs[2].index == 1));
+    CHECK((refs[3].kind == IndexedMessage::Ref::Kind::cell && refs[3].index == 0));
+    CHECK_MESSAGE(std::string(e.what()).find("shares the edge from point 0 to point 1 with hexahedra split") != std::string::npos, e.what());
+  }
 }
 
 TEST_CASE("split boxes: the cantilever's static tip at 10:1, 5:1 and 2.5:1 boxes is the cube-meshed beam's to within 10 %") {

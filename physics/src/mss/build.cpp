@@ -173,11 +173,13 @@ void MssModel<D>::build_elements(const IndexedMesh& mesh, const BuildResult& bui
   for (std::uint32_t q = 0; q < mesh.num_points(); ++q) {
     if (cell_of_point[q] == mss_detail::no_cell || std::isnormal(point_mass[q])) continue;
     const std::uint32_t c = cell_of_point[q];
-    throw CellInputError(options_.source, c, "(" + std::string(to_string(mesh.types[c])) + ", material " +
-                     std::to_string(elements_[c].material) + "): its point " + std::to_string(q) + " gets a mass of " +
-                     mss_detail::sci(point_mass[q]) + " kg (density " + mss_detail::sci(materials_[elements_[c].material].density) +
-                     " kg/m³), which " + (std::isinf(point_mass[q]) ? "overflows" : "underflows") +
-                     " a double: the density or the cell size is out of range");
+    throw CellInputError(options_.source, IndexedMessage()
+                                              << CellRef{c} << " (" + std::string(to_string(mesh.types[c])) + ", "
+                                              << MaterialRef{elements_[c].material} << "): its "
+                                              << PointRef{q} << " gets a mass of " + mss_detail::sci(point_mass[q]) + " kg (density " +
+                                                                    mss_detail::sci(materials_[elements_[c].material].density) + " kg/m³), which " +
+                                                                    (std::isinf(point_mass[q]) ? "overflows" : "underflows") +
+                                                                    " a double: the density or the cell size is out of range");
   }
   node_of_point_.assign(mesh.num_points(), invalid_index);
   NodeTable& nodes = system_.nodes();

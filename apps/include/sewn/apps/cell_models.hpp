@@ -57,8 +57,12 @@ struct MeshSource {
   std::string key;
   std::string file;
   std::vector<std::int64_t> element_tags;
+  std::vector<std::int64_t> point_numbers;  ///< per point, the file's number of it (empty: generated, from 0)
   /// "cell 12 (Gmsh element 40) of b.msh", "cell 3" for a generated mesh (`key` names the mesh).
   [[nodiscard]] std::string cell(std::uint32_t c) const;
+  /// "point 40 of b.msh" (a Gmsh node tag, a MEDIT vertex from 1, a VTK point from 0), "point 3"
+  /// for a generated mesh.
+  [[nodiscard]] std::string point(std::uint32_t p) const;
 };
 
 /// The mesh of `file` without the points no cell uses (what `sewn run` simulates and `sewn check`

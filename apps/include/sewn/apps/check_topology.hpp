@@ -2,7 +2,9 @@
 // The topology part of `sewn check`: the invariants of a mesh's cell complex (cmap/topology.hpp,
 // cells identified by their points), as text for a person and as JSON for scripts.
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -17,6 +19,11 @@ struct MeshTopology {
   Topology topology;
   /// Mesh point of a vertex (by its dart) and the two points of an edge, for the report.
   std::vector<std::uint32_t> point_of_dart, next_of_dart;
+  /// How the report numbers mesh points: the file's number of each (io::MeshFile::point_numbers);
+  /// empty: their index in the mesh.
+  std::vector<std::int64_t> point_numbers;
+  /// Point `p` of the mesh as the report numbers it.
+  [[nodiscard]] std::int64_t number(std::uint32_t p) const { return point_numbers.empty() ? std::int64_t{p} : point_numbers[p]; }
 };
 
 /// Builds a map of the mesh's dimension and computes every invariant on the complex of the mesh

@@ -6,6 +6,7 @@
 // materials (docs/connect.md, "Connections in scenes").
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -47,11 +48,12 @@ struct ConnectionParts {
 /// rods' lightest section), which only the newton integrator takes. Registers
 /// follow_connections with the model. Throws SceneError naming the key: an explicit connection
 /// where no two bodies meet that way, a frame that cannot be built (the connection's name and
-/// the reason), rods with another integrator, refinement. Does nothing without the key.
-/// O(cells log cells).
+/// the reason), rods with another integrator, refinement; `point_name` names a mesh point in
+/// those messages (as its file numbers it: Assembly::point_name; none: "mesh point <index>").
+/// Does nothing without the key. O(cells log cells).
 ConnectionParts build_connections(const Scene& scene, const IndexedMesh& mesh, const std::vector<CellModel>& models,
                                   const std::vector<physics::MaterialParams>& materials, const ContinuumParts& parts,
-                                  physics::MssModel<3>& model);
+                                  physics::MssModel<3>& model, const std::function<std::string(std::uint32_t)>& point_name = {});
 
 /// The rule under cuts and piercings (docs/connect.md): each connection's nodes are taken again
 /// from the model elements its sides were built on. A connection is kept, on the nodes those

@@ -11,6 +11,7 @@
 // positions as the uninterrupted one.
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -50,10 +51,11 @@ class MotionDriver {
  public:
   MotionDriver() = default;
   /// `nodes[k]`: the particles entry k drives. Fixes every one on all axes; x₀ is its position
-  /// now. Throws SceneError (naming motion[k].where) for a particle two entries drive over
-  /// overlapping times. Entries driving one particle at disjoint times chain in time order.
+  /// now. Throws SceneError (naming motion[k].where, and the particle by `name`, or its index
+  /// if none) for a particle two entries drive over overlapping times. Entries driving one
+  /// particle at disjoint times chain in time order.
   MotionDriver(std::vector<MotionSpec> specs, const std::vector<std::vector<physics::Index>>& nodes, physics::NodeTable& table,
-               const std::string& file);
+               const std::string& file, const std::function<std::string(physics::Index)>& name = {});
 
   [[nodiscard]] bool empty() const { return driven_.empty(); }
   [[nodiscard]] std::size_t size() const { return driven_.size(); }

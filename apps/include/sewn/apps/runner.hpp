@@ -14,7 +14,7 @@
 #include "sewn/apps/cell_models.hpp"
 #include "sewn/apps/scene.hpp"
 #include "sewn/cmap/mesh.hpp"
-#include "sewn/physics/cell_input_error.hpp"
+#include "sewn/cmap/indexed_message.hpp"
 
 namespace sewn::app {
 
@@ -52,17 +52,30 @@ struct Assembly {
   std::vector<std::uint32_t> material_of_cell;
   std::vector<std::string> material_names;
   std::vector<std::uint32_t> first_cell;  ///< per scene mesh, its first cell in `mesh`
-  std::vector<MeshSource> sources;        ///< per scene mesh, how its file names its cells
+  std::vector<std::uint32_t> first_point; ///< per scene mesh, its first point in `mesh`
+  std::vector<MeshSource> sources;        ///< per scene mesh, how its file names its cells and points
   std::vector<std::uint32_t> file_cell;   ///< per cell of `mesh`, its index in its scene mesh's file (MeshSource)
   std::uint32_t split_asked = 0;  ///< hexahedra too elongated for Baudet's stiffness, split (materials' elongated = "split")
   std::uint32_t split_cells = 0;  ///< source cells cut into near-cubes (those and their sheets' neighbours)
   std::uint32_t source_cells = 0; ///< cells before the split
+  std::uint32_t source_points = 0; ///< points before the split (the split adds its points after them)
+  std::vector<std::uint32_t> split_source;  ///< per cell of `mesh`, the cell before the split it is (a piece of); empty: none split
 
   /// The scene mesh (index in `sources`) that cell `c` of `mesh` comes from.
   [[nodiscard]] std::size_t mesh_of_cell(std::uint32_t c) const;
-  /// A CellInputError of a model built on `mesh`, restated (same class of error) at the scene
-  /// mesh that holds the cell, naming it as its file does (MeshSource::cell).
-  [[nodiscard]] physics::InputError in_file(const std::string& scene_file, const physics::CellInputError& e) const;
+  /// The scene mesh that point `p` of `mesh` comes from; none for a point the split added.
+  [[nodiscard]] std::optional<std::size_t> mesh_of_point(std::uint32_t p) const;
+  /// Cell `c` of `mesh` as its file names it (MeshSource::cell), "piece p of cell k ..." for a
+  /// piece of a cell the split cut; with `key` its scene mesh first ("meshes[1] cell 3 ...").
+  [[nodiscard]] std::string cell_name(std::uint32_t c, bool key) const;
+  /// Point `p` of `mesh` as its file numbers it (MeshSource::point), with `key` its scene mesh
+  /// first ("meshes[1] point 40 of b.msh"); a point the split added says so.
+  [[nodiscard]] std::string point_name(std::uint32_t p, bool key) const;
+  /// A message about cells and points of `mesh` (physics::CellInputError, MeshCellError),
+  /// restated as "<scene_file>: <message>" with each named as its file does (cell_name,
+  /// MeshSource::point) and each material by its scene name; a message about one scene mesh
+  /// starts at its key ("meshes[1]: ...").
+  [[nodiscard]] std::string in_files(const std::string& scene_file, const IndexedMessage& m) const;
 };
 
 /// Generates or reads every mesh of the scene, places it, and assigns materials by region.

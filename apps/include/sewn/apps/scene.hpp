@@ -20,6 +20,12 @@ namespace sewn::app {
 
 using Vec3 = std::array<double, 3>;
 
+/// How scene keys number mesh points (`points` selectors, cuts' faces and particles), for their
+/// documentation and the messages about them.
+inline constexpr const char* point_numbering =
+    "from 0, over the scene's meshes in order (a mesh's `regions`: over that mesh alone), each mesh's points in its "
+    "file's order without those no cell uses";
+
 /// Where a rule applies: points (or cells, by their centroid) inside a region, or a mesh tag.
 struct Selector {
   enum class Type { all, box, sphere, tag, points } type = Type::all;

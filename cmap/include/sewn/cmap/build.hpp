@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "sewn/cmap/cmap.hpp"
+#include "sewn/cmap/indexed_message.hpp"
 #include "sewn/cmap/mesh.hpp"
 
 namespace sewn {
@@ -136,10 +137,11 @@ inline SharedEdges shared_edges(const IndexedMesh& mesh) {
 }  // namespace detail
 
 /// Creates the cells of `mesh` in `map` (which may already hold darts) and glues them as
-/// described above. Throws MeshError naming the cell for: an index out of range, a repeated
-/// point in a cell, a cell of higher dimension than the map, two volumes whose shared face has
-/// the same orientation in both (one is inverted), or a non-manifold facet when
-/// allow_nonmanifold is false. O(darts + points).
+/// described above. Throws MeshError naming the cell for an index out of range or a repeated
+/// point in a cell, and MeshCellError (the cells apart, to be named as a file does) for a cell of
+/// higher dimension than the map, two volumes whose shared face has the same orientation in both
+/// (one is inverted), or a non-manifold facet when allow_nonmanifold is false (or, of volumes,
+/// manifold_volumes is true). O(darts + points).
 template <int D, class... A>
 BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOptions& opt = {}) {
   constexpr std::uint32_t null = Dart::null_index;
@@ -154,8 +156,8 @@ BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOption
   for (std::uint32_t c = 0; c < nc; ++c) {
     const CellType t = mesh.types[c];
     if (cell_dimension(t) > D)
-      throw MeshError(opt.source + ": cell " + std::to_string(c) + " is a " + to_string(t) + " but the map has dimension " +
-                      std::to_string(D));
+      throw MeshCellError(opt.source, IndexedMessage() << CellRef{c} << " is a " + std::string(to_string(t)) +
+                                                              " but the map has dimension " + std::to_string(D));
     if (cell_dimension(t) == 3)
       for (auto f : cell_faces(t)) darts += f.size();
     else if (cell_dimension(t) == 2)
@@ -178,12 +180,18 @@ BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOption
 
   // 2) orient 2D cells: breadth-first over cells sharing a manifold edge, reversing a
   //    neighbour that runs along the shared edge in the same direction.
-  auto describe = [&](std::uint32_t cell) { return "cell " + std::to_string(cell) + " (" + to_string(mesh.types[cell]) + ")"; };
+  // "cell 3 (tetrahedron) and cell 7 (tetrahedron)", its numbers kept apart
+  auto two_cells = [&](std::uint32_t a, std::uint32_t b) {
+    IndexedMessage m;
+    m << CellRef{a} << " (" + std::string(to_string(mesh.types[a])) + ") and " << CellRef{b} << " (" + std::string(to_string(mesh.types[b])) + ")";
+    return m;
+  };
   const bool any_2d = std::any_of(mesh.types.begin(), mesh.types.end(), [](CellType t) { return cell_dimension(t) == 2; });
   const detail::SharedEdges shared = any_2d && (opt.orient_surfaces || (opt.sew && D >= 2)) ? detail::shared_edges(mesh) : detail::SharedEdges{};
   if (opt.sew && D >= 2 && shared.nonmanifold != 0 && !opt.allow_nonmanifold)
-    throw MeshError(opt.source + ": 3 or more cells share one edge, among them " + describe(shared.first_nonmanifold.first) +
-                    " and " + describe(shared.first_nonmanifold.second) + " (a non-manifold edge where a manifold is required)");
+    throw MeshCellError(opt.source, IndexedMessage() << "3 or more cells share one edge, among them "
+                                    << two_cells(shared.first_nonmanifold.first, shared.first_nonmanifold.second)
+                                    << " (a non-manifold edge where a manifold is required)");
   auto same_direction = [&](const detail::CellEdge& e0, const detail::CellEdge& e1) {
     return mesh.cell(e0.cell)[e0.k] == mesh.cell(e1.cell)[e1.k];  // both start at the same point
   };
@@ -318,9 +326,9 @@ BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOption
     if (count == 1) return;
     if (count > 2) {
       if (!opt.allow_nonmanifold || opt.manifold_volumes)
-        throw MeshError(opt.source + ": " + std::to_string(count) + " cells share one face, among them " +
-                        describe(first->cell) + " and " + describe((first + 1)->cell) +
-                        " (a non-manifold face where a manifold is required)");
+        throw MeshCellError(opt.source, IndexedMessage() << std::to_string(count) + " cells share one face, among them "
+                                        << two_cells(first->cell, (first + 1)->cell)
+                                        << " (a non-manifold face where a manifold is required)");
       ++res.nonmanifold_facets;
       return;
     }
@@ -332,8 +340,9 @@ BuildResult build(CMap<D, A...>& map, const IndexedMesh& mesh, const BuildOption
       std::uint32_t guard = 0;
       while (start_of(y) != want && guard++ < 4) y = map.b(y, 1);
       if (start_of(map.b(y, 1)) != start_of(a)) {
-        throw MeshError(opt.source + ": " + describe(first->cell) + " and " + describe((first + 1)->cell) +
-                        " share a face with the same orientation: one of them is inverted (negative volume)");
+        throw MeshCellError(opt.source, two_cells(first->cell, (first + 1)->cell)
+                                            << " share a face with the same orientation: both lie on the same side of it (they overlap), or one is inverted "
+                                               "(negative volume)");
       }
       std::uint32_t x = a;
       do {

@@ -1,28 +1,31 @@
 #pragma once
-// The InputError of one mesh cell, kept apart from errors.hpp so that what throws or catches it
-// alone depends on it.
+// The InputError of cells and points of one mesh, kept apart from errors.hpp so that what throws
+// or catches it alone depends on it.
 
 #include <cstdint>
 #include <string>
+#include <utility>
 
+#include "sewn/cmap/indexed_message.hpp"
 #include "sewn/physics/errors.hpp"
 
 namespace sewn::physics {
 
-/// Bad input in one cell of the mesh a model was built from. what() names the cell by its index
-/// in that mesh; cell() is that index and detail() the problem alone, so that a caller who built
-/// the mesh from files can name the cell as its file does.
+/// Bad input in cells or points of the mesh a model was built from. what() is
+/// "<source>: <message>", naming them by their index in that mesh; message() keeps the numbers
+/// apart (IndexedMessage) so that a caller who built the mesh from files can name them as its
+/// files do.
 class CellInputError : public InputError {
  public:
+  CellInputError(const std::string& source, IndexedMessage message)
+      : InputError(source + ": " + message.str()), message_(std::move(message)) {}
+  /// "cell <cell> <detail>", detail starting with the cell's type in parentheses.
   CellInputError(const std::string& source, std::uint32_t cell, const std::string& detail)
-      : InputError(source + ": cell " + std::to_string(cell) + " " + detail), cell_(cell), detail_(detail) {}
-  [[nodiscard]] std::uint32_t cell() const noexcept { return cell_; }
-  /// The message after "cell N ": what is wrong with it (starting with its type in parentheses).
-  [[nodiscard]] const std::string& detail() const noexcept { return detail_; }
+      : CellInputError(source, IndexedMessage() << CellRef{cell} << " " + detail) {}
+  [[nodiscard]] const IndexedMessage& message() const noexcept { return message_; }
 
  private:
-  std::uint32_t cell_;
-  std::string detail_;
+  IndexedMessage message_;
 };
 
 }  // namespace sewn::physics
