@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <cstdio>
 #include <map>
 #include <optional>
 #include <set>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -453,12 +455,32 @@ std::vector<std::string> coincidence_warnings(const Assembly& assembly) {
   for (const auto p : used) box.extend(Vec3d(mesh.points[p][0], mesh.points[p][1], mesh.points[p][2]));
   const double tol = 1e-9 * box.diagonal().norm();
   const auto x = [&](std::uint32_t p) { return Vec3d(mesh.points[p][0], mesh.points[p][1], mesh.points[p][2]); };
-  std::sort(used.begin(), used.end(), [&](std::uint32_t a, std::uint32_t b) { return mesh.points[a][0] < mesh.points[b][0]; });
+  // Points binned in cubes of side tol, each compared with the points of the 27 cubes around it:
+  // linear in the points (a sweep along x alone compared every pair of a structured grid's plane).
+  using Bin = std::array<std::int64_t, 3>;
+  const double side = tol > 0 ? tol : 1.0;  // every point at one place: one bin
+  const auto bin_of = [&](std::uint32_t p) {
+    const Vec3d u = (x(p) - box.min()) / side;  // at most ~1e9 (tol is 1e-9 of the diagonal)
+    return Bin{static_cast<std::int64_t>(u.x()), static_cast<std::int64_t>(u.y()), static_cast<std::int64_t>(u.z())};
+  };
+  const auto bin_hash = [](const Bin& b) {
+    return std::hash<std::int64_t>{}(b[0] * 73856093 ^ b[1] * 19349663 ^ b[2] * 83492791);
+  };
+  std::unordered_map<Bin, std::vector<std::uint32_t>, decltype(bin_hash)> bins(used.size(), bin_hash);
   std::uint64_t pairs = 0;
   std::array<std::uint32_t, 2> first{};
-  for (std::size_t i = 0; i < used.size(); ++i)
-    for (std::size_t j = i + 1; j < used.size() && mesh.points[used[j]][0] - mesh.points[used[i]][0] <= tol; ++j)
-      if ((x(used[i]) - x(used[j])).norm() <= tol && pairs++ == 0) first = {used[i], used[j]};
+  for (const auto p : used) {  // each pair met once: p against the points binned before it
+    const Bin b = bin_of(p);
+    for (std::int64_t dx = -1; dx <= 1; ++dx)
+      for (std::int64_t dy = -1; dy <= 1; ++dy)
+        for (std::int64_t dz = -1; dz <= 1; ++dz) {
+          const auto near = bins.find(Bin{b[0] + dx, b[1] + dy, b[2] + dz});
+          if (near == bins.end()) continue;
+          for (const auto q : near->second)
+            if ((x(p) - x(q)).norm() <= tol && pairs++ == 0) first = {std::min(p, q), std::max(p, q)};  // in the meshes' order
+        }
+    bins[b].push_back(p);
+  }
   if (pairs == 0) return {};
   std::string cells;  // a cell of each point of the first pair
   for (const auto p : first)

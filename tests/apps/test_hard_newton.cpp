@@ -184,7 +184,7 @@ TEST_CASE("a rod on a plate's node that is not the plate's own point is said to 
       run_quietly(scene(R"(, {"type": "polyline", "points": [[0.1, 0.025, 0], [0.1, 0.025, -0.02]], "material": "m"})"), "rod_on_plate");
   REQUIRE(both.model_warnings.size() == 1);
   CHECK_MESSAGE(both.model_warnings[0].find("1 pair(s) of distinct mesh points coincide (first: at (0.1, 0.025, 0), of "
-                                             "meshes[1] cell 0 (rod) and meshes[0] cell 6 (shell))") == 0,
+                                             "meshes[0] cell 6 (shell) and meshes[1] cell 0 (rod))") == 0,
                 both.model_warnings[0]);
   CHECK(both.connections.find("none") != std::string::npos);  // what the run simulated: no joint
 }
