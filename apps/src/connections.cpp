@@ -578,7 +578,8 @@ void follow_connections(const ConnectionParts& joints, const physics::MssModel<3
 }
 
 std::string connection_energies_text(const ConnectionParts& c) {
-  if (!c.points && !c.curves) return "";
+  if (!c.sources) return "";  // model.connections not given
+  if (!c.points && !c.curves) return "  energies: none (model.connections is given, but no joint found takes a rotational energy from it)\n";
   return "  energies: " + std::to_string(c.point_joints) + " point, " + std::to_string(c.curve_joints) + " curve (" +
          std::to_string(c.curve_elements) + " edge terms)\n";
 }

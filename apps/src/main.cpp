@@ -186,7 +186,7 @@ int cmd_run(const std::vector<std::string>& args) {
         std::printf("connections found between the bodies (positions shared; no rotational energies: model.connections not given):\n%s",
                     s.connections.c_str());
       else
-        std::printf("connections found between the bodies, with rotational energies (model.connections):\n%s%s", s.connections.c_str(),
+        std::printf("connections found between the bodies, and their rotational energies (model.connections):\n%s%s", s.connections.c_str(),
                     s.connection_energies.c_str());
     }
   }

@@ -91,6 +91,16 @@ double mast_tilt(bool connections, int steps) {
   return std::atan2(rest.cross(now).norm(), rest.dot(now));
 }
 
+TEST_CASE("the run's summary says whether model.connections was given when it built no energy") {
+  Scene scene = sewn::app::load_scene(fin_path);
+  scene.connections.detect = false;  // given, but choosing no joint
+  REQUIRE(scene.connections.explicit_connections.empty());
+  CHECK(sewn::app::connection_energies_text(build_fin(scene)->joints) ==
+        "  energies: none (model.connections is given, but no joint found takes a rotational energy from it)\n");
+  scene.connections.enabled = false;
+  CHECK(sewn::app::connection_energies_text(build_fin(scene)->joints).empty());
+}
+
 TEST_CASE("the fin scene's joints get energies: one rod-shell point, four shell-solid curve edges") {
   const Scene scene = sewn::app::load_scene(fin_path);
   REQUIRE(scene.connections.enabled);

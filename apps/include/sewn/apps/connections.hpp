@@ -65,7 +65,8 @@ ConnectionParts build_connections(const Scene& scene, const IndexedMesh& mesh, c
 /// the particles); calling it again changes nothing. O(connections).
 void follow_connections(const ConnectionParts& joints, const physics::MssModel<3>& model);
 
-/// One line for the run's summary: "  energies: 1 point, 4 curve (4 edges)". Empty without connections.
+/// One line for the run's summary: "  energies: 1 point, 4 curve (4 edges)", or "  energies: none (...)"
+/// when model.connections built none. Empty when model.connections is not given.
 std::string connection_energies_text(const ConnectionParts& c);
 
 }  // namespace sewn::app
