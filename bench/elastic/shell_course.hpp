@@ -148,13 +148,7 @@ Surface grid_surface(int cols, int rows, bool wrap_u, Mesh mesh, unsigned seed, 
   for (int j = 0; j < rows; ++j)
     for (int i = 0; i < cols; ++i) {
       const auto p = id(i, j), q = id(i + 1, j), r = id(i + 1, j + 1), w = id(i, j + 1);
-      if (mesh == Mesh::jittered && coin(rng)) {
-        s.triangles.push_back({p, q, w});
-        s.triangles.push_back({q, r, w});
-      } else {
-        s.triangles.push_back({p, q, r});
-        s.triangles.push_back({p, r, w});
-      }
+      shell_strip::add_cell(s.triangles, {p, q, r, w}, mesh == Mesh::jittered && coin(rng));
     }
   return s;
 }

@@ -48,6 +48,18 @@ inline const char* bending_name(Bending b) {
   return "?";
 }
 
+/// A grid cell (corners p, q, r, u counter-clockwise) as two triangles: across the diagonal p-r,
+/// or across q-u when `other_diagonal`.
+inline void add_cell(std::vector<std::array<physics::Index, 3>>& triangles, std::array<physics::Index, 4> c, bool other_diagonal) {
+  if (other_diagonal) {
+    triangles.push_back({c[0], c[1], c[3]});
+    triangles.push_back({c[1], c[2], c[3]});
+  } else {
+    triangles.push_back({c[0], c[1], c[2]});
+    triangles.push_back({c[0], c[2], c[3]});
+  }
+}
+
 inline const char* mesh_name(Mesh m) {
   switch (m) {
     case Mesh::square: return "square";
@@ -153,13 +165,7 @@ inline Strip strip_mesh(Mesh mesh, int nx, const Shape& shape = {}) {
     for (int i = 0; i + 1 < cols; ++i) {
       const auto p = id(i, j), q = id(i + 1, j), r = id(i + 1, j + 1), u = id(i, j + 1);
       const bool other = mesh == Mesh::flipped || ((mesh == Mesh::jittered || mesh == Mesh::diagonals) && coin(rng));
-      if (other) {
-        s.triangles.push_back({p, q, u});
-        s.triangles.push_back({q, r, u});
-      } else {
-        s.triangles.push_back({p, q, r});
-        s.triangles.push_back({p, r, u});
-      }
+      add_cell(s.triangles, {p, q, r, u}, other);
     }
   return s;
 }
